@@ -1,0 +1,35 @@
+# `make demo`, `make test`, `make bench`: each creates .venv when it is missing.
+SHELL := /bin/bash
+VENV := .venv
+PY := $(VENV)/bin/python
+MPIEXEC := $(VENV)/bin/mpiexec
+# Python >= 3.12 from pyenv (the dolfinx wheel needs it); PYTHON=... overrides.
+PYTHON ?= $(firstword $(wildcard $(shell pyenv root 2>/dev/null)/versions/3.1[2-9]*/bin/python3) \
+	$(wildcard $(HOME)/.pyenv/versions/3.1[2-9]*/bin/python3) $(shell command -v python3.12))
+
+.PHONY: demo test test-serial test-mpi bench lint clean
+
+$(VENV)/.installed: pyproject.toml
+	@if [ -z "$(PYTHON)" ]; then \
+	  echo "error: no Python >= 3.12 found; install one (e.g. 'pyenv install 3.12') or run 'make PYTHON=/path/to/python3.12'"; exit 1; fi
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	@touch $@
+
+demo: $(VENV)/.installed
+	$(PY) demos/newton_scalar.py
+
+test: test-serial test-mpi
+
+test-serial: $(VENV)/.installed
+	$(PY) -m pytest -m "not mpi" -q
+
+test-mpi: $(VENV)/.installed
+	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider
+
+bench: $(VENV)/.installed
+	$(PY) benchmarks/newton.py
+
+clean:
+	rm -rf $(VENV) *.egg-info

@@ -1,0 +1,143 @@
+# # Newton, modified Newton and secant on a scalar equation
+#
+# The course's first look at Newton-type methods: solve $r(u) = 0$ and watch how fast
+# the error $e_k = u_k - u$ falls.
+#
+# ## Problem definition
+#
+# $$ \text{Newton: } u_{k+1} = u_k - \frac{r(u_k)}{r'(u_k)}, \qquad
+#    \text{modified: } u_{k+1} = u_k - \frac{r(u_k)}{K}, \qquad
+#    \text{secant: } u_{k+1} = u_k - r(u_k)\frac{u_k - u_{k-1}}{r(u_k) - r(u_{k-1})} $$
+#
+# Near the root, $|e_{k+1}| \approx C |e_k|^q$ with $q = 2$ (Newton), $q = 1$ and
+# $C = |1 - r'(u)/K|$ (modified), $q = (1+\sqrt5)/2 \approx 1.618$ (secant).
+# The observed order is $q_k = \ln(e_{k+1}/e_k) / \ln(e_k/e_{k-1})$.
+#
+# In double precision round-off arrives after three or four useful iterates, too few to
+# watch an order settle, so by default the iterations run in 60-digit arithmetic (mpmath);
+# `--digits 16` uses plain floats.
+#
+# ## Implementation
+
+# +
+import argparse
+import json
+import sys
+import time
+
+import mpmath
+
+from fenics_nl import scalar
+
+# Each function: r(u), a starting point, and what it models.
+FUNCTIONS = {
+    "spring": (lambda u: mpmath.tanh(u) + 0.2 * u - 1, 0.0,
+               "softening spring tanh(u) + 0.2 u = 1 (initial slope stiffer than at the root)"),
+    "hardening": (lambda u: u + u**3 - 3, 0.5,
+                  "hardening spring u + u^3 = 3 (modified Newton with r'(u0) diverges)"),
+    "cubic": (lambda u: u**3 - 2 * u - 5, 2.0, "Newton's own example u^3 - 2u - 5 = 0"),
+    "kepler": (lambda u: u - 0.5 * mpmath.sin(u) - 1.0, 1.0,
+               "Kepler's equation E - e sin E = M (e = 0.5, M = 1)"),
+}
+# -
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__ or "Scalar Newton-type iterations.",
+                                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p.add_argument("--function", choices=FUNCTIONS, default="spring",
+                   help="equation r(u) = 0 to solve (dimensionless)")
+    p.add_argument("--u0", type=float, default=None, help="starting point (default per function)")
+    p.add_argument("--slope", type=float, default=None,
+                   help="constant slope K of modified Newton (default r'(u0))")
+    p.add_argument("--digits", type=int, default=60,
+                   help="decimal digits of the arithmetic (16 = double precision floats)")
+    p.add_argument("--maxit", type=int, default=500, help="iteration limit per method")
+    p.add_argument("--json", metavar="PATH", help="write orders and iteration counts as JSON")
+    p.add_argument("--plot", metavar="PATH", help="draw |e_k| against k (log scale) to PATH")
+    args = p.parse_args(argv)
+    if not 16 <= args.digits <= 1000:
+        p.error(f"--digits must be in [16, 1000], got {args.digits}")
+    if args.slope is not None and args.slope == 0:
+        p.error("--slope must be non-zero")
+    return args
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    t0 = time.perf_counter()
+    r, u0_default, what = FUNCTIONS[args.function]
+    u0 = args.u0 if args.u0 is not None else u0_default
+    if args.digits > 16:
+        mpmath.mp.dps = args.digits
+        num, tol = mpmath.mpf, mpmath.mpf(10) ** (5 - args.digits)
+    else:
+        num, tol = float, 1e-14
+        r = (lambda f: lambda u: float(f(u)))(r)
+    print(f"r(u) = 0: {what}; u0 = {u0}, {args.digits} digits")
+
+    # Solve with the three methods; a failure (modified Newton with a bad K, say) is reported.
+    # +
+    results = {}
+    for method in scalar.METHODS:
+        k = num(args.slope) if args.slope is not None else None
+        try:
+            results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, maxit=args.maxit)
+        except scalar.ScalarSolveError as err:
+            print(f"error: {err}", file=sys.stderr)
+            return 1
+    # -
+
+    expected = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
+    summary = {}
+    for method, res in results.items():
+        orders = [float(q) for q in res.orders]
+        order = orders[-1] if orders else float("nan")
+        summary[method] = {"order": order, "expected_order": expected[method],
+                           "iterations": res.iterations, "root": float(res.root),
+                           "orders": orders}
+        print(f"\n{method}: {res.iterations} iterations, root {mpmath.nstr(res.root, 17)}")
+        print("  k   u_k                     |r(u_k)|     q_k")
+        q = [None, None, *orders] if len(orders) + 2 <= len(res.iterates) else orders
+        for i, (u, ru) in enumerate(zip(res.iterates, res.residuals, strict=True)):
+            if i > 12 and i < len(res.iterates) - 3:
+                if i == 13:
+                    print("  ...")
+                continue
+            qi = f"{q[i]:.3f}" if i < len(q) and q[i] is not None else ""
+            print(f"  {i:<3d} {mpmath.nstr(u, 20):<23s} {float(abs(ru)):<12.3e} {qi}")
+        print(f"  observed order {order:.3f} (theory {expected[method]:.3f})")
+    summary["function"] = args.function
+    summary["wall_time_s"] = time.perf_counter() - t0
+
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(summary, f, indent=2)
+    if args.plot:
+        plot(results, args.plot, what)
+    return 0
+
+
+def plot(results, path, title):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for method, res in results.items():
+        root = res.iterates[-1]
+        err = [float(abs(u - root)) for u in res.iterates[:-1]]
+        ax.semilogy(range(len(err)), err, "o-", ms=3, label=method)
+    ax.set_xlabel("iteration k")
+    ax.set_ylabel("|u_k - u|")
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,84 @@
+"""PETSc KSP set-ups for the tangent systems: MUMPS LU/Cholesky, or CG + GAMG.
+
+hypre is not in this PETSc build, so the iterative option is CG preconditioned by smoothed
+aggregation (GAMG) with the rigid-body modes as near-nullspace: without them GAMG's
+coarse spaces miss rotations and CG stalls on elasticity.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from dolfinx import fem, la
+from petsc4py import PETSc
+
+KINDS = ("lu", "cholesky", "gamg")
+
+
+def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
+    """Orthonormal rigid-body modes (translations, rotations) of a vector P1/P2 space."""
+    gdim = V.mesh.geometry.dim
+    x = V.tabulate_dof_coordinates()
+    n_owned = V.dofmap.index_map.size_local
+    bs = V.dofmap.index_map_bs
+    x = x[:n_owned]
+    rotations = [(0, 1)] if gdim == 2 else [(0, 1), (1, 2), (2, 0)]
+    modes = [la.vector(V.dofmap.index_map, bs=bs) for _ in range(gdim + len(rotations))]
+    for i in range(gdim):  # translations
+        modes[i].array[i:n_owned * bs:bs] = 1.0
+    for k, (i, j) in enumerate(rotations):  # rotation in the (i, j) plane: (-x_j, x_i)
+        a = modes[gdim + k].array
+        a[i:n_owned * bs:bs] = -x[:, j]
+        a[j:n_owned * bs:bs] = x[:, i]
+    vecs = [m.petsc_vec for m in modes]
+    la.orthonormalize(vecs)
+    ns = PETSc.NullSpace().create(vectors=vecs, comm=V.mesh.comm)
+    ns._fenics_nl_keep = modes  # the PETSc vectors borrow these arrays
+    return ns
+
+
+def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
+               near_nullspace: PETSc.NullSpace | None = None, rtol: float = 1e-10) -> PETSc.KSP:
+    """A KSP on `A`: direct MUMPS LU/Cholesky, or CG+GAMG (needs `near_nullspace`).
+
+    PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
+    command line can override every choice made here.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"linear solver must be one of {', '.join(KINDS)}, got {kind!r}")
+    ksp = PETSc.KSP().create(A.comm)
+    ksp.setOptionsPrefix(prefix)
+    ksp.setOperators(A)
+    pc = ksp.getPC()
+    if kind in ("lu", "cholesky"):
+        ksp.setType("preonly")
+        pc.setType(kind)
+        pc.setFactorSolverType("mumps")
+        if kind == "cholesky":
+            A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    else:
+        if near_nullspace is None:
+            raise ValueError("the gamg solver needs the rigid-body near-nullspace")
+        A.setNearNullSpace(near_nullspace)
+        ksp.setType("cg")
+        ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
+        pc.setType("gamg")
+        ksp.setErrorIfNotConverged(True)
+    ksp.setFromOptions()
+    return ksp
+
+
+def owned_dof_count(V: fem.FunctionSpace) -> int:
+    """Number of scalar unknowns of V summed over ranks."""
+    im = V.dofmap.index_map
+    return int(im.size_global * V.dofmap.index_map_bs)
+
+
+def zero_vector(x: PETSc.Vec) -> None:
+    """Zero a (ghosted) PETSc vector including its ghost entries."""
+    with x.localForm() as loc:
+        loc.set(0.0)
+
+
+def is_finite(value: float) -> bool:
+    """True when `value` is a finite float."""
+    return bool(np.isfinite(value))

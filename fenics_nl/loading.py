@@ -1,0 +1,88 @@
+"""Incremental loading: a load factor t from 0 to 1 with adaptive step control.
+
+Each step sets the load (a user callback, typically scaling `fem.Constant` values), calls the
+solver, and on failure restores the last converged state and halves the step. After an easy
+step (few iterations) the step grows. Below `min_step` it stops with a clear error.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from fenics_nl.newton import ConvergenceError, NewtonResult, WorkCounts
+
+log = logging.getLogger(__name__)
+
+
+class LoadStepError(RuntimeError):
+    """The load could not be reached: the step was cut below its minimum."""
+
+
+@dataclass
+class LoadPath:
+    """Converged load factors and their solve results."""
+
+    factors: list[float] = field(default_factory=list)
+    results: list[NewtonResult] = field(default_factory=list)
+    failures: int = 0
+    work: WorkCounts = field(default_factory=WorkCounts)
+
+    @property
+    def iterations(self) -> int:
+        """Newton iterations summed over converged steps."""
+        return sum(r.iterations for r in self.results)
+
+
+def solve_incrementally(
+    solver,
+    set_load: Callable[[float], None],
+    steps: int = 1,
+    *,
+    adaptive: bool = True,
+    min_step: float = 1e-4,
+    max_step: float = 1.0,
+    easy_iterations: int = 4,
+    on_step: Callable[[float, NewtonResult], None] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> LoadPath:
+    """Drive the load factor from 0 to 1, starting with `steps` equal increments."""
+    if steps < 1:
+        raise ValueError(f"steps must be >= 1, got {steps}")
+    path = LoadPath()
+    x = solver.u.x.petsc_vec
+    saved = x.copy()
+    t, dt = 0.0, 1.0 / steps
+    while t < 1.0 - 1e-12:
+        dt = min(dt, 1.0 - t)
+        set_load(t + dt)
+        try:
+            result = solver.solve()
+        except ConvergenceError as err:
+            path.failures += 1
+            path.work.add(err.result.work)
+            saved.copy(x)
+            x.ghostUpdate()
+            if not adaptive or dt / 2 < min_step:
+                set_load(t)
+                raise LoadStepError(f"load factor {t + dt:.4g} not reached from {t:.4g}: {err}"
+                                    + ("" if not adaptive else f"; step cut below {min_step:g}")
+                                    ) from err
+            dt /= 2
+            if progress:
+                progress(f"  step to t = {t + 2 * dt:.4g} failed ({err}); cut to dt = {dt:.4g}")
+            continue
+        t += dt
+        x.copy(saved)
+        path.factors.append(t)
+        path.results.append(result)
+        path.work.add(result.work)
+        if progress:
+            progress(f"step {len(path.factors)}: t = {t:.4g}, {result.iterations} iterations, "
+                     f"|R| = {result.residual_norms[-1]:.2e}")
+        if on_step:
+            on_step(t, result)
+        if adaptive and result.iterations <= easy_iterations:
+            dt = min(1.5 * dt, max_step)
+    return path

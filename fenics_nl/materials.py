@@ -1,0 +1,178 @@
+"""Materials as free-energy densities in UFL; stress and tangent are derived, never typed.
+
+Small strain (HPP): `φ(ε)`, `σ = ∂φ/∂ε`, `A = ∂²φ/∂ε∂ε`.
+Finite strain: `φ(e)` in the Green–Lagrange strain `e`, `S = ∂φ/∂e`, `P = F·S`.
+
+Strains are 3x3 (see `kinematics`), except plane stress, where a 2x2 strain is passed and
+the materials that support it use the plane-stress Lamé constant `λ* = 2λμ/(λ + 2μ)`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+from fenics_nl import kinematics
+
+
+def check_range(name: str, value: float, low: float, high: float) -> None:
+    """Raise ValueError unless low < value < high (a bound may be ±inf)."""
+    if not (low < float(value) < high):
+        raise ValueError(f"{name} must be in ({low:g}, {high:g}), got {value!r}")
+
+
+@dataclass(frozen=True)
+class Isotropic:
+    """Young's modulus E > 0 and Poisson's ratio -1 < ν < 0.5."""
+
+    E: float
+    nu: float
+
+    def __post_init__(self):
+        check_range("E", self.E, 0.0, float("inf"))
+        check_range("nu", self.nu, -1.0, 0.5)
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus μ."""
+        return self.E / (2 * (1 + self.nu))
+
+    @property
+    def lmbda(self) -> float:
+        """First Lamé constant λ."""
+        return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+
+    @property
+    def kappa(self) -> float:
+        """Bulk modulus κ."""
+        return self.E / (3 * (1 - 2 * self.nu))
+
+    def lmbda_for(self, strain) -> float:
+        """λ for a 3x3 strain, the plane-stress λ* for a 2x2 one."""
+        if strain.ufl_shape[0] == 2:
+            return 2 * self.lmbda * self.mu / (self.lmbda + 2 * self.mu)
+        return self.lmbda
+
+    def require_3x3(self, strain) -> None:
+        """Raise ValueError for a plane-stress (2x2) strain this energy does not support."""
+        if strain.ufl_shape[0] != 3:
+            raise ValueError(f"{type(self).__name__} does not support the plane-stress model")
+
+
+class SmallStrain:
+    """Mixin: stress, tangent and virtual work derived from `energy(ε)`."""
+
+    finite_strain = False
+
+    def energy(self, eps):
+        """Free-energy density φ(ε)."""
+        raise NotImplementedError
+
+    def stress(self, eps):
+        """Cauchy stress σ = ∂φ/∂ε."""
+        eps = ufl.variable(eps)
+        return ufl.diff(self.energy(eps), eps)
+
+    def tangent(self, eps):
+        """Tangent moduli A = ∂²φ/∂ε∂ε (fourth-order tensor)."""
+        eps = ufl.variable(eps)
+        return ufl.diff(ufl.diff(self.energy(eps), eps), eps)
+
+    def internal_work(self, u, v, model: str = "3d"):
+        """Integrand of the internal virtual work σ(ε(u)) : ε(v) (times 2πr if axisymmetric)."""
+        mesh = u.ufl_function_space().mesh
+        eps_u = kinematics.small_strain(u, model)
+        eps_v = kinematics.small_strain(v, model)
+        return ufl.inner(self.stress(eps_u), eps_v) * kinematics.measure_weight(mesh, model)
+
+
+class FiniteStrain:
+    """Mixin: second and first Piola stresses and virtual work derived from `energy(e)`."""
+
+    finite_strain = True
+
+    def energy(self, e):
+        """Free-energy density φ(e) per unit reference volume."""
+        raise NotImplementedError
+
+    def second_piola(self, e):
+        """S = ∂φ/∂e."""
+        e = ufl.variable(e)
+        return ufl.diff(self.energy(e), e)
+
+    def first_piola(self, u, model: str = "3d"):
+        """P = F·S(e(u))."""
+        F = kinematics.deformation_gradient(u, model)
+        return F * self.second_piola(kinematics.green_lagrange(u, model))
+
+    def internal_work(self, u, v, model: str = "3d"):
+        """Integrand of P(u) : ∇v over the reference configuration (times 2πR if axisymmetric)."""
+        mesh = u.ufl_function_space().mesh
+        H_v = kinematics.displacement_gradient(v, model)
+        return ufl.inner(self.first_piola(u, model), H_v) * kinematics.measure_weight(mesh, model)
+
+
+@dataclass(frozen=True)
+class LinearElastic(Isotropic, SmallStrain):
+    """Hooke's law: φ(ε) = λ/2 (tr ε)² + μ ε:ε."""
+
+    def energy(self, eps):
+        """φ(ε)."""
+        return 0.5 * self.lmbda_for(eps) * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
+
+
+@dataclass(frozen=True)
+class PowerLaw(Isotropic, SmallStrain):
+    """Deformation-theory power-law elasticity, linear at small strain.
+
+    φ(ε) = κ/2 (tr ε)² + σ0 ε0/(n+1) [(1 + (ε_eq/ε0)²)^((n+1)/2) − 1],
+    with ε_eq² = ⅔ dev ε : dev ε and ε0 = σ0/(3μ). The energy depends on ε_eq only through
+    ε_eq², so it is smooth at zero strain (this is the regularisation): there the tangent is
+    Hooke's (E, ν); for ε_eq ≫ ε0, σ_eq ≈ σ0 (ε_eq/ε0)^n. n = 1 is exactly Hooke's law,
+    n < 1 softens (hardening plasticity-like), n > 1 stiffens. Convex for every n > 0.
+    """
+
+    sigma0: float = 1.0
+    n: float = 1.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        check_range("sigma0", self.sigma0, 0.0, float("inf"))
+        check_range("n", self.n, 0.0, float("inf"))
+
+    @property
+    def eps0(self) -> float:
+        """Reference strain ε0 = σ0 / (3μ), where the law turns non-linear."""
+        return self.sigma0 / (3 * self.mu)
+
+    def energy(self, eps):
+        """φ(ε)."""
+        self.require_3x3(eps)
+        d = ufl.dev(eps)
+        x2 = (2.0 / 3.0) * ufl.inner(d, d) / self.eps0**2
+        n = self.n
+        return 0.5 * self.kappa * ufl.tr(eps) ** 2 + self.sigma0 * self.eps0 / (n + 1) * (
+            (1 + x2) ** ((n + 1) / 2) - 1
+        )
+
+
+@dataclass(frozen=True)
+class StVenantKirchhoff(Isotropic, FiniteStrain):
+    """St Venant–Kirchhoff: φ(e) = λ/2 (tr e)² + μ e:e (the course's finite-strain law)."""
+
+    def energy(self, e):
+        """φ(e)."""
+        return 0.5 * self.lmbda_for(e) * ufl.tr(e) ** 2 + self.mu * ufl.inner(e, e)
+
+
+@dataclass(frozen=True)
+class NeoHookean(Isotropic, FiniteStrain):
+    """Compressible neo-Hookean: φ = μ/2 (tr C − 3) − μ ln J + λ/2 (ln J)², C = I + 2e."""
+
+    def energy(self, e):
+        """φ(e)."""
+        self.require_3x3(e)
+        C = ufl.Identity(3) + 2 * e
+        lnJ = 0.5 * ufl.ln(ufl.det(C))
+        return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2

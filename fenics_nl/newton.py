@@ -1,0 +1,318 @@
+"""The Newton family on PETSc KSP: full, modified, periodic and BFGS, in one loop.
+
+Solves {R(U)} = {0} for a UFL residual with Dirichlet conditions, as in the course:
+    K δU = −R,   U ← U + δU,   until ‖R‖ ≤ max(atol, rtol ‖R₀‖).
+The variants differ only by *when the tangent K is rebuilt*:
+
+* ``full``: every iteration (quadratic convergence);
+* ``modified``: never within a solve: the tangent at the start of the solve
+  (``constant_tangent="initial"``) or the elastic tangent K(0), assembled and factorized
+  once for the solver's lifetime (``"elastic"``, the course's choice); linear convergence;
+* ``periodic``: every ``period`` iterations (the course's compromise);
+* ``bfgs``: the constant tangent of ``modified`` corrected by inverse BFGS updates
+  (Matthies–Strang), superlinear convergence for one factorization.
+
+Boundary values are imposed on U before the first residual, so every correction δU is
+homogeneous on the Dirichlet dofs and no lifting is needed. A tangent is only reassembled
+when the method asks for it; the matrix keeps its sparsity pattern, so PETSc/MUMPS redo the
+numeric factorization only and reuse the symbolic analysis.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc
+from petsc4py import PETSc
+
+from fenics_nl.convergence import observed_orders
+from fenics_nl.linear_solver import create_ksp, rigid_body_modes
+
+log = logging.getLogger(__name__)
+
+METHODS = ("full", "modified", "periodic", "bfgs")
+PHASES = ("residual", "tangent", "factorization", "solve")
+
+
+class ConvergenceError(RuntimeError):
+    """A non-linear solve failed; `result` holds what was done up to the failure."""
+
+    def __init__(self, message: str, result: NewtonResult):
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass
+class WorkCounts:
+    """What a solve spent: assemblies, factorizations, linear solves and time per phase."""
+
+    residual_assemblies: int = 0
+    tangent_assemblies: int = 0
+    factorizations: int = 0
+    linear_solves: int = 0
+    time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
+
+    def add(self, other: WorkCounts) -> None:
+        """Accumulate `other` into self."""
+        self.residual_assemblies += other.residual_assemblies
+        self.tangent_assemblies += other.tangent_assemblies
+        self.factorizations += other.factorizations
+        self.linear_solves += other.linear_solves
+        for k, v in other.time.items():
+            self.time[k] = self.time.get(k, 0.0) + v
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of one non-linear solve."""
+
+    converged: bool
+    reason: str
+    iterations: int
+    residual_norms: list[float]
+    work: WorkCounts
+    wall_time: float = 0.0
+
+    @property
+    def orders(self) -> list[float]:
+        """Observed orders from the residual norms (round-off tail excluded)."""
+        r = self.residual_norms
+        return observed_orders(r, floor=1e-11 * max(r)) if r else []
+
+    @property
+    def order(self) -> float:
+        """Last observed order, NaN when fewer than three meaningful residuals exist."""
+        q = self.orders
+        return q[-1] if q else math.nan
+
+
+class _Timer:
+    def __init__(self, work: WorkCounts, phase: str):
+        self.work, self.phase = work, phase
+
+    def __enter__(self):
+        self.t0 = time.perf_counter()
+
+    def __exit__(self, *exc):
+        self.work.time[self.phase] += time.perf_counter() - self.t0
+
+
+class NewtonSolver:
+    """Hand-written Newton loop for R(u; v) = 0; `solve()` updates `u` in place.
+
+    Converged when ‖R‖ ≤ max(atol, rtol ‖R₀‖), R₀ the residual at the start of the solve.
+    `atol` is in the residual's force units: set it from the problem's load scale (e.g.
+    1e-10 ‖F_ext‖), since ‖R‖ cannot fall below the round-off of the internal forces and a
+    small load increment makes rtol ‖R₀‖ small too.
+    """
+
+    def __init__(
+        self,
+        residual: ufl.Form,
+        u: fem.Function,
+        bcs: Sequence[fem.DirichletBC] = (),
+        *,
+        method: str = "full",
+        tangent: ufl.Form | None = None,
+        constant_tangent: str = "initial",
+        period: int = 3,
+        linear_solver: str = "lu",
+        prefix: str = "newton_",
+        rtol: float = 1e-10,
+        atol: float = 1e-12,
+        max_it: int = 50,
+        divergence_tol: float = 1e8,
+        line_search: bool = False,
+        bfgs_memory: int = 30,
+    ):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+        if constant_tangent not in ("initial", "elastic"):
+            raise ValueError(f"constant_tangent must be 'initial' or 'elastic', got {constant_tangent!r}")
+        if period < 1:
+            raise ValueError(f"period must be >= 1, got {period}")
+        self.u, self.bcs, self.method = u, list(bcs), method
+        self.rtol, self.atol, self.max_it = rtol, atol, max_it
+        self.divergence_tol, self.line_search = divergence_tol, line_search
+        self.period, self.bfgs_memory = period, bfgs_memory
+        V = u.function_space
+        J = ufl.derivative(residual, u) if tangent is None else tangent
+        self._R = fem.form(residual)
+        self._K = fem.form(J)
+        if constant_tangent == "elastic" and method in ("modified", "bfgs"):
+            # K(0): the same tangent form evaluated at a zero displacement.
+            self._K_const = fem.form(ufl.replace(J, {u: fem.Function(V)}))
+            self._constant_for_life = True
+        else:
+            self._K_const = self._K
+            self._constant_for_life = False
+        self.A = petsc.create_matrix(self._K)
+        self.b = petsc.create_vector(V)
+        self.du = petsc.create_vector(V)
+        nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
+        self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace)
+        self._tangent_ready = False
+        self.total = WorkCounts()
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        im = self.u.function_space.dofmap.index_map
+        return im.size_global * self.u.function_space.dofmap.index_map_bs
+
+    def set_bcs(self, bcs: Sequence[fem.DirichletBC]) -> None:
+        """Replace the Dirichlet conditions (their rows change, so the tangent is stale)."""
+        self.bcs = list(bcs)
+        self._tangent_ready = False
+
+    def invalidate_tangent(self) -> None:
+        """Force the next iteration to rebuild the tangent."""
+        self._tangent_ready = False
+
+    # -- the loop --------------------------------------------------------------------
+
+    def solve(self) -> NewtonResult:
+        """Run the loop from the current `u`; raise ConvergenceError on failure."""
+        t_start = time.perf_counter()
+        work = WorkCounts()
+        x = self.u.x.petsc_vec
+        petsc.set_bc(x, self.bcs)  # U[bc] = g, so every correction is zero there
+        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        if not self._constant_for_life:
+            self._tangent_ready = False
+        pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []  # BFGS (s, y, 1/y·s)
+        norms = [self._residual(work)]
+        k = 0
+
+        def result(converged: bool, reason: str) -> NewtonResult:
+            self.total.add(work)
+            return NewtonResult(converged, reason, k, norms, work, time.perf_counter() - t_start)
+
+        while True:
+            rnorm = norms[-1]
+            log.info("  Newton %s it %d |R| = %.3e", self.method, k, rnorm)
+            if not math.isfinite(rnorm):
+                raise ConvergenceError(f"residual is not finite at iteration {k}",
+                                       result(False, "nan"))
+            if rnorm <= max(self.atol, self.rtol * norms[0]):
+                return result(True, "converged")
+            if k >= self.max_it:
+                raise ConvergenceError(f"no convergence in {self.max_it} iterations "
+                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
+                                       result(False, "max_it"))
+            if rnorm > self.divergence_tol * norms[0]:
+                raise ConvergenceError(f"residual blew up at iteration {k} "
+                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
+                                       result(False, "diverged"))
+            if self._needs_tangent(k):
+                self._assemble_tangent(work)
+            if self.method == "bfgs":
+                b_old = self.b.copy()
+                self._bfgs_direction(pairs, work)
+            else:
+                self._linear_solve(self.b, work)
+            alpha = self._step(rnorm, work)
+            norms.append(self._last_norm)
+            if self.method == "bfgs":
+                self._bfgs_store(pairs, alpha, b_old)
+            k += 1
+
+    # -- pieces ----------------------------------------------------------------------
+
+    def _needs_tangent(self, k: int) -> bool:
+        if self.method == "full":
+            return True
+        if self.method == "periodic":
+            return k % self.period == 0
+        return not self._tangent_ready
+
+    def _residual(self, work: WorkCounts) -> float:
+        """b = R(u) with b[bc] = u − g (zero once imposed); returns ‖b‖."""
+        with _Timer(work, "residual"):
+            with self.b.localForm() as loc:
+                loc.set(0.0)
+            petsc.assemble_vector(self.b, self._R)
+            self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            petsc.set_bc(self.b, self.bcs, x0=self.u.x.petsc_vec, alpha=-1.0)
+            work.residual_assemblies += 1
+            return self.b.norm()
+
+    def _assemble_tangent(self, work: WorkCounts) -> None:
+        with _Timer(work, "tangent"):
+            self.A.zeroEntries()
+            petsc.assemble_matrix(self.A, self._K_const if self._uses_constant else self._K,
+                                  bcs=self.bcs, diag=1.0)
+            self.A.assemble()
+            work.tangent_assemblies += 1
+        with _Timer(work, "factorization"):
+            self.ksp.setUp()  # numeric factorization (symbolic one reused: same pattern)
+            work.factorizations += 1
+        self._tangent_ready = True
+
+    @property
+    def _uses_constant(self) -> bool:
+        return self.method in ("modified", "bfgs")
+
+    def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts) -> None:
+        """du = K⁻¹ rhs (the Newton correction is −du)."""
+        with _Timer(work, "solve"):
+            self.ksp.solve(rhs, self.du)
+            work.linear_solves += 1
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            raise ConvergenceError(f"linear solver failed (KSP reason {reason})",
+                                   NewtonResult(False, "ksp", 0, [], work))
+
+    def _step(self, rnorm: float, work: WorkCounts) -> float:
+        """u ← u − α du with α = 1, or backtracking on ‖R‖ if line search is on."""
+        x = self.u.x.petsc_vec
+        alpha = 1.0
+        x.axpy(-alpha, self.du)
+        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        self._last_norm = self._residual(work)
+        if self.line_search:
+            for _ in range(10):
+                if math.isfinite(self._last_norm) and self._last_norm <= (1 - 1e-4 * alpha) * rnorm:
+                    break
+                x.axpy(alpha / 2, self.du)  # from u − α du back to u − (α/2) du
+                alpha /= 2
+                x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+                self._last_norm = self._residual(work)
+        return alpha
+
+    def _bfgs_direction(self, pairs, work: WorkCounts) -> None:
+        """du = H R with H the L-BFGS inverse built on H0 = K0⁻¹ (two-loop recursion).
+
+        One solve with the factorized constant tangent per iteration, the rest is vector
+        algebra: s_i = u_{i+1} − u_i, y_i = R_{i+1} − R_i, ρ_i = 1/(y_i·s_i).
+        """
+        q = self.b.copy()
+        alphas = []
+        for s, y, rho in reversed(pairs):
+            a = rho * s.dot(q)
+            q.axpy(-a, y)
+            alphas.append(a)
+        self._linear_solve(q, work)
+        for (s, y, rho), a in zip(pairs, reversed(alphas), strict=True):
+            beta = rho * y.dot(self.du)
+            self.du.axpy(a - beta, s)
+        q.destroy()
+
+    def _bfgs_store(self, pairs, alpha: float, b_old: PETSc.Vec) -> None:
+        """Keep s = u_{k+1} − u_k = −α du and y = R_{k+1} − R_k if y·s > 0."""
+        s = self.du.copy()
+        s.scale(-alpha)
+        y = b_old
+        y.aypx(-1.0, self.b)
+        ys = y.dot(s)
+        if not ys > 1e-12 * y.norm() * s.norm():
+            return  # curvature condition fails: skip the update, keep H positive definite
+        pairs.append((s, y, 1.0 / ys))
+        if len(pairs) > self.bfgs_memory:
+            pairs.pop(0)

@@ -1,0 +1,129 @@
+"""The same problems through PETSc SNES (`dolfinx.fem.petsc.NonlinearProblem`), for cross-checks.
+
+`SnesSolver` has the surface of `NewtonSolver` (`solve()` → `NewtonResult`), so scenes and
+benchmarks swap one for the other. Work is counted with PETSc's own logging events, so the
+counts do not depend on our code being right. Modified and periodic Newton are SNES's
+Jacobian lagging (`-snes_lag_jacobian`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc
+from petsc4py import PETSc
+
+from fenics_nl.newton import ConvergenceError, NewtonResult, WorkCounts
+
+# PETSc event names behind each count; MUMPS factorizations log as Mat*FactorNum.
+EVENTS = {
+    "residual_assemblies": "SNESFunctionEval",
+    "tangent_assemblies": "SNESJacobianEval",
+    "factorizations": ("MatLUFactorNum", "MatCholFctrNum"),
+    "linear_solves": "KSPSolve",
+}
+
+
+class EventCounter:
+    """Counts and times of PETSc log events between `start()` and `stop()`."""
+
+    def __init__(self, names: Sequence[str]):
+        if not PETSc.Log.isActive():
+            PETSc.Log.begin()
+        self.events = {n: PETSc.Log.Event(n) for n in names}
+        self.start()
+
+    def _snapshot(self):
+        return {n: e.getPerfInfo() for n, e in self.events.items()}
+
+    def start(self) -> None:
+        """Remember the current counts."""
+        self._t0 = self._snapshot()
+
+    def stop(self) -> dict[str, tuple[int, float]]:
+        """(count, time) of each event since `start()`."""
+        now = self._snapshot()
+        return {n: (now[n]["count"] - self._t0[n]["count"], now[n]["time"] - self._t0[n]["time"])
+                for n in self.events}
+
+
+def petsc_work(counter: EventCounter) -> WorkCounts:
+    """WorkCounts read off PETSc's event log."""
+    ev = counter.stop()
+    work = WorkCounts()
+    for attr, names in EVENTS.items():
+        names = (names,) if isinstance(names, str) else names
+        setattr(work, attr, sum(ev[n][0] for n in names))
+    work.time["residual"] = ev["SNESFunctionEval"][1]
+    work.time["tangent"] = ev["SNESJacobianEval"][1]
+    work.time["factorization"] = ev["MatLUFactorNum"][1] + ev["MatCholFctrNum"][1]
+    work.time["solve"] = ev["KSPSolve"][1]  # SNES factorizes in KSPSetUp, outside KSPSolve
+    return work
+
+
+def _all_event_names():
+    out = []
+    for names in EVENTS.values():
+        out += [names] if isinstance(names, str) else list(names)
+    return out
+
+
+class SnesSolver:
+    """Newton through SNES `newtonls` with a plain full step (no line search by default).
+
+    `method`: ``full`` (lag 1), ``modified`` (Jacobian once per solve) or ``periodic``
+    (lag = `period`). Convergence on ‖F‖ ≤ max(atol, rtol ‖F₀‖) as in `NewtonSolver`.
+    """
+
+    def __init__(self, residual: ufl.Form, u: fem.Function, bcs: Sequence[fem.DirichletBC] = (),
+                 *, method: str = "full", tangent: ufl.Form | None = None, period: int = 3,
+                 linear_solver: str = "lu", prefix: str = "snes_", rtol: float = 1e-10,
+                 atol: float = 1e-12, max_it: int = 50, line_search: str = "basic"):
+        lags = {"full": 1, "modified": -2, "periodic": period}
+        if method not in lags:
+            raise ValueError(f"SNES method must be one of {', '.join(lags)}, got {method!r}")
+        if linear_solver not in ("lu", "cholesky"):
+            raise ValueError(f"SNES linear solver must be lu or cholesky, got {linear_solver!r}")
+        self.u, self.bcs, self.method = u, list(bcs), method
+        opts = {
+            "snes_type": "newtonls",
+            "snes_linesearch_type": line_search,
+            "snes_rtol": rtol,
+            "snes_atol": atol,
+            "snes_stol": 0.0,
+            "snes_max_it": max_it,
+            "snes_lag_jacobian": lags[method],
+            "ksp_type": "preonly",
+            "pc_type": linear_solver,
+            "pc_factor_mat_solver_type": "mumps",
+        }
+        J = ufl.derivative(residual, u) if tangent is None else tangent
+        self.problem = petsc.NonlinearProblem(residual, u, bcs=self.bcs, J=J,
+                                              petsc_options_prefix=prefix, petsc_options=opts)
+        if linear_solver == "cholesky":
+            self.problem.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
+        self.snes = self.problem.solver
+        self.snes.setConvergenceHistory(reset=True)
+        self.counter = EventCounter(_all_event_names())
+
+    def solve(self) -> NewtonResult:
+        """Solve from the current `u` (boundary values imposed first, as NewtonSolver does)."""
+        t0 = time.perf_counter()
+        x = self.u.x.petsc_vec
+        petsc.set_bc(x, self.bcs)
+        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        self.counter.start()
+        self.problem.solve()
+        work = petsc_work(self.counter)
+        norms = [float(r) for r in self.snes.getConvergenceHistory()[0]]
+        reason = self.snes.getConvergedReason()
+        result = NewtonResult(reason > 0, f"SNES reason {reason}",
+                              self.snes.getIterationNumber(), norms, work,
+                              time.perf_counter() - t0)
+        if reason <= 0:
+            raise ConvergenceError(f"SNES did not converge (reason {reason})", result)
+        return result

@@ -1,0 +1,145 @@
+import math
+
+import numpy as np
+import pytest
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.loading import LoadStepError, solve_incrementally
+from fenics_nl.materials import PowerLaw
+from fenics_nl.newton import ConvergenceError, NewtonSolver
+from fenics_nl.problems import cantilever_3d
+from fenics_nl.snes import EventCounter, SnesSolver
+
+# Power law far into its non-linear range: at this load ε_eq reaches ~20 ε0 at the clamp.
+MATERIAL = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=0.3)
+LOAD = -0.05
+CELLS = (16, 3, 3)
+
+
+def tip(problem):
+    value = fem.assemble_scalar(fem.form(problem.observed))
+    return problem.u.function_space.mesh.comm.allreduce(value)
+
+
+def solve(solver_cls, comm=MPI.COMM_WORLD, **kwargs):
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD, comm=comm)
+    solver = solver_cls(p.residual, p.u, p.bcs, prefix=f"t{id(p)}_", max_it=200, **kwargs)
+    counter = EventCounter(["MatLUFactorNum"])
+    result = solver.solve()
+    result.petsc_factorizations = counter.stop()["MatLUFactorNum"][0]
+    return p, result
+
+
+@pytest.fixture(scope="module")
+def snes_reference():
+    p, r = solve(SnesSolver, method="full")
+    assert r.converged
+    return p.u.x.array.copy(), tip(p)
+
+
+@pytest.mark.parametrize("method", ["full", "modified", "periodic", "bfgs"])
+def test_hand_written_newton_matches_snes(method, snes_reference):
+    u_ref, tip_ref = snes_reference
+    p, r = solve(NewtonSolver, method=method)
+    assert r.converged
+    assert abs(tip(p) - tip_ref) < 1e-8 * abs(tip_ref)
+    assert np.linalg.norm(p.u.x.array - u_ref) < 1e-8 * np.linalg.norm(u_ref)
+
+
+def test_full_newton_is_quadratic_and_snes_agrees_iteration_by_iteration():
+    _, r = solve(NewtonSolver, method="full")
+    _, s = solve(SnesSolver, method="full")
+    assert r.order > 1.8
+    assert r.iterations == s.iterations
+    # same algorithm: the residual histories agree to round-off until the last iterate
+    np.testing.assert_allclose(r.residual_norms[:-1], s.residual_norms[:-1], rtol=1e-6)
+    assert r.work.factorizations == r.iterations == r.petsc_factorizations
+
+
+def test_modified_newton_is_linear_and_factorizes_once():
+    _, r = solve(NewtonSolver, method="modified")
+    assert r.iterations > 10
+    assert r.orders[-1] == pytest.approx(1.0, abs=0.1)
+    assert r.work.factorizations == r.work.tangent_assemblies == 1
+    assert r.petsc_factorizations == 1  # PETSc's own count: no refactorization
+    assert r.work.linear_solves == r.iterations
+
+
+def test_elastic_tangent_is_factorized_once_for_the_whole_load_history():
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=0.0)
+    solver = NewtonSolver(p.residual, p.u, p.bcs, method="modified",
+                          constant_tangent="elastic", max_it=300, prefix="elastic_")
+    counter = EventCounter(["MatLUFactorNum"])
+    path = solve_incrementally(solver, lambda t: p.load.value.__setitem__(2, t * LOAD), steps=3,
+                               adaptive=False)
+    assert len(path.results) == 3
+    assert path.work.factorizations == 1 == counter.stop()["MatLUFactorNum"][0]
+
+
+@pytest.mark.parametrize("period", [2, 3])
+def test_periodic_newton_refactorizes_every_period(period):
+    _, r = solve(NewtonSolver, method="periodic", period=period)
+    assert r.work.factorizations == math.ceil(r.iterations / period) == r.petsc_factorizations
+
+
+def test_bfgs_beats_modified_newton_with_one_factorization():
+    _, m = solve(NewtonSolver, method="modified")
+    _, b = solve(NewtonSolver, method="bfgs")
+    assert b.work.factorizations == 1 == b.petsc_factorizations
+    assert b.iterations < 0.6 * m.iterations
+
+
+def test_snes_lagged_jacobian_reproduces_modified_newton():
+    _, r = solve(NewtonSolver, method="modified")
+    _, s = solve(SnesSolver, method="modified")
+    assert s.work.factorizations == 1 and s.iterations == r.iterations
+
+
+def test_failures_raise_clear_errors_and_load_stepping_recovers():
+    # 40x the default load in one step needs more than 4 full Newton iterations.
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=0.0)
+    solver = NewtonSolver(p.residual, p.u, p.bcs, method="full", max_it=4, prefix="div_")
+    p.load.value[2] = 40 * LOAD
+    with pytest.raises(ConvergenceError, match="no convergence in 4 iterations") as err:
+        solver.solve()
+    assert not err.value.result.converged and err.value.result.reason == "max_it"
+    # adaptive steps from the unloaded state reach the same load
+    p.u.x.array[:] = 0.0
+    solver.max_it, solver.atol = 6, 1e-10  # ‖R‖'s round-off floor grows with the load
+    path = solve_incrementally(solver, lambda t: p.load.value.__setitem__(2, t * 40 * LOAD),
+                               steps=1)
+    assert path.failures >= 1 and path.factors[-1] == pytest.approx(1.0)
+    assert all(r.converged for r in path.results)
+    # a non-finite residual is caught, not iterated on
+    p.load.value[2] = np.nan
+    with pytest.raises(ConvergenceError, match="not finite"):
+        solver.solve()
+
+
+def test_load_stepping_refuses_clearly_below_min_step():
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=0.0)
+    solver = NewtonSolver(p.residual, p.u, p.bcs, method="full", max_it=1, prefix="min_")
+    with pytest.raises(LoadStepError, match="not reached"):
+        solve_incrementally(solver, lambda t: p.load.value.__setitem__(2, t * LOAD),
+                            steps=1, min_step=0.2)
+    assert np.all(np.isfinite(p.u.x.array))
+
+
+def test_bad_options_are_value_errors():
+    p = cantilever_3d(MATERIAL, cells=(2, 1, 1))
+    with pytest.raises(ValueError, match="method"):
+        NewtonSolver(p.residual, p.u, p.bcs, method="halley")
+    with pytest.raises(ValueError, match="period"):
+        NewtonSolver(p.residual, p.u, p.bcs, method="periodic", period=0)
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("method", ["full", "bfgs"])
+def test_parallel_solve_matches_serial(method):
+    comm = MPI.COMM_WORLD
+    assert comm.size > 1, "run under mpiexec -n 2"
+    p, r = solve(NewtonSolver, comm=comm, method=method)
+    ps, rs = solve(NewtonSolver, comm=MPI.COMM_SELF, method=method)
+    assert abs(tip(p) - tip(ps)) < 1e-8 * abs(tip(ps))
+    assert r.iterations == rs.iterations
