@@ -55,6 +55,7 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         pc.setFactorSolverType("mumps")
         if kind == "cholesky":
             A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
     else:
         if near_nullspace is None:
             raise ValueError("the gamg solver needs the rigid-body near-nullspace")

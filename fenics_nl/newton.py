@@ -251,7 +251,7 @@ class NewtonSolver:
             self.A.assemble()
             work.tangent_assemblies += 1
         with _Timer(work, "factorization"):
-            self.ksp.setUp()  # numeric factorization (symbolic one reused: same pattern)
+            self.ksp.getPC().setUp()  # numeric factorization now (symbolic one reused)
             work.factorizations += 1
         self._tangent_ready = True
 

@@ -1,0 +1,175 @@
+"""Newton variants against SNES on a 3D power-law cantilever (>= 100k unknowns by default).
+
+One run, one mesh, one linear solver (MUMPS): every variant starts from u = 0 at the same
+load and reaches the same tolerance. Writes benchmarks/results/newton.json and, with
+--update-readme, the table in README.md (between the `bench:newton` markers).
+"""
+
+import argparse
+import json
+import platform
+import time
+from pathlib import Path
+
+import fenics_nl  # noqa: F401  (before dolfinx)
+import dolfinx
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from fenics_nl.linear_solver import create_ksp
+from fenics_nl.materials import LinearElastic, PowerLaw
+from fenics_nl.newton import NewtonSolver
+from fenics_nl.problems import cantilever_3d
+from fenics_nl.snes import SnesSolver
+
+HERE = Path(__file__).resolve().parent
+VARIANTS = [  # (label, solver class, options)
+    ("SNES newtonls", SnesSolver, {"method": "full"}),
+    ("full", NewtonSolver, {"method": "full"}),
+    ("modified", NewtonSolver, {"method": "modified"}),
+    ("periodic m=2", NewtonSolver, {"method": "periodic", "period": 2}),
+    ("periodic m=3", NewtonSolver, {"method": "periodic", "period": 3}),
+    ("bfgs", NewtonSolver, {"method": "bfgs"}),
+    ("SNES lag -2 (modified)", SnesSolver, {"method": "modified"}),
+    ("SNES lag 3 (periodic)", SnesSolver, {"method": "periodic", "period": 3}),
+]
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--cells", type=int, nargs=3, default=[80, 20, 20],
+                   help="tetrahedral box cells (x, y, z); 80 20 20 gives 107k unknowns")
+    p.add_argument("--traction", type=float, default=-0.12,
+                   help="end traction (E = 1000, σ0 = 1): strongly non-linear at the clamp")
+    p.add_argument("--linear-solver", choices=["lu", "cholesky"], default="lu")
+    p.add_argument("--repeat", type=int, default=1, help="runs per variant, the fastest kept")
+    p.add_argument("--update-readme", action="store_true")
+    p.add_argument("--quick", action="store_true", help="small mesh, for a smoke run")
+    return p.parse_args()
+
+
+MATERIAL = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=0.3)
+SIZE = (10.0, 2.5, 2.5)
+
+
+def tip(problem):
+    value = fem.assemble_scalar(fem.form(problem.observed))
+    return problem.u.function_space.mesh.comm.allreduce(value)
+
+
+def run_variant(cls, opts, cells, traction, linear_solver, prefix):
+    p = cantilever_3d(MATERIAL, cells=cells, size=SIZE, traction=traction)
+    solver = cls(p.residual, p.u, p.bcs, linear_solver=linear_solver, prefix=prefix,
+                 rtol=1e-10, atol=1e-12, max_it=500, **opts)
+    MPI.COMM_WORLD.Barrier()
+    t0 = time.perf_counter()
+    r = solver.solve()
+    wall = MPI.COMM_WORLD.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    w = r.work
+    return {"wall_time_s": wall, "iterations": r.iterations, "tip_displacement": tip(p),
+            "residual_assemblies": w.residual_assemblies,
+            "tangent_assemblies": w.tangent_assemblies, "factorizations": w.factorizations,
+            "linear_solves": w.linear_solves, "phase_time_s": dict(w.time),
+            "residual_norms": r.residual_norms, "dofs": p.u.function_space.dofmap.index_map.size_global * 3}
+
+
+def linear_solve_time(cells, linear_solver):
+    """One linear elastic solve (assemble K and F, factorize, solve) on the same mesh."""
+    p = cantilever_3d(LinearElastic(MATERIAL.E, MATERIAL.nu), cells=cells, size=SIZE, traction=-0.12)
+    V = p.u.function_space
+    a = fem.form(ufl.derivative(p.residual, p.u))
+    L = fem.form(-ufl.replace(p.residual, {p.u: fem.Function(V)}))
+    MPI.COMM_WORLD.Barrier()
+    t0 = time.perf_counter()
+    A = petsc.assemble_matrix(a, bcs=p.bcs)
+    A.assemble()
+    b = petsc.assemble_vector(L)
+    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+    petsc.set_bc(b, p.bcs)
+    ksp = create_ksp(A, linear_solver, prefix="linear_")
+    ksp.solve(b, p.u.x.petsc_vec)
+    return MPI.COMM_WORLD.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+
+
+def main():
+    args = parse_args()
+    cells = [8, 2, 2] if args.quick else args.cells
+    rank0 = MPI.COMM_WORLD.rank == 0
+    # Warm-up: JIT-compile every form on a tiny mesh so timings exclude compilation.
+    for k, (_, cls, opts) in enumerate(VARIANTS):
+        run_variant(cls, opts, [4, 1, 1], args.traction, args.linear_solver, f"w{k}_")
+    linear_solve_time([4, 1, 1], args.linear_solver)
+
+    results = {}
+    t_lin = min(linear_solve_time(cells, args.linear_solver) for _ in range(args.repeat))
+    for k, (label, cls, opts) in enumerate(VARIANTS):
+        runs = [run_variant(cls, opts, cells, args.traction, args.linear_solver, f"b{k}_{i}_")
+                for i in range(args.repeat)]
+        results[label] = min(runs, key=lambda r: r["wall_time_s"])
+        if rank0:
+            r = results[label]
+            print(f"{label:24s} {r['wall_time_s']:7.2f} s  its {r['iterations']:3d}  "
+                  f"fact {r['factorizations']:2d}  tip {r['tip_displacement']:.10f}", flush=True)
+    full, snes = results["full"]["wall_time_s"], results["SNES newtonls"]["wall_time_s"]
+    best = min((r["wall_time_s"], k) for k, r in results.items() if not k.startswith("SNES"))
+    tips = [r["tip_displacement"] for r in results.values()]
+    summary = {
+        "dofs": results["full"]["dofs"], "ranks": MPI.COMM_WORLD.size, "cells": cells,
+        "traction": args.traction, "linear_solver": args.linear_solver,
+        "linear_solve_time_s": t_lin,
+        "ratio_full_over_snes": full / snes,
+        "best_variant": best[1], "ratio_best_over_full": best[0] / full,
+        "max_rel_tip_spread": (max(tips) - min(tips)) / abs(np.mean(tips)),
+        "machine": {"cores": MPI.COMM_WORLD.size, "platform": platform.platform(),
+                    "dolfinx": dolfinx.__version__,
+                    "petsc": ".".join(map(str, PETSc.Sys.getVersion()))},
+        "variants": results,
+    }
+    if rank0:
+        print(table(summary))
+        if not args.quick:
+            out = HERE / "results" / "newton.json"
+            out.write_text(json.dumps(summary, indent=1))
+            print(f"wrote {out}")
+            if args.update_readme:
+                update_readme("newton", table(summary))
+
+
+def table(s):
+    lines = [
+        f"3D power-law cantilever, {s['dofs']} unknowns, {s['ranks']} rank(s), MUMPS "
+        f"{s['linear_solver'].upper()}; one linear elastic solve of the same mesh: "
+        f"{s['linear_solve_time_s']:.2f} s.",
+        "",
+        "| variant | time (s) | / full | / linear solve | iterations | factorizations | "
+        "tangent assemblies | residual assemblies | linear solves |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    full = s["variants"]["full"]["wall_time_s"]
+    for label, r in s["variants"].items():
+        lines.append(
+            f"| {label} | {r['wall_time_s']:.2f} | {r['wall_time_s'] / full:.2f} | "
+            f"{r['wall_time_s'] / s['linear_solve_time_s']:.1f} | {r['iterations']} | "
+            f"{r['factorizations']} | {r['tangent_assemblies']} | {r['residual_assemblies']} | "
+            f"{r['linear_solves']} |")
+    lines += ["", f"Hand-written full Newton / SNES newtonls: **{s['ratio_full_over_snes']:.2f}**; "
+              f"best variant ({s['best_variant']}) / full Newton: "
+              f"**{s['ratio_best_over_full']:.2f}**; all variants agree on the tip displacement "
+              f"to {s['max_rel_tip_spread']:.1e} (relative)."]
+    return "\n".join(lines)
+
+
+def update_readme(name, text):
+    readme = HERE.parent / "README.md"
+    src = readme.read_text()
+    start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
+    i, j = src.index(start) + len(start), src.index(end)
+    readme.write_text(src[:i] + "\n" + text + "\n" + src[j:])
+
+
+if __name__ == "__main__":
+    main()

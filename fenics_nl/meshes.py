@@ -1,0 +1,76 @@
+"""gmsh meshes built on rank 0 and distributed by `dolfinx.io.gmsh.model_to_mesh`."""
+
+from __future__ import annotations
+
+import gmsh
+from dolfinx.io import gmsh as gmshio
+from mpi4py import MPI
+
+
+def _start(name: str):
+    if not gmsh.isInitialized():
+        gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add(name)
+
+
+def _graded_size_field(h_fine: float, fine_radius: float, h_coarse: float, far: float):
+    """Element size h_fine within `fine_radius` of the origin, growing linearly to h_coarse."""
+    f_dist = gmsh.model.mesh.field.add("Distance")
+    origin = gmsh.model.getEntitiesInBoundingBox(-1e-9, -1e-9, -1e-9, 1e-9, 1e-9, 1e-9, 0)
+    gmsh.model.mesh.field.setNumbers(f_dist, "PointsList", [tag for _, tag in origin])
+    f_thr = gmsh.model.mesh.field.add("Threshold")
+    gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
+    gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", h_fine)
+    gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", h_coarse)
+    gmsh.model.mesh.field.setNumber(f_thr, "DistMin", fine_radius)
+    gmsh.model.mesh.field.setNumber(f_thr, "DistMax", far)
+    gmsh.model.mesh.field.setAsBackgroundMesh(f_thr)
+    for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
+        gmsh.option.setNumber(f"Mesh.{opt}", 0)
+
+
+def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: float,
+                 fine_radius: float, growth: float = 0.15) -> gmshio.MeshData:
+    """A block under a surface load near the origin, refined there.
+
+    2D: [0, width] x [-depth, 0] (axisymmetric or half plane-strain model).
+    3D: [0, width]² x [-depth, 0] (quarter model). The top (z = 0, or y = 0 in 2D) is the
+    physical group ``contact``; ``symmetry_x`` (x = 0), ``symmetry_y`` (3D, y = 0),
+    ``bottom`` and ``side`` complete it. Element size h_fine inside `fine_radius` of the
+    origin, then growing by `growth` per unit distance (geometric-like grading).
+    """
+    if comm.rank == 0:
+        _start(f"block{dim}d")
+        occ = gmsh.model.occ
+        if dim == 2:
+            occ.addRectangle(0, -depth, 0, width, depth)
+        else:
+            occ.addBox(0, 0, -depth, width, width, depth)
+        occ.synchronize()
+        up = 1 if dim == 2 else 2  # index of the vertical coordinate
+        groups = {"contact": [], "symmetry_x": [], "symmetry_y": [], "bottom": [], "side": []}
+        for d, tag in gmsh.model.getEntities(dim - 1):
+            c = occ.getCenterOfMass(d, tag)
+            if abs(c[up]) < 1e-9 * depth:
+                groups["contact"].append(tag)
+            elif abs(c[up] + depth) < 1e-9 * depth:
+                groups["bottom"].append(tag)
+            elif abs(c[0]) < 1e-9 * width:
+                groups["symmetry_x"].append(tag)
+            elif dim == 3 and abs(c[1]) < 1e-9 * width:
+                groups["symmetry_y"].append(tag)
+            else:
+                groups["side"].append(tag)
+        for i, (name, tags) in enumerate(groups.items(), start=1):
+            if tags:
+                gmsh.model.addPhysicalGroup(dim - 1, tags, i, name=name)
+        gmsh.model.addPhysicalGroup(dim, [t for _, t in gmsh.model.getEntities(dim)], 1,
+                                    name="solid")
+        far = max(width, depth)
+        _graded_size_field(h_fine, fine_radius, h_fine + growth * far, far)
+        gmsh.model.mesh.generate(dim)
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    return data

@@ -1,0 +1,114 @@
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl import boundary, hertz, kinematics
+from fenics_nl.contact import ActiveSetContact
+from fenics_nl.materials import LinearElastic, PowerLaw
+from fenics_nl.meshes import graded_block
+
+
+def spring_over_support(m, k=100.0, g=9.81, gap=0.05, formulation="elimination"):
+    """The course's 1-DOF example: a mass m on a spring k, the support γ below it.
+
+    A one-element bar of stiffness k (EA/L = k) fixed at x = 0; the weight mg pulls the free
+    end x = 1 towards the support, which stands at distance γ along +x.
+    """
+    bar = mesh.create_unit_interval(MPI.COMM_SELF, 1)
+    V = fem.functionspace(bar, ("Lagrange", 1, (1,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    fdim = 0
+    top = mesh.locate_entities_boundary(bar, fdim, lambda x: np.isclose(x[0], 0))
+    end = mesh.locate_entities_boundary(bar, fdim, lambda x: np.isclose(x[0], 1))
+    tags = mesh.meshtags(bar, fdim, end, np.ones(len(end), dtype=np.int32))
+    ds = ufl.Measure("ds", domain=bar, subdomain_data=tags)
+    R = k * ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx - m * g * v[0] * ds(1)
+    c = ActiveSetContact(R, u, [boundary.fixed(V, top)], end, lambda x: np.full(x.shape[1], gap),
+                         normal_axis=0, normal_sign=1, formulation=formulation)
+    res = c.solve()
+    return res, c, float(u.x.array[-1] if np.isclose(V.tabulate_dof_coordinates()[-1, 0], 1)
+                         else u.x.array[0])
+
+
+@pytest.mark.parametrize("m", [0.2, 0.5, 0.5097, 0.6, 2.0])  # kγ/g = 0.50968...
+def test_course_mass_spring_example(m):
+    k, g, gap = 100.0, 9.81, 0.05
+    res, c, u_end = spring_over_support(m, k, g, gap)
+    if m >= k * gap / g:  # contact, reaction R = mg − kγ
+        assert res.force == pytest.approx(m * g - k * gap, rel=1e-10, abs=1e-12)
+        assert u_end == pytest.approx(gap, rel=1e-12)
+        assert c.active.all()
+    else:  # hangs free at mg/k above the support
+        assert res.force == pytest.approx(0.0, abs=1e-12)
+        assert u_end == pytest.approx(m * g / k, rel=1e-12)
+        assert not c.active.any()
+
+
+def axisymmetric_punch(formulation, comm=MPI.COMM_WORLD, E=1.0, nu=0.3, R=1.0, delta=0.01,
+                       material=None, h_over_a=0.05, block=300.0):
+    a = np.sqrt(R * delta)
+    data = graded_block(comm, 2, block * a, block * a, h_over_a * a, 1.5 * a, 0.05)
+    V = fem.functionspace(data.mesh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    material = material or LinearElastic(E, nu)
+    dx = kinematics.quadrature_measure("dx", data.mesh, 2)
+    res_form = material.internal_work(u, v, "axisymmetric") * dx
+    tag = lambda name: data.facet_tags.find(data.physical_groups[name].tag)  # noqa: E731
+    bcs = [boundary.component(V, 0, tag("symmetry_x")), boundary.component(V, 1, tag("bottom"))]
+    c = ActiveSetContact(res_form, u, bcs, tag("contact"), lambda x: x[0] ** 2 / (2 * R) - delta,
+                         normal_axis=1, normal_sign=1, formulation=formulation,
+                         initial="penetrating", prefix=f"ax{formulation}{id(u)}_",
+                         newton_options={"line_search": True})
+    return c, c.solve()
+
+
+def test_formulations_agree_to_solver_precision():
+    ce, re = axisymmetric_punch("elimination")
+    cm, rm = axisymmetric_punch("multiplier")
+    assert re.active_sizes == rm.active_sizes
+    assert np.array_equal(ce.active, cm.active)
+    Te, Tm = ce.normal_forces(), cm.normal_forces()
+    assert np.max(np.abs(Te - Tm)) < 1e-9 * np.max(np.abs(Te))
+    assert abs(re.force - rm.force) < 1e-9 * re.force
+
+
+def test_axisymmetric_punch_matches_hertz_coarse():
+    # A quick version of the demo's check (the demo runs the finer default mesh):
+    # h = a/20 and a 300a block: force within 1 % (+0.45 % block-size error measured).
+    c, r = axisymmetric_punch("elimination")
+    ref = hertz.sphere_from_indentation(1.0, 0.3, 1.0, 0.01)
+    assert r.force == pytest.approx(ref["force"], rel=1e-2)
+    a_h = c.comm.allreduce(float(np.max(c.x[c.active, 0], initial=0.0)), op=MPI.MAX)
+    assert abs(a_h - ref["contact_radius"]) <= 0.05 * ref["contact_radius"]  # one element
+
+
+def test_nonlinear_material_runs_newton_inside_each_iteration():
+    # Power law softer than Hooke beyond ε0: the same indentation needs less force.
+    c_lin, r_lin = axisymmetric_punch("elimination")
+    c_pl, r_pl = axisymmetric_punch("elimination", material=PowerLaw(1.0, 0.3, 2e-3, 0.3))
+    assert r_pl.newton_iterations > 2 * r_pl.iterations  # real Newton solves inside
+    assert 0.2 * r_lin.force < r_pl.force < 0.95 * r_lin.force
+
+
+def test_missing_surface_is_a_clear_error():
+    with pytest.raises(ValueError, match="2D or 3D"):
+        spring_over_support(1.0, formulation="multiplier")
+    bar = mesh.create_unit_interval(MPI.COMM_SELF, 1)
+    V = fem.functionspace(bar, ("Lagrange", 1, (1,)))
+    u = fem.Function(V)
+    R = ufl.inner(ufl.grad(u), ufl.grad(ufl.TestFunction(V))) * ufl.dx
+    with pytest.raises(ValueError, match="no facets"):
+        ActiveSetContact(R, u, [], np.array([], dtype=np.int32), lambda x: 0 * x[0],
+                         normal_axis=0)
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("formulation", ["elimination", "multiplier"])
+def test_parallel_contact_matches_serial(formulation):
+    assert MPI.COMM_WORLD.size > 1
+    cp, rp = axisymmetric_punch(formulation, comm=MPI.COMM_WORLD)
+    cs, rs = axisymmetric_punch(formulation, comm=MPI.COMM_SELF)
+    assert rp.active_sizes == rs.active_sizes
+    assert abs(rp.force - rs.force) < 1e-9 * rs.force
