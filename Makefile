@@ -31,5 +31,8 @@ test-mpi: $(VENV)/.installed
 bench: $(VENV)/.installed
 	$(PY) benchmarks/newton.py
 
+lint: $(VENV)/.installed
+	$(VENV)/bin/ruff check .
+
 clean:
 	rm -rf $(VENV) *.egg-info

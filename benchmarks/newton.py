@@ -11,7 +11,6 @@ import platform
 import time
 from pathlib import Path
 
-import fenics_nl  # noqa: F401  (before dolfinx)
 import dolfinx
 import numpy as np
 import ufl
@@ -20,6 +19,7 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import fenics_nl  # noqa: F401  (before dolfinx)
 from fenics_nl.linear_solver import create_ksp
 from fenics_nl.materials import LinearElastic, PowerLaw
 from fenics_nl.newton import NewtonSolver
@@ -74,12 +74,14 @@ def run_variant(cls, opts, cells, traction, linear_solver, prefix):
             "residual_assemblies": w.residual_assemblies,
             "tangent_assemblies": w.tangent_assemblies, "factorizations": w.factorizations,
             "linear_solves": w.linear_solves, "phase_time_s": dict(w.time),
-            "residual_norms": r.residual_norms, "dofs": p.u.function_space.dofmap.index_map.size_global * 3}
+            "residual_norms": r.residual_norms,
+            "dofs": p.u.function_space.dofmap.index_map.size_global * 3}
 
 
 def linear_solve_time(cells, linear_solver):
     """One linear elastic solve (assemble K and F, factorize, solve) on the same mesh."""
-    p = cantilever_3d(LinearElastic(MATERIAL.E, MATERIAL.nu), cells=cells, size=SIZE, traction=-0.12)
+    linear = LinearElastic(MATERIAL.E, MATERIAL.nu)
+    p = cantilever_3d(linear, cells=cells, size=SIZE, traction=-0.12)
     V = p.u.function_space
     a = fem.form(ufl.derivative(p.residual, p.u))
     L = fem.form(-ufl.replace(p.residual, {p.u: fem.Function(V)}))

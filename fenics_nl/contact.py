@@ -201,7 +201,7 @@ class ActiveSetContact:
     def total_force(self, T_n: np.ndarray | None = None) -> float:
         """−Σ T_n over owned S_C nodes, summed over ranks (positive in compression)."""
         T_n = self.normal_forces() if T_n is None else T_n
-        return -self.comm.allreduce(float(np.sum(T_n[self._owned()])))
+        return 0.0 - self.comm.allreduce(float(np.sum(T_n[self._owned()])))  # no −0.0
 
     def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
         """New obstacle position (a load step); the active set is kept as a warm start."""
@@ -255,7 +255,8 @@ class ActiveSetContact:
         """Global signature of a set: its size and the sum of its nodes' global indices."""
         im = self.Vn.dofmap.index_map
         gidx = im.local_to_global(self.dofs_n[mask & self._owned()].astype(np.int32))
-        return (self.comm.allreduce(len(gidx)), self.comm.allreduce(int(np.sum(gidx, dtype=np.int64))))
+        total = int(np.sum(gidx, dtype=np.int64))
+        return self.comm.allreduce(len(gidx)), self.comm.allreduce(total)
 
     # -- meshtags ----------------------------------------------------------------------
 

@@ -7,7 +7,6 @@ coarse spaces miss rotations and CG stalls on elasticity.
 
 from __future__ import annotations
 
-import numpy as np
 from dolfinx import fem, la
 from petsc4py import PETSc
 
@@ -29,11 +28,10 @@ def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
         a = modes[gdim + k].array
         a[i:n_owned * bs:bs] = -x[:, j]
         a[j:n_owned * bs:bs] = x[:, i]
-    vecs = [m.petsc_vec for m in modes]
-    la.orthonormalize(vecs)
-    ns = PETSc.NullSpace().create(vectors=vecs, comm=V.mesh.comm)
-    ns._fenics_nl_keep = modes  # the PETSc vectors borrow these arrays
-    return ns
+    la.orthonormalize(modes)
+    # copies own their memory (petsc_vec borrows the dolfinx vector's array)
+    return PETSc.NullSpace().create(vectors=[m.petsc_vec.copy() for m in modes],
+                                    comm=V.mesh.comm)
 
 
 def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
@@ -63,23 +61,5 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         ksp.setType("cg")
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
         pc.setType("gamg")
-        ksp.setErrorIfNotConverged(True)
     ksp.setFromOptions()
     return ksp
-
-
-def owned_dof_count(V: fem.FunctionSpace) -> int:
-    """Number of scalar unknowns of V summed over ranks."""
-    im = V.dofmap.index_map
-    return int(im.size_global * V.dofmap.index_map_bs)
-
-
-def zero_vector(x: PETSc.Vec) -> None:
-    """Zero a (ghosted) PETSc vector including its ghost entries."""
-    with x.localForm() as loc:
-        loc.set(0.0)
-
-
-def is_finite(value: float) -> bool:
-    """True when `value` is a finite float."""
-    return bool(np.isfinite(value))

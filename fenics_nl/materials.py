@@ -64,6 +64,7 @@ class SmallStrain:
     """Mixin: stress, tangent and virtual work derived from `energy(ε)`."""
 
     finite_strain = False
+    is_linear = False  # True only where the residual is linear in u (Newton: one step)
 
     def energy(self, eps):
         """Free-energy density φ(ε)."""
@@ -91,6 +92,7 @@ class FiniteStrain:
     """Mixin: second and first Piola stresses and virtual work derived from `energy(e)`."""
 
     finite_strain = True
+    is_linear = False
 
     def energy(self, e):
         """Free-energy density φ(e) per unit reference volume."""
@@ -116,6 +118,8 @@ class FiniteStrain:
 @dataclass(frozen=True)
 class LinearElastic(Isotropic, SmallStrain):
     """Hooke's law: φ(ε) = λ/2 (tr ε)² + μ ε:ε."""
+
+    is_linear = True
 
     def energy(self, eps):
         """φ(ε)."""

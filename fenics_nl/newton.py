@@ -134,7 +134,8 @@ class NewtonSolver:
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if constant_tangent not in ("initial", "elastic"):
-            raise ValueError(f"constant_tangent must be 'initial' or 'elastic', got {constant_tangent!r}")
+            raise ValueError("constant_tangent must be 'initial' or 'elastic', "
+                             f"got {constant_tangent!r}")
         if period < 1:
             raise ValueError(f"period must be >= 1, got {period}")
         self.u, self.bcs, self.method = u, list(bcs), method

@@ -86,8 +86,8 @@ def test_axisymmetric_punch_matches_hertz_coarse():
 
 def test_nonlinear_material_runs_newton_inside_each_iteration():
     # Power law softer than Hooke beyond ε0: the same indentation needs less force.
-    c_lin, r_lin = axisymmetric_punch("elimination")
-    c_pl, r_pl = axisymmetric_punch("elimination", material=PowerLaw(1.0, 0.3, 2e-3, 0.3))
+    _, r_lin = axisymmetric_punch("elimination")
+    _, r_pl = axisymmetric_punch("elimination", material=PowerLaw(1.0, 0.3, 2e-3, 0.3))
     assert r_pl.newton_iterations > 2 * r_pl.iterations  # real Newton solves inside
     assert 0.2 * r_lin.force < r_pl.force < 0.95 * r_lin.force
 
@@ -108,7 +108,7 @@ def test_missing_surface_is_a_clear_error():
 @pytest.mark.parametrize("formulation", ["elimination", "multiplier"])
 def test_parallel_contact_matches_serial(formulation):
     assert MPI.COMM_WORLD.size > 1
-    cp, rp = axisymmetric_punch(formulation, comm=MPI.COMM_WORLD)
-    cs, rs = axisymmetric_punch(formulation, comm=MPI.COMM_SELF)
+    _, rp = axisymmetric_punch(formulation, comm=MPI.COMM_WORLD)
+    _, rs = axisymmetric_punch(formulation, comm=MPI.COMM_SELF)
     assert rp.active_sizes == rs.active_sizes
     assert abs(rp.force - rs.force) < 1e-9 * rs.force

@@ -46,3 +46,90 @@ def test_newton_scalar_bad_input(tmp_path, args, message):
     proc = run([DEMOS / "newton_scalar.py", *args], tmp_path, check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
+
+
+def punch(tmp_path, *args, ranks=1):
+    out = tmp_path / f"punch{ranks}{'_'.join(args)}.json".replace("/", "")
+    cmd = [DEMOS / "punch.py", *args, "--json", out]
+    if ranks > 1:
+        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr
+    else:
+        run(cmd, tmp_path)
+    return json.loads(out.read_text())
+
+
+def test_punch_axisymmetric_default_matches_hertz(tmp_path):
+    d = punch(tmp_path, "--steps", "4")
+    assert abs(d["force_rel_error"]) < 0.005
+    assert abs(d["contact_radius"] - d["hertz_contact_radius"]) <= d["element_size"]
+    assert abs(d["max_pressure_rel_error"]) < 0.03
+    assert abs(d["fitted_exponent"] - 1.5) < 0.02
+    assert d["active_set_iterations"] >= 4 and d["dofs"] > 0 and d["ranks"] == 1
+
+
+@pytest.mark.parametrize("E,nu,R,delta", [
+    (210e9, 0.25, 0.02, 2e-5),  # steel ball, 20 mm, 20 µm
+    (3e6, 0.45, 5.0, 0.2),  # rubber-like block, large punch
+])
+def test_punch_accuracy_holds_for_other_parameters(tmp_path, E, nu, R, delta):
+    d = punch(tmp_path, "--E", str(E), "--nu", str(nu), "--radius", str(R),
+              "--indentation", str(delta))
+    assert abs(d["force_rel_error"]) < 0.005
+    assert abs(d["contact_radius"] - d["hertz_contact_radius"]) <= d["element_size"]
+    assert abs(d["max_pressure_rel_error"]) < 0.03
+
+
+def test_punch_plane_strain_half_width_and_pressure(tmp_path):
+    d = punch(tmp_path, "--model", "plane-strain")
+    assert abs(d["contact_radius_rel_error"]) < 0.02
+    assert abs(d["max_pressure_rel_error"]) < 0.02
+
+
+def test_punch_3d_quarter_model(tmp_path):
+    d = punch(tmp_path, "--model", "3d")
+    assert abs(d["force_rel_error"]) < 0.02
+
+
+def test_punch_force_control_reaches_the_force(tmp_path):
+    d = punch(tmp_path, "--force", "0.0015")
+    assert d["force"] == pytest.approx(0.0015, rel=1e-9)
+    assert abs(d["force_rel_error"]) < 0.005  # P against Hertz at the δ found
+
+
+def test_punch_formulations_agree(tmp_path):
+    e = punch(tmp_path, "--formulation", "elimination")
+    m = punch(tmp_path, "--formulation", "multiplier")
+    assert m["force"] == pytest.approx(e["force"], rel=1e-9)
+    assert m["contact_radius"] == e["contact_radius"]
+
+
+def test_punch_two_ranks_match_serial(tmp_path):
+    s = punch(tmp_path, "--steps", "2")
+    p = punch(tmp_path, "--steps", "2", ranks=2)
+    assert p["ranks"] == 2
+    assert p["force"] == pytest.approx(s["force"], rel=1e-8)
+    assert p["contact_radius"] == pytest.approx(s["contact_radius"], rel=1e-12)
+
+
+def test_punch_that_never_touches_gives_zero_force(tmp_path):
+    proc = run([DEMOS / "punch.py", "--indentation", "-0.01", "--json", tmp_path / "z.json"],
+               tmp_path)
+    d = json.loads((tmp_path / "z.json").read_text())
+    assert d["force"] == 0.0 and d["contact_radius"] == 0.0
+    assert "does not touch" in proc.stdout
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--nu", "0.5"], "nu must be in"), (["--radius", "-1"], "radius must be > 0"),
+    (["--E", "-3"], "E must be in"), (["--steps", "0"], "--steps"),
+    (["--bogus", "1"], "unrecognized"), (["--force", "-1"], "--force"),
+])
+def test_punch_bad_input_one_clear_line(tmp_path, args, message):
+    proc = run([DEMOS / "punch.py", *args], tmp_path, check=False)
+    assert proc.returncode != 0
+    assert message in proc.stderr and "Traceback" not in proc.stderr

@@ -71,14 +71,14 @@ def test_linear_elastic_energy_gives_hooke_exactly():
     ref = fem.assemble_scalar(fem.form(ufl.inner(hooke, hooke) * ufl.dx))
     assert err <= 1e-28 * ref
     # tangent A_ijkl = λ δij δkl + μ (δik δjl + δil δjk), at any strain
-    i, j, k, l = ufl.indices(4)
+    i, j, k, m = ufl.indices(4)
     d = ufl.Identity(3)
-    C = ufl.as_tensor(mat.lmbda * d[i, j] * d[k, l]
-                      + mat.mu * (d[i, k] * d[j, l] + d[i, l] * d[j, k]), (i, j, k, l))
+    C = ufl.as_tensor(mat.lmbda * d[i, j] * d[k, m]
+                      + mat.mu * (d[i, k] * d[j, m] + d[i, m] * d[j, k]), (i, j, k, m))
     # ∂²φ/∂ε∂ε treats ε as a general tensor: only its action on symmetric tensors is defined
     B = ufl.sym(ufl.as_matrix([[1.0, 2.0, -3.0], [0.5, -1.0, 4.0], [2.0, 1.0, 0.25]]))
-    AB = ufl.as_tensor(mat.tangent(eps)[i, j, k, l] * B[k, l], (i, j))
-    CB = ufl.as_tensor(C[i, j, k, l] * B[k, l], (i, j))
+    AB = ufl.as_tensor(mat.tangent(eps)[i, j, k, m] * B[k, m], (i, j))
+    CB = ufl.as_tensor(C[i, j, k, m] * B[k, m], (i, j))
     dx = ufl.dx(domain=V.mesh)
     errA = fem.assemble_scalar(fem.form(ufl.inner(AB - CB, AB - CB) * dx))
     assert errA <= 1e-24 * fem.assemble_scalar(fem.form(ufl.inner(CB, CB) * dx))
