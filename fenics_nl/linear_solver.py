@@ -35,9 +35,13 @@ def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
 
 
 def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
-               near_nullspace: PETSc.NullSpace | None = None, rtol: float = 1e-10) -> PETSc.KSP:
+               near_nullspace: PETSc.NullSpace | None = None, rtol: float = 1e-10,
+               P: PETSc.Mat | None = None) -> PETSc.KSP:
     """A KSP on `A`: direct MUMPS LU/Cholesky, or CG+GAMG (needs `near_nullspace`).
 
+    With a separate preconditioning matrix `P` and a direct `kind`, the KSP is CG
+    preconditioned by the factorization of P: P may lag behind A (an older tangent, older
+    Dirichlet rows) and the factorization is reused until it no longer pays.
     PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
     command line can override every choice made here.
     """
@@ -45,9 +49,14 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         raise ValueError(f"linear solver must be one of {', '.join(KINDS)}, got {kind!r}")
     ksp = PETSc.KSP().create(A.comm)
     ksp.setOptionsPrefix(prefix)
-    ksp.setOperators(A)
+    ksp.setOperators(A, P if P is not None else A)
     pc = ksp.getPC()
-    if kind in ("lu", "cholesky"):
+    if kind in ("lu", "cholesky") and P is not None:
+        ksp.setType("cg")
+        ksp.setTolerances(rtol=rtol, atol=0.0, max_it=50)
+        pc.setType(kind)
+        pc.setFactorSolverType("mumps")
+    elif kind in ("lu", "cholesky"):
         ksp.setType("preonly")
         pc.setType(kind)
         pc.setFactorSolverType("mumps")

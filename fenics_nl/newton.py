@@ -26,10 +26,13 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
+from ufl.algorithms import expand_derivatives
+from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.convergence import observed_orders
 from fenics_nl.linear_solver import create_ksp, rigid_body_modes
@@ -56,6 +59,7 @@ class WorkCounts:
     tangent_assemblies: int = 0
     factorizations: int = 0
     linear_solves: int = 0
+    krylov_iterations: int = 0  # with a reused factorization: CG iterations, else 0
     time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
 
     def add(self, other: WorkCounts) -> None:
@@ -64,6 +68,7 @@ class WorkCounts:
         self.tangent_assemblies += other.tangent_assemblies
         self.factorizations += other.factorizations
         self.linear_solves += other.linear_solves
+        self.krylov_iterations += other.krylov_iterations
         for k, v in other.time.items():
             self.time[k] = self.time.get(k, 0.0) + v
 
@@ -107,10 +112,17 @@ class NewtonSolver:
     """Hand-written Newton loop for R(u; v) = 0; `solve()` updates `u` in place.
 
     Converged when ‖R‖ ≤ max(atol, rtol ‖R₀‖), R₀ the residual at the start of the solve.
+
+    `reuse_factorization`: a new tangent (or new Dirichlet rows, as in contact) is not
+    refactorized; CG on it is preconditioned by the last factorization, which is renewed
+    only when CG needed more than REUSE_ITERATIONS iterations. Where the tangent changes by
+    a low-rank term (a few constrained rows), CG converges in a handful of iterations.
     `atol` is in the residual's force units: set it from the problem's load scale (e.g.
     1e-10 ‖F_ext‖), since ‖R‖ cannot fall below the round-off of the internal forces and a
     small load increment makes rtol ‖R₀‖ small too.
     """
+
+    REUSE_ITERATIONS = 10
 
     def __init__(
         self,
@@ -130,6 +142,7 @@ class NewtonSolver:
         divergence_tol: float = 1e8,
         line_search: bool = False,
         bfgs_memory: int = 30,
+        reuse_factorization: bool = False,
     ):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -146,6 +159,11 @@ class NewtonSolver:
         J = ufl.derivative(residual, u) if tangent is None else tangent
         self._R = fem.form(residual)
         self._K = fem.form(J)
+        # A tangent with no coefficients (linear material) is assembled once; new Dirichlet
+        # rows are then applied to a copy instead of reassembling.
+        J_expanded = expand_derivatives(J)
+        self._tangent_fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
+        self._K_fixed = None  # K without Dirichlet rows, kept after its first assembly
         if constant_tangent == "elastic" and method in ("modified", "bfgs"):
             # K(0): the same tangent form evaluated at a zero displacement.
             self._K_const = fem.form(ufl.replace(J, {u: fem.Function(V)}))
@@ -154,10 +172,19 @@ class NewtonSolver:
             self._K_const = self._K
             self._constant_for_life = False
         self.A = petsc.create_matrix(self._K)
+        # reuse: the factorized matrix P lags behind A and preconditions CG on A
+        self.reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
+        self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
+        self._P_current = False
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
         nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
-        self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace)
+        self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
+                              P=self.A if self.reuse else None, rtol=1e-12)
+        if self.reuse and self.ksp.getType() == "preonly":
+            # options turned CG off: a lagging factorization would then give wrong solves
+            log.warning("%sksp_type preonly: factorization reuse disabled", prefix)
+            self.reuse = False
         self._tangent_ready = False
         self.total = WorkCounts()
 
@@ -167,10 +194,16 @@ class NewtonSolver:
         im = self.u.function_space.dofmap.index_map
         return im.size_global * self.u.function_space.dofmap.index_map_bs
 
-    def set_bcs(self, bcs: Sequence[fem.DirichletBC]) -> None:
-        """Replace the Dirichlet conditions (their rows change, so the tangent is stale)."""
+    def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False) -> None:
+        """Replace the Dirichlet conditions (their rows change, so the tangent is stale).
+
+        `small_change`: only a few rows differ from the last factorized tangent, so with
+        `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
+        """
         self.bcs = list(bcs)
         self._tangent_ready = False
+        if not small_change:
+            self._P_current = False
 
     def invalidate_tangent(self) -> None:
         """Force the next iteration to rebuild the tangent."""
@@ -246,15 +279,42 @@ class NewtonSolver:
 
     def _assemble_tangent(self, work: WorkCounts) -> None:
         with _Timer(work, "tangent"):
-            self.A.zeroEntries()
-            petsc.assemble_matrix(self.A, self._K_const if self._uses_constant else self._K,
-                                  bcs=self.bcs, diag=1.0)
+            if self._tangent_fixed and not self._uses_constant:
+                self._apply_bcs_to_fixed_tangent(work)
+            else:
+                self.A.zeroEntries()
+                petsc.assemble_matrix(self.A, self._K_const if self._uses_constant else self._K,
+                                      bcs=self.bcs, diag=1.0)
+                self.A.assemble()
+                work.tangent_assemblies += 1
+        if not (self.reuse and self._P_current):
+            self._factorize(work)
+        self._tangent_ready = True
+
+    def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
+        """A = K with the Dirichlet rows and columns replaced by the identity (no assembly)."""
+        if self._K_fixed is None:
+            petsc.assemble_matrix(self.A, self._K)
             self.A.assemble()
             work.tangent_assemblies += 1
+            self._K_fixed = self.A.copy()
+        else:
+            self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        rows = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in self.bcs]
+        rows = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
+        self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
+
+    def _factorize(self, work: WorkCounts) -> None:
+        """Numeric factorization of the current tangent (the symbolic one is reused)."""
         with _Timer(work, "factorization"):
-            self.ksp.getPC().setUp()  # numeric factorization now (symbolic one reused)
+            if self.reuse and self.P is None:
+                self.P = self.A.copy()
+                self.ksp.setOperators(self.A, self.P)
+            elif self.reuse:
+                self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.ksp.getPC().setUp()
             work.factorizations += 1
-        self._tangent_ready = True
+        self._P_current = True
 
     @property
     def _uses_constant(self) -> bool:
@@ -266,6 +326,14 @@ class NewtonSolver:
             self.ksp.solve(rhs, self.du)
             work.linear_solves += 1
         reason = self.ksp.getConvergedReason()
+        if self.reuse:
+            its = self.ksp.getIterationNumber()
+            work.krylov_iterations += its
+            if reason < 0:  # the old factorization no longer helps: refactorize, solve again
+                self._factorize(work)
+                return self._linear_solve(rhs, work)
+            # cheaper to refactorize next time than to keep paying many iterations
+            self._P_current = its <= self.REUSE_ITERATIONS
         if reason < 0:
             raise ConvergenceError(f"linear solver failed (KSP reason {reason})",
                                    NewtonResult(False, "ksp", 0, [], work))

@@ -77,6 +77,7 @@ class Punch:
         self.weight = kinematics.measure_weight(self.mesh, kin)
         dx = kinematics.quadrature_measure("dx", self.mesh, 2)
         residual = material.internal_work(self.u, v, kin) * dx
+        self.residual, self.kinematics = residual, kin
 
         def facets(name):
             return data.facet_tags.find(data.physical_groups[name].tag)
@@ -85,6 +86,7 @@ class Punch:
                boundary.component(V, self.vertical, facets("bottom"))]
         if dim == 3:
             bcs.append(boundary.component(V, 1, facets("symmetry_y")))
+        self.bcs, self.contact_facets = bcs, facets("contact")
         # force of the whole body from the modelled part (2πr is in the weight)
         self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
         opts = {"line_search": not getattr(material, "is_linear", False)}
