@@ -165,7 +165,8 @@ def table(r):
                      f"{row['wall_time_s']:.2f} | {ratio:.2f} | "
                      f"{100 * row['force_rel_error']:+.3f} % | "
                      f"{100 * row['max_pressure_rel_error']:+.2f} % | "
-                     f"{row['contact_radius_error_over_h']:+.2f} | {row['active_set_iterations']} |")
+                     f"{row['contact_radius_error_over_h']:+.2f} | "
+                     f"{row['active_set_iterations']} |")
     lines += ["", "Same axisymmetric mesh, side by side:", "",
               "| method | time (s) | force | force error | iterations | factorizations | "
               "max penetration |",
