@@ -1,8 +1,13 @@
 """Incremental loading: a load factor t from 0 to 1 with adaptive step control.
 
-Each step sets the load (a user callback, typically scaling `fem.Constant` values), calls the
-solver, and on failure restores the last converged state and halves the step. After an easy
-step (few iterations) the step grows. Below `min_step` it stops with a clear error.
+Each step sets the load (a user callback, typically scaling `fem.Constant` values), predicts
+the state by extrapolating the last two converged ones (secant predictor), calls the solver,
+and on failure restores the last converged state and halves the step. After an easy step
+(few iterations) the step grows. Below `min_step` it stops with a clear error.
+
+The predictor matters past a bifurcation: from the last state alone Newton can settle on a
+nearby unstable branch (a column that stays straight above its Euler load); extrapolation
+carries the growing buckling mode into the next step.
 """
 
 from __future__ import annotations
@@ -44,6 +49,7 @@ def solve_incrementally(
     min_step: float = 1e-4,
     max_step: float = 1.0,
     easy_iterations: int = 4,
+    predictor: bool = True,
     on_step: Callable[[float, NewtonResult], None] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> LoadPath:
@@ -52,11 +58,16 @@ def solve_incrementally(
         raise ValueError(f"steps must be >= 1, got {steps}")
     path = LoadPath()
     x = solver.u.x.petsc_vec
-    saved = x.copy()
+    saved = x.copy()  # last converged state
+    previous, dt_previous = None, None  # the one before, for the predictor
     t, dt = 0.0, 1.0 / steps
     while t < 1.0 - 1e-12:
         dt = min(dt, 1.0 - t)
         set_load(t + dt)
+        if predictor and previous is not None:  # u = u_k + (dt/dt_k)(u_k − u_{k−1})
+            x.axpy(dt / dt_previous, saved)
+            x.axpy(-dt / dt_previous, previous)
+            x.ghostUpdate()
         try:
             result = solver.solve()
         except ConvergenceError as err:
@@ -74,6 +85,11 @@ def solve_incrementally(
                 progress(f"  step to t = {t + 2 * dt:.4g} failed ({err}); cut to dt = {dt:.4g}")
             continue
         t += dt
+        if predictor:
+            if previous is None:
+                previous = saved.duplicate()
+            saved.copy(previous)
+            dt_previous = dt
         x.copy(saved)
         path.factors.append(t)
         path.results.append(result)

@@ -1,6 +1,7 @@
 """Run each demo as a user would (a subprocess), serially and under mpiexec."""
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -131,5 +132,76 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path):
 ])
 def test_punch_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "punch.py", *args], tmp_path, check=False)
+    assert proc.returncode != 0
+    assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+def beam(tmp_path, *args, ranks=1):
+    out = tmp_path / ("beam" + "_".join(args).replace("-", "").replace(".", "p") + f"{ranks}.json")
+    cmd = [DEMOS / "buckling_beam.py", *args, "--json", out]
+    if ranks > 1:
+        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr
+    else:
+        run(cmd, tmp_path)
+    return json.loads(out.read_text())
+
+
+def assert_on_elastica(d):
+    assert abs(d["critical_load_rel_error"]) < 0.005
+    da = abs(d["tip_rotation_deg"] - d["elastica_tip_rotation_deg"])
+    assert da < max(0.5, 0.01 * d["elastica_tip_rotation_deg"]), d
+    assert d["tip_deflection"] == pytest.approx(d["elastica_tip_deflection"], rel=0.01)
+    assert all(math.isfinite(p["tip_rotation_deg"]) for p in d["path"])
+
+
+@pytest.mark.parametrize("ratio", ["1.05", "1.2", "2.0"])
+def test_beam_follows_the_elastica(tmp_path, ratio):
+    assert_on_elastica(beam(tmp_path, "--load-ratio", ratio))
+
+
+@pytest.mark.parametrize("args", [
+    ["--length", "2", "--thickness", "0.02", "--E", "210e9", "--nu", "0.25"],  # L/h = 100
+    # ν = 0.45 stiffens 2 Q2 elements through the height (P_cr +0.46 %, α −0.78°):
+    # one refinement halves it, so this case runs at --refine 1
+    ["--plane", "strain", "--E", "5e6", "--nu", "0.45", "--refine", "1"],
+    ["--plane", "strain", "--material", "neo-hookean"],
+])
+def test_beam_accuracy_holds_for_other_parameters(tmp_path, args):
+    assert_on_elastica(beam(tmp_path, *args, "--load-ratio", "1.2"))
+
+
+def test_beam_below_euler_stays_straight(tmp_path):
+    # Only the imperfection bends it: linear theory gives α ≈ ε r π²/8 / (1 − r) rad.
+    d = beam(tmp_path, "--load-ratio", "0.9")
+    eps, r = 1e-4, 0.9
+    amplified = math.degrees(eps * r * math.pi**2 / 8 / (1 - r))
+    assert 0.5 * amplified < d["tip_rotation_deg"] < 1.5 * amplified
+    assert d["tip_rotation_deg"] < 0.1
+
+
+@pytest.mark.parametrize("args", [["--steps", "1"], ["--load-ratio", "10"]])
+def test_beam_stress_cases_land_on_the_right_branch(tmp_path, args):
+    # One huge step converges to the unstable straight beam; the stability check sees it
+    # and switches branch. r = 10 is deep in the post-buckling range (α ≈ 177°).
+    assert_on_elastica(beam(tmp_path, *args))
+
+
+def test_beam_two_ranks_match_serial(tmp_path):
+    s = beam(tmp_path, "--load-ratio", "1.2", "--steps", "20")
+    p = beam(tmp_path, "--load-ratio", "1.2", "--steps", "20", ranks=2)
+    assert p["ranks"] == 2
+    assert p["critical_load"] == pytest.approx(s["critical_load"], rel=1e-8)
+    assert p["tip_rotation_deg"] == pytest.approx(s["tip_rotation_deg"], rel=1e-6)
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--thickness", "0.5"], "slender"), (["--nu", "0.5"], "nu must be in"),
+    (["--load-ratio", "-1"], "--load-ratio"), (["--steps", "0"], "--steps"),
+    (["--material", "neo-hookean"], "plane strain only"), (["--oops"], "unrecognized"),
+])
+def test_beam_bad_input_one_clear_line(tmp_path, args, message):
+    proc = run([DEMOS / "buckling_beam.py", *args], tmp_path, check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr

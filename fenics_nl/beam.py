@@ -1,0 +1,108 @@
+"""The buckling beam: a slender 2D cantilever under a dead axial load at its free end.
+
+Clamped at x = 0, length L, height h (unit width), Q2 quadrilaterals, finite strain. The
+end x = L carries the dead traction (−P, H)/h: the axial load P and a small lateral load
+H = ε P, the imperfection that picks the buckled branch. Tip quantities are averages over
+the end face (parallel-safe integrals): lateral deflection, axial displacement, and the
+rotation α of the end section, from its deformed tangent F·e_y.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl import boundary, kinematics
+from fenics_nl.buckling import critical_loads, geometric_stiffness
+from fenics_nl.elastica import euler_load
+from fenics_nl.materials import LinearElastic, NeoHookean, StVenantKirchhoff
+
+MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
+
+
+class Beam:
+    """Build once; `set_load(P)`, `tip()`, `critical_loads()`."""
+
+    def __init__(self, length: float, thickness: float, E: float, nu: float, *,
+                 material: str = "svk", plane: str = "stress", refine: int = 0,
+                 imperfection: float = 1e-4, comm: MPI.Comm = MPI.COMM_WORLD):
+        if material not in MATERIALS:
+            raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
+        if plane not in ("stress", "strain"):
+            raise ValueError(f"plane must be stress or strain, got {plane!r}")
+        if not (length > 0 and thickness > 0):
+            raise ValueError(f"length and thickness must be > 0, got {length}, {thickness}")
+        if thickness > length / 5:
+            raise ValueError(f"the beam must be slender: thickness <= length/5, got L/h = "
+                             f"{length / thickness:.3g}")
+        if material == "neo-hookean" and plane == "stress":
+            raise ValueError("neo-hookean is implemented in plane strain only (--plane strain)")
+        if refine < 0:
+            raise ValueError(f"refine must be >= 0, got {refine}")
+        self.L, self.h, self.imperfection = length, thickness, imperfection
+        self.model = "plane_stress" if plane == "stress" else "plane_strain"
+        self.material = MATERIALS[material](E, nu)
+        self.E_bending = E if plane == "stress" else E / (1 - nu**2)
+        self.P_euler = euler_load(self.E_bending, thickness**3 / 12, length)
+        ny = 2 * 2**refine
+        nx = max(4, round(length / thickness * ny / 2))  # square-ish Q2 elements
+        self.mesh = mesh.create_rectangle(comm, [[0, -thickness / 2], [length, thickness / 2]],
+                                          [nx, ny], mesh.CellType.quadrilateral)
+        V = fem.functionspace(self.mesh, ("Lagrange", 2, (2,)))
+        self.V = V
+        self.u = fem.Function(V, name="displacement")
+        fdim = 1
+        clamped = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], 0))
+        end = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], length))
+        tags = mesh.meshtags(self.mesh, fdim, end, np.ones(len(end), dtype=np.int32))
+        self.bcs = [boundary.fixed(V, clamped)]
+        self.ds_end = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
+        self.traction = fem.Constant(self.mesh, np.zeros(2))
+        v = ufl.TestFunction(V)
+        self.dx = kinematics.quadrature_measure("dx", self.mesh, 4)
+        self.residual = (self.material.internal_work(self.u, v, self.model) * self.dx
+                         - ufl.dot(self.traction, v) * self.ds_end)
+        u = self.u
+        F = kinematics.deformation_gradient(u, "plane_stress")  # 2x2 in-plane F
+        self._tip_forms = [fem.form(f * self.ds_end) for f in
+                           (u[0] / thickness, u[1] / thickness, F[0, 1], F[1, 1])]
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        return self.V.dofmap.index_map.size_global * 2
+
+    def set_load(self, P: float) -> None:
+        """Dead end load: axial compression P and the lateral imperfection ε P."""
+        self.traction.value[:] = [-P / self.h, self.imperfection * P / self.h]
+
+    def tip(self) -> dict[str, float]:
+        """Mean end-face axial and lateral displacement, and the end-section rotation α."""
+        comm = self.mesh.comm
+        ux, uy, t0, t1 = (comm.allreduce(fem.assemble_scalar(f)) for f in self._tip_forms)
+        return {"axial": ux, "lateral": uy, "rotation": math.atan2(-t0, t1)}
+
+    def critical_loads(self, n: int = 3):
+        """SLEPc: the first n critical loads and modes around the undeformed state."""
+        du, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        lin = LinearElastic(self.material.E, self.material.nu)
+        # pre-stress of a unit compressive load: one linear solve
+        u0 = fem.Function(self.V)
+        eps = kinematics.small_strain
+        a = ufl.inner(lin.stress(eps(du, self.model)), eps(v, self.model)) * self.dx
+        t = fem.Constant(self.mesh, np.array([-1.0 / self.h, 0.0]))
+        from dolfinx.fem.petsc import LinearProblem
+
+        LinearProblem(a, ufl.dot(t, v) * self.ds_end, u=u0, bcs=self.bcs,
+                      petsc_options_prefix="prestress_",
+                      petsc_options={"ksp_type": "preonly", "pc_type": "lu",
+                                     "pc_factor_mat_solver_type": "mumps"}).solve()
+        sigma0 = lin.stress(eps(u0, self.model))
+        a_G = geometric_stiffness(sigma0, du, v,  # embedded 3x3 ∇ matches a 3x3 σ₀
+                                  lambda w: kinematics.displacement_gradient(w, self.model))
+        a_G = a_G * self.dx
+        return critical_loads(a, a_G, self.bcs, self.V, n=n)
