@@ -34,11 +34,11 @@ import sys
 import time
 from pathlib import Path
 
-import fenics_nl  # noqa: F401  (loads MPI/PETSc first)
 import numpy as np
 import ufl
 from mpi4py import MPI
 
+import fenics_nl  # noqa: F401  (loads MPI/PETSc first)
 from fenics_nl import elastica
 from fenics_nl.beam import Beam
 from fenics_nl.buckling import lowest_tangent_mode
@@ -121,7 +121,7 @@ def run(args):
 
     # Linear buckling (SLEPc) against Euler.
     # +
-    loads, modes = beam.critical_loads(3)
+    loads, _ = beam.critical_loads(3)
     P_cr = loads[0]
     say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
         f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
@@ -149,7 +149,7 @@ def run(args):
     # +
     tangent = ufl.derivative(beam.residual, beam.u)
     steps, switched = args.steps, False
-    for attempt in range(3):
+    for _ in range(3):
         history[:], shapes[:] = [(0.0, 0.0, 0.0, 0.0)], []
         beam.u.x.array[:] = 0.0
         path = solve_incrementally(solver, lambda t: beam.set_load(t * P), steps=steps,
