@@ -16,6 +16,10 @@ import platform
 import time
 from pathlib import Path
 
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
 import dolfinx
 import ufl
 from dolfinx import fem
@@ -23,7 +27,6 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-import fenics_nl  # noqa: F401
 from fenics_nl import hertz
 from fenics_nl.contact_peers import solve_penalty, solve_snes_vi
 from fenics_nl.linear_solver import create_ksp

@@ -11,6 +11,10 @@ import platform
 import time
 from pathlib import Path
 
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
 import dolfinx
 import numpy as np
 import ufl
@@ -19,7 +23,6 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-import fenics_nl  # noqa: F401  (before dolfinx)
 from fenics_nl.linear_solver import create_ksp
 from fenics_nl.materials import LinearElastic, PowerLaw
 from fenics_nl.newton import NewtonSolver

@@ -34,11 +34,14 @@ import sys
 import time
 from pathlib import Path
 
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
 import numpy as np
 import ufl
 from mpi4py import MPI
 
-import fenics_nl  # noqa: F401  (loads MPI/PETSc first)
 from fenics_nl import elastica
 from fenics_nl.beam import Beam
 from fenics_nl.buckling import lowest_tangent_mode

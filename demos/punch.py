@@ -38,10 +38,13 @@ import sys
 import time
 from pathlib import Path
 
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
 import numpy as np
 from mpi4py import MPI
 
-import fenics_nl  # noqa: F401  (loads MPI/PETSc first)
 from fenics_nl import hertz
 from fenics_nl.contact import ContactError
 from fenics_nl.materials import LinearElastic, PowerLaw
