@@ -39,14 +39,12 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
-import ufl
 from mpi4py import MPI
 
 from fenics_nl import elastica
 from fenics_nl.beam import Beam
-from fenics_nl.buckling import lowest_tangent_mode
-from fenics_nl.loading import LoadStepError, solve_incrementally
-from fenics_nl.newton import ConvergenceError, NewtonSolver
+from fenics_nl.loading import LoadStepError
+from fenics_nl.newton import ConvergenceError
 
 comm = MPI.COMM_WORLD
 
@@ -130,53 +128,26 @@ def run(args):
         f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
     # -
 
-    # Post-buckling path: load steps to r·P_Euler, adaptive cuts, never larger than 1/n.
+    # Post-buckling path: load steps to r·P_Euler (never larger than 1/n, cut on failure),
+    # then the stability check of the end state and, if needed, branch switching.
     # +
-    P = args.load_ratio * beam.P_euler
-    # rtol 1e-8: near P_cr the tangent is nearly singular and modified Newton's linear rate
-    # is close to 1; tighter tolerances stall there on round-off.
-    solver = NewtonSolver(beam.residual, beam.u, beam.bcs, method=args.newton, rtol=1e-8,
-                          atol=1e-9 * P, max_it=30 if args.newton == "full" else 500,
-                          prefix="beam_")
-    history, shapes = [], []
+    history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
 
     def record(t, result):
+        r = t * args.load_ratio
+        # a redone path, or the branch-switched end state, replaces what it passes again
+        while len(history) > 1 and history[-1][0] >= r:
+            history.pop()
+        while shapes and shapes[-1][0] >= r:
+            shapes.pop()
         tip = beam.tip()
-        history.append((t * args.load_ratio, math.degrees(abs(tip["rotation"])),
-                        abs(tip["lateral"]), tip["axial"]))
+        history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
+                        tip["axial"]))
         if args.png:
-            shapes.append((t * args.load_ratio, centreline(beam)))
+            shapes.append((r, centreline(beam)))
 
-    # An unstable end state is the straight branch: kick it along its unstable mode to
-    # the elastica's deflection; if Newton cannot follow, redo the path with 4x the steps.
-    # +
-    tangent = ufl.derivative(beam.residual, beam.u)
-    steps, switched = args.steps, False
-    for _ in range(3):
-        history[:], shapes[:] = [(0.0, 0.0, 0.0, 0.0)], []
-        beam.u.x.array[:] = 0.0
-        path = solve_incrementally(solver, lambda t: beam.set_load(t * P), steps=steps,
-                                   max_step=1.0 / steps, on_step=record,
-                                   progress=lambda m: say("  " + m))
-        lam, mode = lowest_tangent_mode(tangent, beam.bcs, beam.V)
-        if lam >= 0:
-            break
-        say(f"end state unstable (tangent eigenvalue {lam:.3g}): switching branch")
-        kick_along(beam, mode, elastica.tip_position(args.load_ratio)[0] * args.length)
-        try:
-            result = solver.solve()
-        except ConvergenceError:
-            steps *= 4
-            say(f"branch switching failed: load path again with {steps} steps")
-            continue
-        if lowest_tangent_mode(tangent, beam.bcs, beam.V)[0] >= 0:
-            path.results.append(result)
-            record(1.0, result)
-            switched = True
-            break
-    else:
-        raise RuntimeError(f"no stable end state at P/P_cr = {args.load_ratio:g} "
-                           f"with up to {steps} steps")
+    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
+                                     on_step=record, progress=lambda m: say("  " + m))
     # -
 
     tip = beam.tip()
@@ -215,17 +186,6 @@ def run(args):
     if args.png:
         picture(shapes, args)
     return out
-
-
-def kick_along(beam, mode, deflection):
-    """u += η φ with η such that φ's end-face lateral displacement equals `deflection`."""
-    x = beam.V.tabulate_dof_coordinates()[:, 0]
-    at_tip = np.isclose(x, beam.L)
-    lat = mode.x.array.reshape(-1, 2)[:, 1]
-    s = comm.allreduce(float(lat[at_tip].sum()))
-    n = comm.allreduce(int(at_tip.sum()))
-    beam.u.x.array[:] += deflection / (s / n) * mode.x.array
-    beam.u.x.scatter_forward()
 
 
 def centreline(beam):

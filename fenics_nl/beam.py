@@ -16,10 +16,12 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import boundary, kinematics
-from fenics_nl.buckling import critical_loads, geometric_stiffness
+from fenics_nl import boundary, elastica, kinematics
+from fenics_nl.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.elastica import euler_load
+from fenics_nl.loading import LoadPath, solve_incrementally
 from fenics_nl.materials import LinearElastic, NeoHookean, StVenantKirchhoff
+from fenics_nl.newton import ConvergenceError, NewtonSolver
 
 MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
 
@@ -29,7 +31,7 @@ class Beam:
 
     def __init__(self, length: float, thickness: float, E: float, nu: float, *,
                  material: str = "svk", plane: str = "stress", refine: int = 0,
-                 imperfection: float = 1e-4, comm: MPI.Comm = MPI.COMM_WORLD):
+                 imperfection: float = 1e-4, degree: int = 2, comm: MPI.Comm = MPI.COMM_WORLD):
         if material not in MATERIALS:
             raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
         if plane not in ("stress", "strain"):
@@ -52,7 +54,7 @@ class Beam:
         nx = max(4, round(length / thickness * ny / 2))  # square-ish Q2 elements
         self.mesh = mesh.create_rectangle(comm, [[0, -thickness / 2], [length, thickness / 2]],
                                           [nx, ny], mesh.CellType.quadrilateral)
-        V = fem.functionspace(self.mesh, ("Lagrange", 2, (2,)))
+        V = fem.functionspace(self.mesh, ("Lagrange", degree, (2,)))
         self.V = V
         self.u = fem.Function(V, name="displacement")
         fdim = 1
@@ -106,3 +108,56 @@ class Beam:
                                   lambda w: kinematics.displacement_gradient(w, self.model))
         a_G = a_G * self.dx
         return critical_loads(a, a_G, self.bcs, self.V, n=n)
+
+    def solve_path(self, ratio: float, steps: int = 40, method: str = "full", *,
+                   grow: bool = False, on_step=None, progress=None) -> tuple[LoadPath, bool]:
+        """Load steps from 0 to ratio·P_Euler, then make sure the end state is stable.
+
+        Steps start at 1/steps and are cut on failure; with `grow` they also grow after easy
+        steps. Past P_cr the straight beam is an unstable equilibrium Newton can settle on;
+        the tangent's eigenvalue nearest 0 (SLEPc) tells. An unstable end state is kicked
+        along its unstable mode to the elastica's deflection and solved again (branch
+        switching); if Newton cannot follow, the path is redone with 4x the steps.
+        Returns the path and whether the branch was switched.
+        """
+        P = ratio * self.P_euler
+        # rtol 1e-8: near P_cr the tangent is nearly singular and modified Newton's linear
+        # rate is close to 1; tighter tolerances stall there on round-off.
+        solver = NewtonSolver(self.residual, self.u, self.bcs, method=method, rtol=1e-8,
+                              atol=1e-9 * P, max_it=30 if method == "full" else 500,
+                              prefix=f"beam_{method}_")
+        tangent = ufl.derivative(self.residual, self.u)
+        for _ in range(3):
+            self.u.x.array[:] = 0.0
+            path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
+                                       max_step=1.0 if grow else 1.0 / steps,
+                                       on_step=on_step, progress=progress)
+            lam, mode = lowest_tangent_mode(tangent, self.bcs, self.V)
+            if lam >= 0:
+                return path, False
+            if progress:
+                progress(f"end state unstable (tangent eigenvalue {lam:.3g}): switching branch")
+            self.kick_along(mode, elastica.tip_position(ratio)[0] * self.L)
+            try:
+                result = solver.solve()
+            except ConvergenceError:
+                steps *= 4
+                if progress:
+                    progress(f"branch switching failed: load path again with {steps} steps")
+                continue
+            if lowest_tangent_mode(tangent, self.bcs, self.V)[0] >= 0:
+                path.results.append(result)
+                path.work.add(result.work)
+                if on_step:
+                    on_step(1.0, result)
+                return path, True
+        raise RuntimeError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
+
+    def kick_along(self, mode: fem.Function, deflection: float) -> None:
+        """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`."""
+        comm = self.mesh.comm
+        at_tip = np.isclose(self.V.tabulate_dof_coordinates()[:, 0], self.L)
+        lateral = mode.x.array.reshape(-1, 2)[:, 1]
+        mean = comm.allreduce(float(lateral[at_tip].sum())) / comm.allreduce(int(at_tip.sum()))
+        self.u.x.array[:] += deflection / mean * mode.x.array
+        self.u.x.scatter_forward()
