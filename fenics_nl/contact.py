@@ -39,7 +39,7 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenics_nl.newton import NewtonSolver
+from fenics_nl.newton import NewtonSolver, WorkCounts
 
 log = logging.getLogger(__name__)
 
@@ -62,6 +62,8 @@ class ContactResult:
     wall_time: float
     force: float = 0.0  # total normal contact force, −Σ T_n (positive in compression)
     history: list[dict] = field(default_factory=list)
+    work: WorkCounts = field(default_factory=WorkCounts)  # summed over the inner solves
+    residual_norms: list[float] = field(default_factory=list)  # of the last inner solve
 
 
 class ActiveSetContact:
@@ -239,6 +241,8 @@ class ActiveSetContact:
             res.newton_iterations += nr.iterations
             res.linear_solves += nr.work.linear_solves
             res.factorizations += nr.work.factorizations
+            res.work.add(nr.work)
+            res.residual_norms = nr.residual_norms
             T_n, d = self.normal_forces(), self.normal_gap()
             scale_T = self.comm.allreduce(float(np.max(np.abs(T_n), initial=0.0)), op=MPI.MAX)
             scale_u = self.comm.allreduce(

@@ -205,3 +205,71 @@ def test_beam_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "buckling_beam.py", *args], tmp_path, check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+def bracket(tmp_path, *args, ranks=1):
+    out = tmp_path / ("bracket" + "_".join(args).replace("-", "") + f"{ranks}.json")
+    cmd = [DEMOS / "bracket.py", *args, "--json", out]
+    if ranks > 1:
+        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=900)
+        assert proc.returncode == 0, proc.stderr
+    else:
+        run(cmd, tmp_path)
+    return json.loads(out.read_text())
+
+
+def test_bracket_newton_variants_agree(tmp_path):
+    d = bracket(tmp_path, "--compare")
+    ref = d["variants"]["full"]["load_point_displacement"]
+    for name, v in d["variants"].items():
+        assert abs(v["load_point_displacement"] / ref - 1) < 1e-7, name
+    steps = len(d["steps"])
+    assert d["variants"]["modified"]["factorizations"] == steps  # once per load step
+    assert d["variants"]["quasi-newton"]["factorizations"] == steps
+    assert d["max_eps_eq_over_eps0"] > 10  # strongly non-linear, as the demo says
+
+
+def test_bracket_contact_support_lifts_off(tmp_path):
+    c = bracket(tmp_path, "--support", "contact")
+    k = bracket(tmp_path)
+    base_area = 100 * 60 - 2 * math.pi * 6**2
+    assert 0 < c["lifted_off_area"] < base_area
+    # the floor only adds support: the arm moves less than with the bolts alone
+    assert c["load_point_displacement"] < k["load_point_displacement"]
+
+
+@pytest.mark.parametrize("support", ["clamped", "contact"])
+def test_bracket_two_ranks_match_serial(tmp_path, support):
+    s = bracket(tmp_path, "--support", support)
+    p = bracket(tmp_path, "--support", support, ranks=2)
+    assert p["ranks"] == 2 and p["dofs"] == s["dofs"]
+    assert p["load_point_displacement"] == pytest.approx(s["load_point_displacement"], rel=1e-8)
+
+
+def _box_without_groups(path):
+    import gmsh
+
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("box")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.model.addPhysicalGroup(3, [1], 1, name="solid")
+    gmsh.model.addPhysicalGroup(2, [1], 2, name="bolts")
+    gmsh.model.mesh.generate(3)
+    gmsh.write(str(path))
+    gmsh.finalize()
+
+
+def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
+    (tmp_path / "corrupt.msh").write_text("$MeshFormat\nthis is not a mesh\n")
+    _box_without_groups(tmp_path / "box.msh")
+    for args, message in [(["--mesh", "nowhere.msh"], "mesh file not found"),
+                          (["--mesh", "corrupt.msh"], "cannot read mesh file"),
+                          (["--mesh", "box.msh"], "no physical group load, base"),
+                          (["--support", "contact", "--newton", "snes"], "clamped only"),
+                          (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size")]:
+        proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
+        assert proc.returncode != 0, args
+        assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)

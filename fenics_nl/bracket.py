@@ -1,0 +1,138 @@
+"""The bracket scene: a 3D gmsh part, a power-law material, bolts and a rigid floor.
+
+The mesh comes from `meshes/bracket.py` (built on rank 0, distributed) or from a user's
+.msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
+a uniform traction of total force F along +x; the bolt holes are clamped, and with
+``support="contact"`` the base also rests on a rigid floor (frictionless, may lift off).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import gmsh
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.io import gmsh as gmshio
+from mpi4py import MPI
+
+from fenics_nl import boundary, kinematics
+from fenics_nl.contact import ActiveSetContact
+from fenics_nl.newton import NewtonSolver
+from fenics_nl.snes import SnesSolver
+
+GROUPS = ("bolts", "load", "base")
+GEOMETRY = Path(__file__).resolve().parents[1] / "meshes" / "bracket.py"
+
+
+def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None):
+    """MeshData from `meshes/bracket.py` (element size `size`) or from a .msh file."""
+    if path is not None:
+        if not Path(path).is_file():
+            raise ValueError(f"mesh file not found: {path}")
+        try:
+            data = gmshio.read_from_msh(path, comm, 0, gdim=3)
+        except Exception as err:  # gmsh/dolfinx raise various types on corrupt files
+            raise ValueError(f"cannot read mesh file {path}: {err}") from None
+    else:
+        spec = importlib.util.spec_from_file_location("bracket_geometry", GEOMETRY)
+        geometry = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(geometry)
+        if comm.rank == 0:
+            if not gmsh.isInitialized():
+                gmsh.initialize(interruptible=False)
+            geometry.build(size)
+        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+        if comm.rank == 0:
+            gmsh.model.remove()
+    missing = [g for g in GROUPS if g not in data.physical_groups]
+    if missing:
+        raise ValueError(f"the mesh has no physical group {', '.join(missing)} "
+                         f"(needs {', '.join(GROUPS)})")
+    return data
+
+
+class Bracket:
+    """Build once; `set_load(F)`, `solve()`, `load_point_displacement()`, `von_mises()`."""
+
+    def __init__(self, material, *, size: float = 5.0, mesh_file: str | None = None,
+                 support: str = "clamped", degree: int = 1, newton: str = "full",
+                 linear_solver: str = "lu", comm: MPI.Comm = MPI.COMM_WORLD, period: int = 3,
+                 force_scale: float = 1e4):
+        if support not in ("clamped", "contact"):
+            raise ValueError(f"support must be clamped or contact, got {support!r}")
+        if newton == "snes" and support == "contact":
+            raise ValueError("--newton snes works with --support clamped only")
+        self.material, self.support = material, support
+        data = load_mesh(comm, size, mesh_file)
+        self.mesh = data.mesh
+        tags = data.facet_tags
+
+        def facets(name):
+            return tags.find(data.physical_groups[name].tag)
+
+        V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
+        self.V = V
+        self.u = fem.Function(V, name="displacement")
+        v = ufl.TestFunction(V)
+        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
+        self.ds_load = ds(data.physical_groups["load"].tag)
+        self.load_area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * self.ds_load)))
+        self.traction = fem.Constant(self.mesh, np.zeros(3))
+        dx = kinematics.quadrature_measure("dx", self.mesh, 2 * degree)
+        self.residual = (material.internal_work(self.u, v) * dx
+                         - ufl.dot(self.traction, v) * self.ds_load)
+        bcs = [boundary.fixed(V, facets("bolts"))]
+        self.base_facets = facets("base")
+        # atol from the load: ‖R‖ cannot go below the round-off of forces of that size, and
+        # an active-set iteration restarts Newton close to equilibrium (small ‖R₀‖)
+        atol = 1e-10 * force_scale
+        opts = {"method": {"quasi-newton": "bfgs"}.get(newton, newton), "rtol": 1e-10,
+                "atol": atol, "max_it": 500, "linear_solver": linear_solver, "period": period}
+        if support == "contact":
+            # the floor z = 0 under the base: outward normal −e_z, gap 0
+            self.solver = ActiveSetContact(
+                self.residual, self.u, bcs, self.base_facets, lambda x: np.zeros(x.shape[1]),
+                normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
+                newton_options={k: v for k, v in opts.items() if k != "linear_solver"})
+        elif newton == "snes":
+            self.solver = SnesSolver(self.residual, self.u, bcs, prefix="bracket_snes_",
+                                     rtol=1e-10, atol=atol, max_it=100,
+                                     linear_solver=linear_solver)
+        else:
+            self.solver = NewtonSolver(self.residual, self.u, bcs, prefix="bracket_", **opts)
+        self.bcs = bcs
+        self._mean_u = [fem.form(self.u[i] * self.ds_load) for i in range(3)]
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        return self.V.dofmap.index_map.size_global * 3
+
+    def set_load(self, force: float) -> None:
+        """Total force `force` [N] along +x, spread uniformly over the loaded hole."""
+        self.traction.value[:] = [force / self.load_area, 0.0, 0.0]
+
+    def load_point_displacement(self) -> float:
+        """|mean displacement of the loaded hole| [mm]."""
+        comm = self.mesh.comm
+        mean = [comm.allreduce(fem.assemble_scalar(f)) / self.load_area for f in self._mean_u]
+        return float(np.linalg.norm(mean))
+
+    def von_mises(self) -> fem.Function:
+        """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""
+        Q = fem.functionspace(self.mesh, ("DG", 0))
+        s = ufl.dev(self.material.stress(kinematics.small_strain(self.u)))
+        expr = fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)), Q.element.interpolation_points)
+        f = fem.Function(Q, name="von_mises")
+        f.interpolate(expr)
+        return f
+
+    def lifted_off_area(self) -> float:
+        """Area of the base not in contact with the floor [mm²] (contact support only)."""
+        c = self.solver
+        tags = c.active_facets()
+        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
+        return self.mesh.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds(0))))
