@@ -55,7 +55,8 @@ def refinement(degrees, refines, ratio=1.5):
                          "tip_rotation_error_deg": alpha - math.degrees(
                              elastica.tip_rotation(ratio)),
                          "path_time_s": t2 - t1, "newton_iterations": path.iterations})
-            say(f"Q{degree} refine {r}: {b.dofs} dofs, P_cr {100 * rows[-1]['critical_load_rel_error']:+.3f} %, "
+            err = 100 * rows[-1]["critical_load_rel_error"]
+            say(f"Q{degree} refine {r}: {b.dofs} dofs, P_cr {err:+.3f} %, "
                 f"rotation error {rows[-1]['tip_rotation_error_deg']:+.3f} deg, "
                 f"{t2 - t0:.2f} s")
     return rows
@@ -88,8 +89,8 @@ def variants(ratio=2.0, steps=40):
             "time_per_step_near_s": sum(s[2] for s in near) / len(near) if near else None,
             "time_per_step_away_s": sum(s[2] for s in away) / len(away) if away else None,
         }
-        say(f"{method}: {wall:.2f} s, failed at {failed_at}, near {out[method]['mean_iterations_near']}, "
-            f"away {out[method]['mean_iterations_away']}")
+        near, away = out[method]["mean_iterations_near"], out[method]["mean_iterations_away"]
+        say(f"{method}: {wall:.2f} s, failed at {failed_at}, near {near}, away {away}")
     return out
 
 
@@ -111,11 +112,13 @@ def step_control(ratio=2.0):
 
 
 def tables(r):
-    a = ["| element | refine | unknowns | P_cr error | α error at 1.5 P_cr | SLEPc (s) | path (s) |",
+    a = ["| element | refine | unknowns | P_cr error | α error at 1.5 P_cr | SLEPc (s) | "
+         "path (s) |",
          "|---|---|---|---|---|---|---|"]
     for x in r["refinement"]:
         a.append(f"| Q{x['degree']} | {x['refine']} | {x['dofs']} | "
-                 f"{100 * x['critical_load_rel_error']:+.3f} % | {x['tip_rotation_error_deg']:+.3f}° | "
+                 f"{100 * x['critical_load_rel_error']:+.3f} % | "
+                 f"{x['tip_rotation_error_deg']:+.3f}° | "
                  f"{x['buckling_time_s']:.2f} | {x['path_time_s']:.2f} |")
     b = ["| Newton | time (s) | factorizations | mean its/step away (r < 0.8 or > 1.5) | "
          "near (0.95-1.1) | outcome |", "|---|---|---|---|---|---|"]

@@ -24,6 +24,7 @@
 # +
 import argparse
 import json
+import resource
 import sys
 import time
 from pathlib import Path
@@ -127,6 +128,8 @@ def summary(b, steps, wall, args):
         "residual_norms": steps[-1]["residual_norms"],
         "steps": [{k: v for k, v in s.items() if k != "residual_norms"} for s in steps],
         "dofs": b.dofs, "ranks": comm.size, "solve_time_s": wall,
+        "peak_memory_mb": comm.allreduce(
+            resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, op=MPI.MAX),
     }
     if args.support == "contact":
         out["lifted_off_area"] = b.lifted_off_area()

@@ -41,7 +41,7 @@ def build(size: float) -> None:
     occ.synchronize()
     groups = {name: [] for name in GROUPS}
     for _, tag in gmsh.model.getEntities(2):
-        x, y, z = occ.getCenterOfMass(2, tag)
+        x, _, z = occ.getCenterOfMass(2, tag)
         if abs(z) < 1e-6 and occ.getMass(2, tag) > 100:
             groups["base"].append(tag)
         elif abs(x - BOLT_X) < 1e-6 and z < THICK:
@@ -62,6 +62,7 @@ def _is_line_at(c, x, z):
 
 
 def main():
+    """Write the bracket mesh to a .msh file."""
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--size", type=float, default=5.0, help="largest element size [mm]")
