@@ -19,8 +19,10 @@ and stops when the set does not change. Two formulations of each iteration:
   multiplier (the contact pressure) on a facet submesh of S_C, coupled by a vertex
   quadrature so that the constraint is nodal, as in the elimination.
 
-Non-linear materials: each active-set iteration is a full Newton solve (warm-started), so
-the set is only updated from equilibrium states, where the course's rules are meaningful.
+The nodes are the displacement dofs on S_C: vertices for P1, vertices and edge midpoints for
+P2 (the multiplier formulation is written for P1). Non-linear materials: each active-set
+iteration is a full Newton solve (warm-started), so the set is only updated from
+equilibrium states, where the course's rules are meaningful.
 The active set is kept as DOLFINx meshtags: vertices (`active_vertices`) and the facets of
 S_C whose vertices are all active (`active_facets`), ready to write out.
 """
@@ -99,8 +101,8 @@ class ActiveSetContact:
         if initial not in ("all", "none", "penetrating"):
             raise ValueError(f"initial must be all, none or penetrating, got {initial!r}")
         V = u.function_space
-        if V.element.basix_element.degree != 1:
-            raise ValueError("contact needs a P1 displacement space (nodal active set)")
+        if V.element.basix_element.degree != 1 and formulation == "multiplier":
+            raise ValueError("the multiplier formulation needs a P1 displacement space")
         self.u, self.bcs, self.gap_fn = u, list(bcs), gap
         self.axis, self.sign = normal_axis, int(np.sign(normal_sign))
         self.formulation, self.max_iterations = formulation, max_iterations
@@ -280,6 +282,7 @@ class ActiveSetContact:
     def active_vertices(self) -> mesh.MeshTags:
         """Vertex meshtags of the active nodes (value 1)."""
         verts = self._vertex_of_dof[self.dofs_n[self.active]]
+        verts = verts[verts >= 0]
         order = np.argsort(verts)
         return mesh.meshtags(self.mesh, 0, verts[order].astype(np.int32),
                              np.ones(len(verts), dtype=np.int32))
@@ -291,19 +294,24 @@ class ActiveSetContact:
         f2v = self.mesh.topology.connectivity(fdim, 0)
         active_v = np.zeros(self.mesh.topology.index_map(0).size_local
                             + self.mesh.topology.index_map(0).num_ghosts, dtype=bool)
-        active_v[self._vertex_of_dof[self.dofs_n[self.active]]] = True
+        verts = self._vertex_of_dof[self.dofs_n[self.active]]
+        active_v[verts[verts >= 0]] = True
         values = np.array([active_v[f2v.links(f)].all() for f in self.facets], dtype=np.int32)
         order = np.argsort(self.facets)
         return mesh.meshtags(self.mesh, fdim, self.facets[order], values[order])
 
 
 def _vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
-    """Mesh vertex of each dof of a scalar P1 space (P1 cell dofs follow cell vertices)."""
+    """Mesh vertex of each dof of a scalar Lagrange space, −1 for dofs not at a vertex.
+
+    A Lagrange cell numbers its vertex dofs first, in the order of the cell's vertices.
+    """
     topo = V.mesh.topology
     tdim = topo.dim
     topo.create_connectivity(tdim, 0)
     c2v = topo.connectivity(tdim, 0).array.reshape(-1, tdim + 1)
-    dofs = V.dofmap.list
-    out = np.empty(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, dtype=np.int32)
+    dofs = V.dofmap.list[:, : tdim + 1]
+    out = np.full(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, -1,
+                  dtype=np.int32)
     out[dofs.ravel()] = c2v[: dofs.shape[0]].ravel()
     return out

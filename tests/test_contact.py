@@ -47,13 +47,13 @@ def test_course_mass_spring_example(m):
 
 
 def axisymmetric_punch(formulation, comm=MPI.COMM_WORLD, E=1.0, nu=0.3, R=1.0, delta=0.01,
-                       material=None, h_over_a=0.05, block=300.0):
+                       material=None, h_over_a=0.05, block=300.0, degree=1):
     a = np.sqrt(R * delta)
     data = graded_block(comm, 2, block * a, block * a, h_over_a * a, 1.5 * a, 0.05)
-    V = fem.functionspace(data.mesh, ("Lagrange", 1, (2,)))
+    V = fem.functionspace(data.mesh, ("Lagrange", degree, (2,)))
     u, v = fem.Function(V), ufl.TestFunction(V)
     material = material or LinearElastic(E, nu)
-    dx = kinematics.quadrature_measure("dx", data.mesh, 2)
+    dx = kinematics.quadrature_measure("dx", data.mesh, 2 * degree)
     res_form = material.internal_work(u, v, "axisymmetric") * dx
     tag = lambda name: data.facet_tags.find(data.physical_groups[name].tag)  # noqa: E731
     bcs = [boundary.component(V, 0, tag("symmetry_x")), boundary.component(V, 1, tag("bottom"))]
@@ -82,6 +82,20 @@ def test_axisymmetric_punch_matches_hertz_coarse():
     assert r.force == pytest.approx(ref["force"], rel=1e-2)
     a_h = c.comm.allreduce(float(np.max(c.x[c.active, 0], initial=0.0)), op=MPI.MAX)
     assert abs(a_h - ref["contact_radius"]) <= 0.05 * ref["contact_radius"]  # one element
+
+
+def test_quadratic_elements_use_every_surface_node():
+    # P2: the set is decided on vertex and edge-midpoint nodes by the same rules; the
+    # solution must still be Hertz's (same 1 % as P1) and satisfy the contact conditions.
+    c, r = axisymmetric_punch("elimination", degree=2)
+    ref = hertz.sphere_from_indentation(1.0, 0.3, 1.0, 0.01)
+    assert r.force == pytest.approx(ref["force"], rel=1e-2)
+    assert len(c.dofs_n) > 1.9 * axisymmetric_punch("elimination")[0].dofs_n.size
+    T_n, gap = c.normal_forces(), c.normal_gap()
+    assert np.all(T_n[c.active] <= 1e-10 * np.abs(T_n).max())
+    assert np.all(gap[~c.active] <= 1e-12)
+    with pytest.raises(ValueError, match="multiplier formulation needs a P1"):
+        axisymmetric_punch("multiplier", degree=2)
 
 
 def test_nonlinear_material_runs_newton_inside_each_iteration():
