@@ -43,6 +43,7 @@ from mpi4py import MPI
 
 from fenics_nl import elastica
 from fenics_nl.beam import Beam
+from fenics_nl.cli import parse_with_petsc_options
 from fenics_nl.loading import LoadStepError
 from fenics_nl.newton import ConvergenceError
 
@@ -82,10 +83,7 @@ def parse_args(argv=None):
     p.add_argument("--output", metavar="DIR", help="write the final displacement (XDMF)")
     p.add_argument("--png", metavar="PATH", help="deformed shapes along the load path")
     p.add_argument("--plot", metavar="PATH", help="P/P_cr against tip rotation and deflection")
-    args, petsc_args = p.parse_known_args(argv)
-    unknown = [a for a in petsc_args if not a.startswith("-") or a.startswith("--")]
-    if unknown:
-        p.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args, petsc_args = parse_with_petsc_options(p, argv)
     if args.steps < 1:
         p.error(f"--steps must be >= 1, got {args.steps}")
     if not 0 < args.load_ratio <= 20:

@@ -46,6 +46,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl import hertz
+from fenics_nl.cli import parse_with_petsc_options
 from fenics_nl.contact import ContactError
 from fenics_nl.materials import LinearElastic, PowerLaw
 from fenics_nl.newton import ConvergenceError
@@ -93,10 +94,7 @@ def parse_args(argv=None):
     p.add_argument("--output", metavar="DIR", help="write displacement and active set (XDMF)")
     p.add_argument("--png", metavar="PATH", help="picture of the deformed contact zone")
     p.add_argument("--plot", metavar="PATH", help="force-indentation and pressure against Hertz")
-    args, petsc_args = p.parse_known_args(argv)
-    unknown = [a for a in petsc_args if not a.startswith("-") or a.startswith("--")]
-    if unknown:
-        p.error(f"unrecognized arguments: {' '.join(unknown)}")
+    args, petsc_args = parse_with_petsc_options(p, argv)
     if args.steps < 1:
         p.error(f"--steps must be >= 1, got {args.steps}")
     if args.force is not None and args.force <= 0:
