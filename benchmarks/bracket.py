@@ -10,7 +10,7 @@ variant's peak memory is its own. Three parts, each on the same meshes for all m
 * large (CG + GAMG, 2 ranks): full Newton in one load step (each CG solve costs as much as
   the linear solve, so the fewest iterations win) and one linear solve at about 1M unknowns.
 
-    python benchmarks/bracket.py [--quick] [--update-readme]
+    python benchmarks/bracket.py [--quick] [--update-readme] [--resume]
 """
 
 from __future__ import annotations
@@ -48,6 +48,8 @@ def parse_args():
                    help="element size of the iterative part (about 1M unknowns); 0 skips it")
     p.add_argument("--quick", action="store_true", help="two small meshes, nothing written")
     p.add_argument("--update-readme", action="store_true", help="rewrite the README table")
+    p.add_argument("--resume", action="store_true",
+                   help="keep the parts already in results/bracket.json, measure the rest")
     return p.parse_args()
 
 
@@ -112,12 +114,23 @@ def richardson(rows) -> dict | None:
 def main():
     args = parse_args()
     sizes = [10.0, 7.0] if args.quick else args.sizes
+    path = HERE / "results" / "bracket.json"
     out = {"machine": {"cores": os.cpu_count(), "platform": platform.platform(),
                        "python": platform.python_version()},
            "force_N": 8000.0, "degree": 2, "steps": 4}
-    out["refinement"] = refinement(sizes)
-    out["richardson"] = richardson(out["refinement"])
-    if not args.quick:
+    if args.resume and path.exists():
+        out = json.loads(path.read_text())  # parts measured by an interrupted run stay
+
+    def save():  # after each part: a long run that is stopped keeps what it measured
+        if not args.quick:
+            path.write_text(json.dumps(out, indent=1))
+            say(f"wrote {path}")
+
+    if "refinement" not in out:
+        out["refinement"] = refinement(sizes)
+        out["richardson"] = richardson(out["refinement"])
+        save()
+    if not args.quick and "parallel" not in out:
         out["parallel"] = {}
         for v in ("full", "quasi-newton"):
             p = {str(n): record(run("--size", args.parallel_size, "--newton", v, ranks=n))
@@ -125,17 +138,17 @@ def main():
             p["speedup"] = p["1"]["solve_time_s"] / p["2"]["solve_time_s"]
             out["parallel"][v] = p
             say(f"parallel {v}, {p['1']['dofs']} unknowns: speed-up {p['speedup']:.2f}")
-        if args.large_size > 0:
-            common = ["--size", args.large_size, "--solver", "iterative", *GAMG]
-            lin = record(run(*common, "--material", "linear", "--steps", 1, ranks=2))
-            full = record(run(*common, "--newton", "full", "--steps", 1, ranks=2))
-            out["large"] = {"linear": lin, "full, 1 step": full,
-                            "over_linear": full["solve_time_s"] / lin["solve_time_s"]}
-            say(f"large {lin['dofs']} unknowns: {full['solve_time_s']:.1f} s, "
-                f"{out['large']['over_linear']:.1f} linear solves")
-        path = HERE / "results" / "bracket.json"
-        path.write_text(json.dumps(out, indent=1))
-        say(f"wrote {path}")
+        save()
+    if not args.quick and args.large_size > 0 and "large" not in out:
+        common = ["--size", args.large_size, "--solver", "iterative", *GAMG]
+        lin = record(run(*common, "--material", "linear", "--steps", 1, ranks=2))
+        full = record(run(*common, "--newton", "full", "--steps", 1, ranks=2))
+        out["large"] = {"linear": lin, "full, 1 step": full,
+                        "over_linear": full["solve_time_s"] / lin["solve_time_s"]}
+        say(f"large {lin['dofs']} unknowns: {full['solve_time_s']:.1f} s, "
+            f"{out['large']['over_linear']:.1f} linear solves")
+        save()
+    if not args.quick:
         plot(out, HERE / "results" / "bracket.png")
     text = table(out)
     say(text)

@@ -68,6 +68,8 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
             raise ValueError("the gamg solver needs the rigid-body near-nullspace")
         A.setNearNullSpace(near_nullspace)
         ksp.setType("cg")
+        # the true residual ‖A x − b‖ is what an inexact Newton step needs to control
+        ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
         pc.setType("gamg")
     ksp.setFromOptions()

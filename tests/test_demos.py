@@ -239,6 +239,16 @@ def test_bracket_contact_support_lifts_off(tmp_path):
     assert c["load_point_displacement"] < k["load_point_displacement"]
 
 
+def test_bracket_iterative_solver_matches_direct(tmp_path):
+    # CG + GAMG (inexact Newton corrections) must land on MUMPS's answer: the Newton
+    # loop stops on the same residual tolerance whatever the linear solver.
+    args = ("--size", "10", "--steps", "1")
+    d = bracket(tmp_path, *args)
+    g = bracket(tmp_path, *args, "--solver", "iterative")
+    assert d["krylov_iterations"] == 0 and g["krylov_iterations"] > g["newton_iterations"]
+    assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-7)
+
+
 @pytest.mark.parametrize("support", ["clamped", "contact"])
 def test_bracket_two_ranks_match_serial(tmp_path, support):
     s = bracket(tmp_path, "--support", support)
