@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 from fenics_nl import boundary, kinematics
 from fenics_nl.contact import ActiveSetContact
+from fenics_nl.mesh_check import check_cells
 from fenics_nl.newton import NewtonSolver
 from fenics_nl.snes import SnesSolver
 
@@ -36,6 +37,7 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
             data = gmshio.read_from_msh(path, comm, 0, gdim=3)
         except Exception as err:  # gmsh/dolfinx raise various types on corrupt files
             raise ValueError(f"cannot read mesh file {path}: {err}") from None
+        check_cells(data.mesh, name=path)  # a file may hold anything: inverted cells too
     else:
         spec = importlib.util.spec_from_file_location("bracket_geometry", GEOMETRY)
         geometry = importlib.util.module_from_spec(spec)

@@ -108,6 +108,15 @@ def forcing_term(relative_residual: float) -> float:
     return 1e-3 * min(1.0, max(relative_residual, 1e-11))
 
 
+def _round_off_hint(norms: list[float]) -> str:
+    """A hint when ‖R‖ has stalled far below its start: round-off, not a bad method."""
+    last = norms[-5:]
+    if len(last) == 5 and max(last) < 1e-8 * max(norms) and max(last) < 10 * min(last):
+        return (f"; |R| stalls at {min(last):.1e}, the round-off of the internal forces: "
+                "set atol above it (e.g. 1e-10 times the load)")
+    return ""
+
+
 class _Timer:
     def __init__(self, work: WorkCounts, phase: str):
         self.work, self.phase = work, phase
@@ -253,8 +262,8 @@ class NewtonSolver:
                 return result(True, "converged")
             if k >= self.max_it:
                 raise ConvergenceError(f"no convergence in {self.max_it} iterations "
-                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
-                                       result(False, "max_it"))
+                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})"
+                                       + _round_off_hint(norms), result(False, "max_it"))
             if rnorm > self.divergence_tol * norms[0]:
                 raise ConvergenceError(f"residual blew up at iteration {k} "
                                        f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",

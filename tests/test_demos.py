@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -257,7 +258,7 @@ def test_bracket_two_ranks_match_serial(tmp_path, support):
     assert p["load_point_displacement"] == pytest.approx(s["load_point_displacement"], rel=1e-8)
 
 
-def _box_without_groups(path):
+def _box_without_groups(path, fold=False):
     import gmsh
 
     gmsh.initialize()
@@ -268,6 +269,11 @@ def _box_without_groups(path):
     gmsh.model.addPhysicalGroup(3, [1], 1, name="solid")
     gmsh.model.addPhysicalGroup(2, [1], 2, name="bolts")
     gmsh.model.mesh.generate(3)
+    if fold:  # push the node nearest the centre through its neighbours
+        tags, x, _ = gmsh.model.mesh.getNodes()
+        x = x.reshape(-1, 3)
+        i = np.argmin(np.linalg.norm(x - 0.5, axis=1))
+        gmsh.model.mesh.setNode(int(tags[i]), list(x[i] + [0.4, 0, 0]), [])
     gmsh.write(str(path))
     gmsh.finalize()
 
@@ -275,9 +281,11 @@ def _box_without_groups(path):
 def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
     (tmp_path / "corrupt.msh").write_text("$MeshFormat\nthis is not a mesh\n")
     _box_without_groups(tmp_path / "box.msh")
+    _box_without_groups(tmp_path / "folded.msh", fold=True)
     for args, message in [(["--mesh", "nowhere.msh"], "mesh file not found"),
                           (["--mesh", "corrupt.msh"], "cannot read mesh file"),
                           (["--mesh", "box.msh"], "no physical group load, base"),
+                          (["--mesh", "folded.msh"], "inverted (folded over a neighbour)"),
                           (["--support", "contact", "--newton", "snes"], "clamped only"),
                           (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size")]:
         proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)

@@ -1,0 +1,229 @@
+"""Numerical-stability stress cases: each ends in the right answer (checked) or a clear error.
+
+The README's stress table lists every case with its expected and observed behaviour.
+"""
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl import boundary, hertz
+from fenics_nl.contact import ActiveSetContact
+from fenics_nl.loading import LoadStepError, solve_incrementally
+from fenics_nl.materials import LinearElastic, PowerLaw
+from fenics_nl.mesh_check import bad_cells
+from fenics_nl.newton import ConvergenceError, NewtonSolver
+from fenics_nl.problems import cantilever_3d
+
+pytestmark = pytest.mark.stress
+
+# the power-law cantilever of test_newton: ε_eq reaches ~20 ε0 at the clamp
+MATERIAL = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=0.3)
+LOAD = -0.05
+CELLS = (16, 3, 3)
+
+
+def tip(p):
+    return p.u.function_space.mesh.comm.allreduce(fem.assemble_scalar(fem.form(p.observed)))
+
+
+def loaded(problem, factor):
+    problem.load.value[2] = factor * LOAD
+
+
+def solved(material=MATERIAL, cells=CELLS, steps=10, method="full", **options):
+    """The cantilever taken to LOAD in `steps` equal (adaptive) increments."""
+    p = cantilever_3d(material, cells=cells, traction=LOAD)
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix=f"s{id(p)}_", method=method, **options)
+    path = solve_incrementally(s, lambda t: loaded(p, t), steps)
+    return p, path
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """Tip displacement from 10 full-Newton steps (the default increment is LOAD/10)."""
+    p, _ = solved()
+    return tip(p)
+
+
+@pytest.mark.parametrize("steps", [10, 1])  # the default increment, ×10
+def test_large_increments_reach_the_same_answer(reference, steps):
+    p, path = solved(steps=steps)
+    assert abs(tip(p) - reference) < 1e-8 * abs(reference)
+    assert path.failures == 0  # full Newton takes the whole load in one step
+
+
+def test_hundredfold_increment_reaches_the_answer():
+    # ×100: the load 10 LOAD in one step (ε_eq ~ 10^3 ε0 at the clamp for n = 0.3):
+    # full Newton on this convex energy takes it at once (adaptive stepping would cut the
+    # step otherwise); the answer is checked against
+    # the same load reached in 40 small steps. Residuals stall at ~1e-12 at this load, so
+    # atol is set from the load (1e-10 |F_ext|), as the NewtonSolver docstring asks.
+    atol = 1e-10 * abs(10 * LOAD)
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix="x100_", max_it=30, atol=atol)
+    solve_incrementally(s, lambda t: loaded(p, 10 * t), 1)
+    q = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="x100ref_", max_it=30, atol=atol)
+    solve_incrementally(sq, lambda t: loaded(q, 10 * t), 40, adaptive=False)
+    assert abs(tip(p) - tip(q)) < 1e-8 * abs(tip(q))  # (measured: 6 iterations, no cut)
+
+
+def test_round_off_stall_is_named_in_the_error():
+    q = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="stall_", max_it=30)
+    with pytest.raises(LoadStepError, match=r"stalls at .* round-off of the internal forces"):
+        solve_incrementally(sq, lambda t: loaded(q, 10 * t), 40, adaptive=False)
+
+
+def test_modified_newton_without_adaptivity_refuses_clearly():
+    # modified Newton on the initial (elastic) tangent cannot take ×100 in 20 iterations
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix="noadapt_", method="modified", max_it=20)
+    with pytest.raises(LoadStepError, match="load factor 1 not reached from 0: no conv"):
+        solve_incrementally(s, lambda t: loaded(p, 10 * t), 1, adaptive=False)
+    assert np.all(np.isfinite(p.u.x.array))
+
+
+@pytest.mark.parametrize("scale", [1, 100])
+def test_poor_initial_guess(reference, scale):
+    # u0 = random nodal values `scale` times the solution's size: full Newton with
+    # backtracking finds the solution (26 and 37 iterations measured); without it, it
+    # wanders (|R| ~ 1e10) and stops with a clear error. The stopping test is absolute
+    # (1e-10 |F_ext|): relative to the huge ‖R0‖ of such a guess it would stop too early.
+    for line_search in (True, False):
+        p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+        rng = np.random.default_rng(0)
+        p.u.x.array[:] = scale * abs(reference) * rng.standard_normal(p.u.x.array.size)
+        s = NewtonSolver(p.residual, p.u, p.bcs, prefix=f"guess{scale}{line_search}_",
+                         max_it=60, line_search=line_search, rtol=0.0,
+                         atol=1e-10 * abs(LOAD))
+        if line_search:
+            assert s.solve().converged
+            assert abs(tip(p) - reference) < 1e-8 * abs(reference)
+        else:
+            with pytest.raises(ConvergenceError, match="no convergence in 60 iterations"):
+                s.solve()
+
+
+@pytest.mark.parametrize("n", [0.1, 0.5])
+def test_tangent_singular_at_zero_strain_for_n_below_one(n):
+    # For n < 1 the unregularised law has an infinite tangent at ε = 0; the energy's
+    # regularisation keeps it Hooke's there. Full Newton from u = 0 and BFGS (a different
+    # algorithm on a different matrix) must agree.
+    m = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=n)
+    p_full, _ = solved(m, steps=1, line_search=True)
+    p_bfgs, _ = solved(m, steps=1, method="bfgs", max_it=300)
+    assert abs(tip(p_full) - tip(p_bfgs)) < 1e-7 * abs(tip(p_full))
+
+
+def test_very_coarse_mesh_converges():
+    # one element through the thickness: a stiff discrete answer, reached without trouble
+    p, path = solved(cells=(4, 1, 1), steps=1)
+    assert path.failures == 0 and np.isfinite(tip(p))
+
+
+def distorted_tip(cells, amplitude):
+    """P2 cantilever, interior nodes moved at random by up to `amplitude` element sizes."""
+    p = cantilever_3d(MATERIAL, cells=cells, traction=LOAD, degree=2)
+    x = p.u.function_space.mesh.geometry.x
+    size = np.array([10.0, 1.0, 1.0])
+    inner = np.all((x > 1e-9) & (x < size - 1e-9), axis=1)
+    rng = np.random.default_rng(1)
+    x[inner] += amplitude * size / np.array(cells) * rng.uniform(-1, 1, (inner.sum(), 3))
+    assert all(len(c) == 0 for c in bad_cells(p.u.function_space.mesh).values())
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix=f"distorted{id(p)}_")
+    solve_incrementally(s, lambda t: loaded(p, t), 1)
+    return tip(p)
+
+
+def test_distorted_mesh_moves_the_answer_less_than_refinement_does():
+    # P2 (P1 locks: the 16x3x3 P1 tip is 3x too stiff, so any change would hide in it).
+    # Measured: 30 % distortion moves the tip by 0.3 %, one refinement step by 11 %.
+    straight, distorted = distorted_tip(CELLS, 0.0), distorted_tip(CELLS, 0.3)
+    coarser = distorted_tip((8, 2, 2), 0.0)
+    assert abs(distorted - straight) < 0.1 * abs(straight - coarser)
+
+
+def test_inverted_cell_is_found():
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD, comm=MPI.COMM_SELF)
+    x = p.u.function_space.mesh.geometry.x
+    i = np.argmin(np.linalg.norm(x - [5.0, 0.5, 0.5], axis=1))
+    x[i, 0] += 1.2  # through two layers of neighbours
+    assert len(bad_cells(p.u.function_space.mesh)["folded"]) > 0
+
+
+# -- contact -----------------------------------------------------------------------------
+
+def compressed_square(push, gap, formulation, initial="all"):
+    """Unit square on lateral rollers, top pushed down by `push`, floor `gap` below.
+
+    The bottom is S_C with u_n = −u_y. While push > gap the state is a uniform uniaxial
+    strain and the floor's reaction is exactly M (push − gap), M = λ + 2μ (P1 is exact).
+    """
+    E, nu = 1.0, 0.3
+    square = mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
+    V = fem.functionspace(square, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    on = lambda axis, value: mesh.locate_entities_boundary(  # noqa: E731
+        square, 1, lambda x: np.isclose(x[axis], value))
+    top = on(1, 1.0)
+    bcs = [boundary.component(V, 0, on(0, 0.0)), boundary.component(V, 0, on(0, 1.0)),
+           boundary.component(V, 0, top), boundary.component(V, 1, top, -push)]
+    R = LinearElastic(E, nu).internal_work(u, v, "plane_strain") * ufl.dx
+    c = ActiveSetContact(R, u, bcs, on(1, 0.0), lambda x: np.full(x.shape[1], gap),
+                         normal_axis=1, normal_sign=-1, formulation=formulation,
+                         initial=initial, prefix=f"sq{id(u)}_")
+    lmbda, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    return c, c.solve(), (lmbda + 2 * mu) * max(push - gap, 0.0)
+
+
+@pytest.mark.parametrize("formulation", ["elimination", "multiplier"])
+@pytest.mark.parametrize("push,gap,case", [
+    (0.0, 0.0, "grazing: touching everywhere, no load"),
+    (0.01, 1e-15, "gap at round-off level"),
+    (0.0, -0.01, "initial penetration, no load"),
+    (0.01, 0.02, "never touches"),
+    (0.01, 0.01 - 1e-15, "touches by round-off"),
+])
+def test_contact_limit_cases(formulation, push, gap, case):
+    for initial in ("all", "none"):
+        c, r, exact = compressed_square(push, gap, formulation, initial)
+        assert abs(r.force - exact) <= 1e-10 * max(exact, 1e-3), (case, initial, r.force)
+        assert r.iterations <= 3, case  # no cycling: a uniform state decides in one update
+        assert np.all(np.isfinite(c.u.x.array))
+
+
+# -- near incompressibility ------------------------------------------------------------
+
+@pytest.mark.parametrize("nu", [0.45, 0.49, 0.499])
+def test_near_incompressibility_p2_keeps_hertz_p1_locks(nu):
+    # measured force errors against Hertz (axisymmetric, h = a/20): P1 +0.50 %, +1.37 %,
+    # +8.7 % for ν = 0.45, 0.49, 0.499 (volumetric locking); P2 +0.18 % throughout
+    from test_contact import axisymmetric_punch
+
+    ref = hertz.sphere_from_indentation(1.0, nu, 1.0, 0.01)["force"]
+    _, p2 = axisymmetric_punch("elimination", nu=nu, degree=2)
+    _, p1 = axisymmetric_punch("elimination", nu=nu, degree=1)
+    assert abs(p2.force / ref - 1) < 5e-3
+    assert abs(p2.force / ref - 1) < abs(p1.force / ref - 1)
+
+
+# -- three ranks ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("scene,args,keys", [
+    ("punch", ["--steps", "2"], ["force", "contact_radius"]),
+    ("beam", ["--load-ratio", "1.2", "--steps", "20"], ["critical_load", "tip_rotation_deg"]),
+    ("bracket", ["--support", "contact", "--size", "8"], ["load_point_displacement",
+                                                          "lifted_off_area"]),
+])
+def test_three_ranks_give_the_serial_answer(tmp_path, scene, args, keys):
+    import test_demos
+
+    run = getattr(test_demos, scene)
+    s, p = run(tmp_path, *args), run(tmp_path, *args, ranks=3)
+    assert p["ranks"] == 3
+    for k in keys:  # the 2-rank tests use the same tolerances
+        assert p[k] == pytest.approx(s[k], rel=1e-6 if k == "tip_rotation_deg" else 1e-8), k
