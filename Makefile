@@ -28,8 +28,12 @@ test-serial: $(VENV)/.installed
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider
 
+# every benchmark, results in benchmarks/results/ and the README tables regenerated;
+# `make bench QUICK=1`: small meshes, a smoke run that writes nothing
+BENCHMARKS := newton contact buckling bracket
 bench: $(VENV)/.installed
-	$(PY) benchmarks/newton.py
+	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
+	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

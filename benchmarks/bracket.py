@@ -18,12 +18,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from common import machine, update_readme
 
 HERE = Path(__file__).resolve().parent
 DEMO = HERE.parent / "demos" / "bracket.py"
@@ -44,7 +44,7 @@ def parse_args():
                    help="element sizes of the refinement part [mm]")
     p.add_argument("--parallel-size", type=float, default=2.4,
                    help="element size of the 1 vs 2 ranks part (about 320k unknowns)")
-    p.add_argument("--large-size", type=float, default=1.64,
+    p.add_argument("--large-size", type=float, default=1.55,
                    help="element size of the iterative part (about 1M unknowns); 0 skips it")
     p.add_argument("--quick", action="store_true", help="two small meshes, nothing written")
     p.add_argument("--update-readme", action="store_true", help="rewrite the README table")
@@ -115,8 +115,7 @@ def main():
     args = parse_args()
     sizes = [10.0, 7.0] if args.quick else args.sizes
     path = HERE / "results" / "bracket.json"
-    out = {"machine": {"cores": os.cpu_count(), "platform": platform.platform(),
-                       "python": platform.python_version()},
+    out = {"machine": machine(),
            "force_N": 8000.0, "degree": 2, "steps": 4}
     if args.resume and path.exists():
         out = json.loads(path.read_text())  # parts measured by an interrupted run stay
@@ -153,8 +152,6 @@ def main():
     text = table(out)
     say(text)
     if args.update_readme and not args.quick:
-        from newton import update_readme
-
         update_readme("bracket", text)
 
 

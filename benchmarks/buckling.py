@@ -12,7 +12,6 @@ Writes benchmarks/results/buckling.json and, with --update-readme, the README ta
 import argparse
 import json
 import math
-import platform
 import time
 from pathlib import Path
 
@@ -20,9 +19,8 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-import dolfinx
+from common import machine
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from fenics_nl import elastica
 from fenics_nl.beam import Beam
@@ -151,8 +149,7 @@ def main():
         "variants": variants(),
         "step_control": step_control(),
         "ranks": comm.size,
-        "machine": {"platform": platform.platform(), "dolfinx": dolfinx.__version__,
-                    "petsc": ".".join(map(str, PETSc.Sys.getVersion()))},
+        "machine": machine(comm.size),
     }
     if comm.rank == 0:
         text = tables(result)
@@ -160,7 +157,7 @@ def main():
         if not args.quick:
             (HERE / "results" / "buckling.json").write_text(json.dumps(result, indent=1))
             if args.update_readme:
-                from newton import update_readme
+                from common import update_readme
 
                 update_readme("buckling", text)
 

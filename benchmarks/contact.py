@@ -12,7 +12,6 @@ Writes benchmarks/results/contact.json, benchmarks/results/contact.png and, with
 
 import argparse
 import json
-import platform
 import time
 from pathlib import Path
 
@@ -20,8 +19,8 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-import dolfinx
 import ufl
+from common import machine
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
@@ -143,15 +142,14 @@ def main():
     same = peers(0 if args.quick else 1, [10, 100, 1000, 10000])
     result = {"axisymmetric": ax, "3d": d3, "same_mesh": same, "hertz": REF,
               "ranks": comm.size,
-              "machine": {"platform": platform.platform(), "dolfinx": dolfinx.__version__,
-                          "petsc": ".".join(map(str, PETSc.Sys.getVersion()))}}
+              "machine": machine(comm.size)}
     if comm.rank == 0 and not args.quick:
         (HERE / "results" / "contact.json").write_text(json.dumps(result, indent=1))
         plot(result, HERE / "results" / "contact.png")
         text = table(result)
         print(text)
         if args.update_readme:
-            from newton import update_readme
+            from common import update_readme
 
             update_readme("contact", text)
 

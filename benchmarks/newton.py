@@ -7,7 +7,6 @@ load and reaches the same tolerance. Writes benchmarks/results/newton.json and, 
 
 import argparse
 import json
-import platform
 import time
 from pathlib import Path
 
@@ -15,9 +14,9 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-import dolfinx
 import numpy as np
 import ufl
+from common import machine, update_readme
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
@@ -129,9 +128,7 @@ def main():
         "ratio_full_over_snes": full / snes,
         "best_variant": best[1], "ratio_best_over_full": best[0] / full,
         "max_rel_tip_spread": (max(tips) - min(tips)) / abs(np.mean(tips)),
-        "machine": {"cores": MPI.COMM_WORLD.size, "platform": platform.platform(),
-                    "dolfinx": dolfinx.__version__,
-                    "petsc": ".".join(map(str, PETSc.Sys.getVersion()))},
+        "machine": machine(MPI.COMM_WORLD.size),
         "variants": results,
     }
     if rank0:
@@ -166,14 +163,6 @@ def table(s):
               f"**{s['ratio_best_over_full']:.2f}**; all variants agree on the tip displacement "
               f"to {s['max_rel_tip_spread']:.1e} (relative)."]
     return "\n".join(lines)
-
-
-def update_readme(name, text):
-    readme = HERE.parent / "README.md"
-    src = readme.read_text()
-    start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
-    i, j = src.index(start) + len(start), src.index(end)
-    readme.write_text(src[:i] + "\n" + text + "\n" + src[j:])
 
 
 if __name__ == "__main__":

@@ -202,9 +202,12 @@ class NewtonSolver:
         self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                               P=self.A if self.reuse else None, rtol=1e-12)
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
-        # residual deserves, unless the command line fixed -{prefix}ksp_rtol
-        self.forcing = (linear_solver == "gamg"
-                        and not PETSc.Options().hasName(f"{prefix}ksp_rtol"))
+        # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
+        # problem (fixed tangent) is solved once, to the Newton tolerance
+        own_rtol = linear_solver == "gamg" and not PETSc.Options().hasName(f"{prefix}ksp_rtol")
+        self.forcing = own_rtol and not self._tangent_fixed
+        if own_rtol and self._tangent_fixed:
+            self.ksp.setTolerances(rtol=1e-11)
         if self.reuse and self.ksp.getType() == "preonly":
             # options turned CG off: a lagging factorization would then give wrong solves
             log.warning("%sksp_type preonly: factorization reuse disabled", prefix)
@@ -286,6 +289,8 @@ class NewtonSolver:
     # -- pieces ----------------------------------------------------------------------
 
     def _needs_tangent(self, k: int) -> bool:
+        if self._tangent_fixed and self._tangent_ready:
+            return False  # a linear material: the tangent built for this solve is exact
         if self.method == "full":
             return True
         if self.method == "periodic":

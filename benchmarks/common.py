@@ -1,0 +1,31 @@
+"""What every benchmark shares: the machine facts stored with its results, and the
+README section it regenerates between `<!-- bench:NAME -->` markers."""
+
+from __future__ import annotations
+
+import os
+import platform
+from pathlib import Path
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def machine(ranks: int = 1) -> dict:
+    """Cores, ranks and versions, so that a result file says where it was measured."""
+    import fenics_nl  # noqa: F401  (first: loads the wheel's MPI before dolfinx)
+
+    # isort: split
+    import dolfinx
+    from petsc4py import PETSc
+
+    return {"cores": os.cpu_count(), "ranks": ranks, "platform": platform.platform(),
+            "python": platform.python_version(), "dolfinx": dolfinx.__version__,
+            "petsc": ".".join(map(str, PETSc.Sys.getVersion()))}
+
+
+def update_readme(name: str, text: str) -> None:
+    """Replace the README's generated section `name` with `text`."""
+    src = README.read_text()
+    start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
+    i, j = src.index(start) + len(start), src.index(end)
+    README.write_text(src[:i] + "\n" + text + "\n" + src[j:])
