@@ -7,7 +7,7 @@ MPIEXEC := $(VENV)/bin/mpiexec
 PYTHON ?= $(firstword $(wildcard $(shell pyenv root 2>/dev/null)/versions/3.1[2-9]*/bin/python3) \
 	$(wildcard $(HOME)/.pyenv/versions/3.1[2-9]*/bin/python3) $(shell command -v python3.12))
 
-.PHONY: demo test test-serial test-mpi bench lint clean
+.PHONY: demo test test-serial test-mpi bench bench-large lint clean
 
 $(VENV)/.installed: pyproject.toml
 	@if [ -z "$(PYTHON)" ]; then \
@@ -28,12 +28,19 @@ test-serial: $(VENV)/.installed
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider
 
-# every benchmark, results in benchmarks/results/ and the README tables regenerated;
-# `make bench QUICK=1`: small meshes, a smoke run that writes nothing
+# every benchmark at sizes for 2 cores (about 25 min), results in benchmarks/results/, the
+# README tables and the "which method when" reading regenerated from them;
+# `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 3 min);
+# `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
 BENCHMARKS := newton contact buckling bracket
 bench: $(VENV)/.installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done
+	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-readme)
+
+bench-large: $(VENV)/.installed
+	$(PY) benchmarks/bracket.py --large --update-readme
+	$(PY) benchmarks/reading.py --update-readme
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

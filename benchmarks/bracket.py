@@ -4,13 +4,19 @@ Every number comes from `demos/bracket.py --json`, run as a separate process so 
 variant's peak memory is its own. Three parts, each on the same meshes for all methods:
 
 * refinement (MUMPS, 1 rank): each Newton variant and one linear elastic solve on every
-  mesh size; time per Newton iteration, total, peak memory, and the load-point displacement,
-  whose Richardson extrapolation over the three finest meshes gives the error of each;
-* parallel (MUMPS): full and quasi-Newton on 1 and 2 ranks on a mesh of >= 300k unknowns;
+  mesh size; time per Newton iteration, total, peak memory, iterations per load step and
+  the load-point displacement, whose Richardson extrapolation over the three finest meshes
+  gives the error of each;
+* parallel (MUMPS): full and quasi-Newton on 1 and 2 ranks on the same mesh;
 * large (CG + GAMG, 2 ranks): full Newton in one load step (each CG solve costs as much as
   the linear solve, so the fewest iterations win) and one linear solve at about 1M unknowns.
 
-    python benchmarks/bracket.py [--quick] [--update-readme] [--resume]
+Two profiles. The default one fits `make bench` (about 12 min on 2 cores: meshes of 12k,
+31k and 81k unknowns, 1 vs 2 ranks at 81k, no large part) and writes results/bracket.json;
+`--large` (`make bench-large`, about 75 min) measures 31k, 81k and 234k, 1 vs 2 ranks at
+300k and the ~1M iterative part, into results/bracket_large.json.
+
+    python benchmarks/bracket.py [--large] [--quick] [--update-readme] [--resume]
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from common import machine, update_readme
+from common import elapsed, machine, pyplot, save_figure, update_readme
 
 HERE = Path(__file__).resolve().parent
 DEMO = HERE.parent / "demos" / "bracket.py"
@@ -37,20 +43,36 @@ VARIANTS = {"full": ["--newton", "full"], "modified": ["--newton", "modified"],
 GAMG = ["-bracket_pc_gamg_threshold", "0.02"]  # measured: 25 % fewer CG iterations
 
 
+PROFILES = {  # sizes of the refinement [mm], of the 1 vs 2 ranks part, of the large part
+    "standard": {"sizes": [9.0, 6.0, 4.0], "parallel_size": 4.0, "large_size": 0.0,
+                 "iterative_size": 9.0},
+    "large": {"sizes": [6.0, 4.0, 2.67], "parallel_size": 2.4, "large_size": 1.55,
+              "iterative_size": 0.0},
+}
+
+
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--sizes", type=float, nargs="+", default=[6.0, 4.0, 2.67],
-                   help="element sizes of the refinement part [mm]")
-    p.add_argument("--parallel-size", type=float, default=2.4,
-                   help="element size of the 1 vs 2 ranks part (about 320k unknowns)")
-    p.add_argument("--large-size", type=float, default=1.55,
-                   help="element size of the iterative part (about 1M unknowns); 0 skips it")
+    p.add_argument("--large", action="store_true",
+                   help="the large profile: 234k refinement, 300k in parallel, ~1M with GAMG")
+    p.add_argument("--sizes", type=float, nargs="+", help="element sizes of the refinement [mm]")
+    p.add_argument("--parallel-size", type=float, help="element size of the 1 vs 2 ranks part")
+    p.add_argument("--large-size", type=float,
+                   help="element size of the large part (CG + GAMG, 2 ranks; 1.55: about 1M "
+                   "unknowns); 0 skips it")
+    p.add_argument("--iterative-size", type=float,
+                   help="element size of the Newton variants with CG + GAMG; 0 skips them")
     p.add_argument("--quick", action="store_true", help="two small meshes, nothing written")
     p.add_argument("--update-readme", action="store_true", help="rewrite the README table")
     p.add_argument("--resume", action="store_true",
-                   help="keep the parts already in results/bracket.json, measure the rest")
-    return p.parse_args()
+                   help="keep the parts already in the results file, measure the rest")
+    args = p.parse_args()
+    args.profile = "large" if args.large else "standard"
+    for key, value in PROFILES[args.profile].items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
+    return args
 
 
 def run(*args, ranks=1) -> dict:
@@ -71,6 +93,7 @@ def record(d: dict) -> dict:
             "tangent_assemblies", "krylov_iterations", "solve_time_s", "peak_memory_mb")
     r = {k: d[k] for k in keys}
     r["time_per_iteration_s"] = d["solve_time_s"] / max(d["newton_iterations"], 1)
+    r["iterations_per_step"] = [s["newton_iterations"] for s in d["steps"]]
     return r
 
 
@@ -111,16 +134,55 @@ def richardson(rows) -> dict | None:
     return {"order": p, "extrapolated": u_inf}
 
 
+def parallel(size) -> dict:
+    out = {}
+    for v in ("full", "quasi-newton"):
+        p = {str(n): record(run("--size", size, "--newton", v, ranks=n)) for n in (1, 2)}
+        p["speedup"] = p["1"]["solve_time_s"] / p["2"]["solve_time_s"]
+        out[v] = p
+        say(f"parallel {v}, {p['1']['dofs']} unknowns: speed-up {p['speedup']:.2f}")
+    return out
+
+
+def iterative(size) -> dict:
+    """CG + GAMG, one load step, 1 rank: which Newton variant suits a Krylov solver."""
+    common = ["--size", size, "--solver", "iterative", "--steps", 1, *GAMG]
+    lin = record(run(*common, "--material", "linear"))
+    out = {"linear": lin, "variants": {}}
+    for v in ("full", "quasi-newton", "modified"):
+        r = record(run(*common, "--newton", v))
+        r["over_linear"] = r["solve_time_s"] / lin["solve_time_s"]
+        out["variants"][v] = r
+        say(f"GAMG {v}, {r['dofs']} unknowns: {r['solve_time_s']:.1f} s, "
+            f"{r['newton_iterations']} its, {r['krylov_iterations']} CG its")
+    return out
+
+
+def large(size) -> dict:
+    common = ["--size", size, "--solver", "iterative", *GAMG]
+    lin = record(run(*common, "--material", "linear", "--steps", 1, ranks=2))
+    full = record(run(*common, "--newton", "full", "--steps", 1, ranks=2))
+    out = {"linear": lin, "full, 1 step": full,
+           "over_linear": full["solve_time_s"] / lin["solve_time_s"]}
+    say(f"large {lin['dofs']} unknowns: {full['solve_time_s']:.1f} s, "
+        f"{out['over_linear']:.1f} linear solves")
+    return out
+
+
 def main():
     args = parse_args()
     sizes = [10.0, 7.0] if args.quick else args.sizes
-    path = HERE / "results" / "bracket.json"
-    out = {"machine": machine(),
+    name = "bracket" if args.profile == "standard" else "bracket_large"
+    path = HERE / "results" / f"{name}.json"
+    out = {"machine": machine(), "profile": args.profile,
            "force_N": 8000.0, "degree": 2, "steps": 4}
     if args.resume and path.exists():
         out = json.loads(path.read_text())  # parts measured by an interrupted run stay
 
+    spent = out.get("benchmark_time_s", 0.0)  # by the interrupted run, when resuming
+
     def save():  # after each part: a long run that is stopped keeps what it measured
+        out["benchmark_time_s"] = spent + elapsed()
         if not args.quick:
             path.write_text(json.dumps(out, indent=1))
             say(f"wrote {path}")
@@ -130,29 +192,20 @@ def main():
         out["richardson"] = richardson(out["refinement"])
         save()
     if not args.quick and "parallel" not in out:
-        out["parallel"] = {}
-        for v in ("full", "quasi-newton"):
-            p = {str(n): record(run("--size", args.parallel_size, "--newton", v, ranks=n))
-                 for n in (1, 2)}
-            p["speedup"] = p["1"]["solve_time_s"] / p["2"]["solve_time_s"]
-            out["parallel"][v] = p
-            say(f"parallel {v}, {p['1']['dofs']} unknowns: speed-up {p['speedup']:.2f}")
+        out["parallel"] = parallel(args.parallel_size)
+        save()
+    if not args.quick and args.iterative_size > 0 and "iterative" not in out:
+        out["iterative"] = iterative(args.iterative_size)
         save()
     if not args.quick and args.large_size > 0 and "large" not in out:
-        common = ["--size", args.large_size, "--solver", "iterative", *GAMG]
-        lin = record(run(*common, "--material", "linear", "--steps", 1, ranks=2))
-        full = record(run(*common, "--newton", "full", "--steps", 1, ranks=2))
-        out["large"] = {"linear": lin, "full, 1 step": full,
-                        "over_linear": full["solve_time_s"] / lin["solve_time_s"]}
-        say(f"large {lin['dofs']} unknowns: {full['solve_time_s']:.1f} s, "
-            f"{out['large']['over_linear']:.1f} linear solves")
+        out["large"] = large(args.large_size)
         save()
     if not args.quick:
-        plot(out, HERE / "results" / "bracket.png")
+        plot(out, HERE / "results" / f"{name}.png")
     text = table(out)
     say(text)
     if args.update_readme and not args.quick:
-        update_readme("bracket", text)
+        update_readme(name.replace("_", "-"), text)
 
 
 def table(s) -> str:
@@ -179,6 +232,16 @@ def table(s) -> str:
         lines += ["", f"1 vs 2 ranks ({p['1']['dofs']} unknowns, MUMPS, {v}): "
                   f"{p['1']['solve_time_s']:.1f} s vs {p['2']['solve_time_s']:.1f} s, "
                   f"speed-up **{p['speedup']:.2f}**."]
+    if "iterative" in s:
+        g = s["iterative"]
+        lines += ["", f"CG + GAMG, 1 rank, one load step, {g['linear']['dofs']} unknowns; one "
+                  f"linear solve {g['linear']['solve_time_s']:.2f} s "
+                  f"({g['linear']['krylov_iterations']} CG iterations):", "",
+                  "| variant | time (s) | / linear solve | Newton iterations | CG iterations |",
+                  "|---|---|---|---|---|"]
+        lines += [f"| {v} | {r['solve_time_s']:.2f} | {r['over_linear']:.1f} | "
+                  f"{r['newton_iterations']} | {r['krylov_iterations']} |"
+                  for v, r in g["variants"].items()]
     if "large" in s:
         g = s["large"]
         best = g["full, 1 step"]
@@ -192,28 +255,34 @@ def table(s) -> str:
 
 
 def plot(s, path):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Error against run time per variant; iterations per load step on the finest mesh."""
     rich = s["richardson"]
     if not rich:
         return
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    plt = pyplot()
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.4))
+    finest = s["refinement"][-1]
     for v in VARIANTS:
         t = [r["variants"][v]["solve_time_s"] for r in s["refinement"]]
         e = [abs(r["variants"][v]["load_point_displacement"] / rich["extrapolated"] - 1)
              for r in s["refinement"]]
         ax.loglog(t, e, "o-", label=v)
+        steps = finest["variants"][v].get("iterations_per_step")
+        if steps:  # results of earlier versions do not have them
+            bx.plot(range(1, len(steps) + 1), steps, "o-", label=v)
     ax.set_xlabel("wall time of the non-linear solve [s] (1 rank, MUMPS)")
     ax.set_ylabel("|u_load| error vs Richardson extrapolation")
-    ax.set_title("bracket, P2, 8 kN: error against run time")
+    ax.set_title("bracket, P2, 8 kN: error against run time", fontsize=9)
     ax.grid(alpha=0.3, which="both")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    say(f"wrote {path}")
+    ax.legend(fontsize=7)
+    bx.set_xlabel("load step")
+    bx.set_ylabel("Newton iterations")
+    bx.set_yscale("log")
+    bx.set_xticks(range(1, s["steps"] + 1))
+    bx.set_title(f"iterations per load step, {finest['dofs']} unknowns", fontsize=9)
+    bx.grid(alpha=0.3, which="both")
+    bx.legend(fontsize=7)
+    save_figure(fig, path)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,9 @@ B. Newton variants along the path to 2 P_cr (40 fixed steps): iterations per ste
    away from the bifurcation, factorizations, time; where a variant gives up.
 C. Step control: fixed steps against growing steps (with the end-state stability check).
 
-Writes benchmarks/results/buckling.json and, with --update-readme, the README tables.
+Writes benchmarks/results/buckling.json, buckling.png (error against wall time for each
+element; Newton iterations per load step for each variant) and, with --update-readme, the
+README tables.
 """
 
 import argparse
@@ -19,7 +21,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-from common import machine
+from common import elapsed, machine, pyplot, save_figure, update_readme
 from mpi4py import MPI
 
 from fenics_nl import elastica
@@ -137,6 +139,37 @@ def tables(r):
                       *a, "", *b, "", *c])
 
 
+def plot(r, path):
+    plt = pyplot()
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.4))
+    for degree in sorted({x["degree"] for x in r["refinement"]}):
+        rows = [x for x in r["refinement"] if x["degree"] == degree]
+        ax.loglog([x["buckling_time_s"] for x in rows],
+                  [abs(x["critical_load_rel_error"]) for x in rows], "o-",
+                  label=f"Q{degree}: |P_cr / P_Euler - 1| (SLEPc time)")
+        ax.loglog([x["path_time_s"] for x in rows],
+                  [abs(math.radians(x["tip_rotation_error_deg"])) for x in rows], "s--",
+                  label=f"Q{degree}: |α - α_elastica| [rad] at 1.5 P_cr (path time)")
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("error")
+    ax.set_title("accuracy against run time (refinements)", fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    for method, x in r["variants"].items():
+        steps = x["iterations_per_step"]
+        end = ("" if x["failed_at_load_ratio"] is None
+               else f", gave up after {x['failed_at_load_ratio']:.3f} P_cr")
+        bx.plot([s[0] for s in steps], [s[1] for s in steps], "o-", ms=3, label=method + end)
+    bx.axvline(1.0, color="k", lw=0.8, ls=":")
+    bx.set_xlabel("load P / P_cr at the end of the step")
+    bx.set_ylabel("Newton iterations in the step")
+    bx.set_yscale("log")
+    bx.set_title("Newton variants along the path (40 fixed steps)", fontsize=9)
+    bx.grid(alpha=0.3, which="both")
+    bx.legend(fontsize=7)
+    save_figure(fig, path)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true")
@@ -150,15 +183,15 @@ def main():
         "step_control": step_control(),
         "ranks": comm.size,
         "machine": machine(comm.size),
+        "benchmark_time_s": elapsed(),
     }
     if comm.rank == 0:
         text = tables(result)
         print(text)
         if not args.quick:
             (HERE / "results" / "buckling.json").write_text(json.dumps(result, indent=1))
+            plot(result, HERE / "results" / "buckling.png")
             if args.update_readme:
-                from common import update_readme
-
                 update_readme("buckling", text)
 
 

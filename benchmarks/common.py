@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import os
 import platform
+import time
 from pathlib import Path
+
+_START = time.perf_counter()
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -23,9 +26,30 @@ def machine(ranks: int = 1) -> dict:
             "petsc": ".".join(map(str, PETSc.Sys.getVersion()))}
 
 
+def elapsed() -> float:
+    """Seconds since the benchmark started (this module's import): its run time."""
+    return time.perf_counter() - _START
+
+
 def update_readme(name: str, text: str) -> None:
     """Replace the README's generated section `name` with `text`."""
     src = README.read_text()
     start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
     i, j = src.index(start) + len(start), src.index(end)
     README.write_text(src[:i] + "\n" + text + "\n" + src[j:])
+
+
+def pyplot():
+    """matplotlib's pyplot without a display."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig, path: Path) -> None:
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print(f"wrote {path}", flush=True)

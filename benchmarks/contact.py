@@ -20,7 +20,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import ufl
-from common import machine
+from common import elapsed, machine, pyplot, save_figure, update_readme
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
@@ -142,15 +142,13 @@ def main():
     same = peers(0 if args.quick else 1, [10, 100, 1000, 10000])
     result = {"axisymmetric": ax, "3d": d3, "same_mesh": same, "hertz": REF,
               "ranks": comm.size,
-              "machine": machine(comm.size)}
+              "machine": machine(comm.size), "benchmark_time_s": elapsed()}
     if comm.rank == 0 and not args.quick:
         (HERE / "results" / "contact.json").write_text(json.dumps(result, indent=1))
         plot(result, HERE / "results" / "contact.png")
         text = table(result)
         print(text)
         if args.update_readme:
-            from common import update_readme
-
             update_readme("contact", text)
 
 
@@ -183,11 +181,7 @@ def table(r):
 
 
 def plot(r, path):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for model in ("axisymmetric", "3d"):
         rows = r[model]
@@ -200,8 +194,7 @@ def plot(r, path):
     ax.set_ylabel("|P / P_Hertz - 1|")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
 
 
 if __name__ == "__main__":

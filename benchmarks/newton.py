@@ -1,7 +1,8 @@
 """Newton variants against SNES on a 3D power-law cantilever (>= 100k unknowns by default).
 
 One run, one mesh, one linear solver (MUMPS): every variant starts from u = 0 at the same
-load and reaches the same tolerance. Writes benchmarks/results/newton.json and, with
+load and reaches the same tolerance. Writes benchmarks/results/newton.json, the plot
+newton.png (relative residual against wall time, one curve per variant) and, with
 --update-readme, the table in README.md (between the `bench:newton` markers).
 """
 
@@ -16,7 +17,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 import ufl
-from common import machine, update_readme
+from common import elapsed, machine, pyplot, save_figure, update_readme
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
@@ -76,7 +77,7 @@ def run_variant(cls, opts, cells, traction, linear_solver, prefix):
             "residual_assemblies": w.residual_assemblies,
             "tangent_assemblies": w.tangent_assemblies, "factorizations": w.factorizations,
             "linear_solves": w.linear_solves, "phase_time_s": dict(w.time),
-            "residual_norms": r.residual_norms,
+            "residual_norms": r.residual_norms, "elapsed_s": r.elapsed,
             "dofs": p.u.function_space.dofmap.index_map.size_global * 3}
 
 
@@ -129,6 +130,7 @@ def main():
         "best_variant": best[1], "ratio_best_over_full": best[0] / full,
         "max_rel_tip_spread": (max(tips) - min(tips)) / abs(np.mean(tips)),
         "machine": machine(MPI.COMM_WORLD.size),
+        "benchmark_time_s": elapsed(),
         "variants": results,
     }
     if rank0:
@@ -137,6 +139,7 @@ def main():
             out = HERE / "results" / "newton.json"
             out.write_text(json.dumps(summary, indent=1))
             print(f"wrote {out}")
+            plot(summary, HERE / "results" / "newton.png")
             if args.update_readme:
                 update_readme("newton", table(summary))
 
@@ -163,6 +166,22 @@ def table(s):
               f"**{s['ratio_best_over_full']:.2f}**; all variants agree on the tip displacement "
               f"to {s['max_rel_tip_spread']:.1e} (relative)."]
     return "\n".join(lines)
+
+
+def plot(s, path):
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    for label, r in s["variants"].items():
+        norms = np.asarray(r["residual_norms"])
+        ax.loglog(r["elapsed_s"], norms / norms[0], ".-" if "SNES" in label else "o-",
+                  ms=3, label=f"{label} ({r['iterations']} its)")
+    ax.set_xlabel("wall time since the start of the solve [s]")
+    ax.set_ylabel("|R| / |R0|")
+    ax.set_title(f"power-law cantilever, {s['dofs']} unknowns, MUMPS, {s['ranks']} rank(s)",
+                 fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    save_figure(fig, path)
 
 
 if __name__ == "__main__":

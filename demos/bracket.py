@@ -106,7 +106,11 @@ def run_variant(args, newton):
     for k in range(1, args.steps + 1):
         force = args.force * k / args.steps
         b.set_load(force)
-        r = b.solver.solve()
+        try:
+            r = b.solver.solve()
+        except ConvergenceError as err:
+            raise ConvergenceError(f"load step {k}/{args.steps} (F = {force:.4g} N), {newton} "
+                                   f"Newton: {err}; take more --steps", err.result) from err
         its = getattr(r, "newton_iterations", r.iterations)
         steps.append({"force": force, "load_point_displacement": b.load_point_displacement(),
                       "newton_iterations": its, "factorizations": r.work.factorizations,

@@ -83,6 +83,7 @@ class NewtonResult:
     residual_norms: list[float]
     work: WorkCounts
     wall_time: float = 0.0
+    elapsed: list[float] = field(default_factory=list)  # seconds from the start, per norm
 
     @property
     def orders(self) -> list[float]:
@@ -249,11 +250,13 @@ class NewtonSolver:
             self._tangent_ready = False
         pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []  # BFGS (s, y, 1/y·s)
         norms = [self._residual(work)]
+        elapsed = [time.perf_counter() - t_start]
         k = 0
 
         def result(converged: bool, reason: str) -> NewtonResult:
             self.total.add(work)
-            return NewtonResult(converged, reason, k, norms, work, time.perf_counter() - t_start)
+            return NewtonResult(converged, reason, k, norms, work, time.perf_counter() - t_start,
+                                elapsed)
 
         while True:
             rnorm = norms[-1]
@@ -282,6 +285,7 @@ class NewtonSolver:
                 self._linear_solve(self.b, work)
             alpha = self._step(rnorm, work)
             norms.append(self._last_norm)
+            elapsed.append(time.perf_counter() - t_start)
             if self.method == "bfgs":
                 self._bfgs_store(pairs, alpha, b_old)
             k += 1

@@ -108,6 +108,8 @@ class SnesSolver:
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes = self.problem.solver
         self.snes.setConvergenceHistory(reset=True)
+        self._stamps: list[float] = []  # time of each residual norm, as NewtonResult.elapsed
+        self.snes.setMonitor(lambda snes, it, norm: self._stamps.append(time.perf_counter()))
         self.counter = EventCounter(_all_event_names())
 
     def solve(self) -> NewtonResult:
@@ -117,13 +119,14 @@ class SnesSolver:
         petsc.set_bc(x, self.bcs)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         self.counter.start()
+        self._stamps.clear()
         self.problem.solve()
         work = petsc_work(self.counter)
         norms = [float(r) for r in self.snes.getConvergenceHistory()[0]]
         reason = self.snes.getConvergedReason()
         result = NewtonResult(reason > 0, f"SNES reason {reason}",
                               self.snes.getIterationNumber(), norms, work,
-                              time.perf_counter() - t0)
+                              time.perf_counter() - t0, [t - t0 for t in self._stamps])
         if reason <= 0:
             raise ConvergenceError(f"SNES did not converge (reason {reason})", result)
         return result

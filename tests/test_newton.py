@@ -78,6 +78,10 @@ def test_full_newton_is_quadratic_and_snes_agrees_iteration_by_iteration():
     # same algorithm: the residual histories agree to round-off until the last iterate
     np.testing.assert_allclose(r.residual_norms[:-1], s.residual_norms[:-1], rtol=1e-6)
     assert r.work.factorizations == r.iterations == r.petsc_factorizations
+    # each residual norm has its time stamp (the benchmarks plot error against time)
+    for x in (r, s):
+        assert len(x.elapsed) == len(x.residual_norms)
+        assert np.all(np.diff(x.elapsed) > 0) and x.elapsed[-1] <= x.wall_time
 
 
 def test_modified_newton_is_linear_and_factorizes_once():

@@ -1,0 +1,176 @@
+"""Which method when: the README's reading of the benchmarks, written from their results.
+
+Every figure and every choice ("fastest", "gave up at") is computed from the JSON files in
+benchmarks/results/, so the text stays true when `make bench` is run again. A benchmark
+whose result file is missing is left out.
+
+    python benchmarks/reading.py [--update-readme]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from itertools import pairwise
+from pathlib import Path
+
+from common import update_readme
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def load(name: str) -> dict | None:
+    path = RESULTS / f"{name}.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def fastest(rows: dict, time_key: str, exclude: str = "\0") -> str:
+    return min((k for k in rows if exclude not in k), key=lambda k: rows[k][time_key])
+
+
+def kilo(dofs: int) -> str:
+    return f"{round(dofs / 1000)}k"
+
+
+def newton(n: dict) -> str:
+    v = n["variants"]
+    full, best = v["full"], fastest(v, "wall_time_s", exclude="SNES")
+    mod = v["modified"]
+    return (
+        f"* **A smoothly non-linear material with a direct solver** (power-law cantilever, "
+        f"{n['dofs']} unknowns, one load step, MUMPS): **{best}** is the fastest, "
+        f"{v[best]['wall_time_s']:.1f} s against {full['wall_time_s']:.1f} s for full Newton "
+        f"({n['ratio_best_over_full']:.2f}x) with {v[best]['factorizations']} factorization(s) "
+        f"for {v[best]['iterations']} iterations, where full Newton needs "
+        f"{full['iterations']} iterations and as many factorizations. Modified Newton's "
+        f"{mod['iterations']} iterations on one factorization cost "
+        f"{mod['wall_time_s'] / full['wall_time_s']:.2f}x full Newton. The hand-written loop "
+        f"costs {n['ratio_full_over_snes']:.2f}x SNES `newtonls` ({full['iterations']} "
+        f"against {v['SNES newtonls']['iterations']} iterations).")
+
+
+def bracket(b: dict, large: dict | None) -> list[str]:
+    out = []
+    ranking = []
+    for row in b["refinement"]:
+        v = {k: x for k, x in row["variants"].items() if "1 step" not in k}
+        best = fastest(v, "solve_time_s")
+        ranking.append(f"{kilo(row['dofs'])}: {best} "
+                       f"{v['full']['solve_time_s'] / v[best]['solve_time_s']:.1f}x faster")
+    rows = b["refinement"] + (large["refinement"][-1:] if large else [])
+    ratios = [r["variants"]["quasi-newton, 1 step"]["over_linear"] for r in rows]
+    one = [f"{x:.1f} at {kilo(r['dofs'])}" for x, r in zip(ratios, rows, strict=True)]
+    trend = (", falling as the mesh grows (the one factorization takes a larger share)"
+             if all(x > y for x, y in pairwise(ratios)) else "")
+    out.append(
+        "* **The same on a 3D part** (bracket, P2, 4 load steps): the fastest four-step "
+        f"variant and its gain on full Newton per mesh: {'; '.join(ranking)}. The power law "
+        "is hyperelastic, so one load step is legitimate: quasi-Newton on a single "
+        f"factorization then costs {', '.join(one)} linear solves{trend}.")
+    if "iterative" in b:
+        g = b["iterative"]
+        v = g["variants"]
+        best = fastest(v, "solve_time_s")
+        items = ", ".join(f"{k} {x['solve_time_s']:.1f} s ({x['newton_iterations']} its, "
+                          f"{x['krylov_iterations']} CG)" for k, x in v.items())
+        out.append(
+            f"* **With CG + GAMG** (bracket, {kilo(g['linear']['dofs'])} unknowns, one "
+            f"step) the ranking turns over: {items}; **{best}** wins. With no factorization to "
+            "amortize, every iteration costs a Krylov solve, so the fewest iterations win; "
+            "the inexact-Newton forcing term keeps the early CG solves loose.")
+    sp = [f"{k} **{p['speedup']:.2f}** at {kilo(p['1']['dofs'])}"
+          for r in (b, large or {}) for k, p in r.get("parallel", {}).items()]
+    if sp:
+        out.append(f"* **2 ranks against 1** (MUMPS, bracket): speed-up {'; '.join(sp)}.")
+    if large and "large" in large:
+        g = large["large"]
+        f = g["full, 1 step"]
+        out.append(
+            f"* **Beyond a direct solver** ({f['dofs']} unknowns, CG + GAMG, 2 ranks): full "
+            f"Newton in one step, {f['solve_time_s']:.0f} s, {g['over_linear']:.1f} linear "
+            f"solves, {f['peak_memory_mb']:.0f} MB per rank.")
+    return out
+
+
+def buckling(k: dict) -> str:
+    v = k["variants"]
+    gave_up = [f"{m} after {x['failed_at_load_ratio']:.3f} P_cr" for m, x in v.items()
+               if x["failed_at_load_ratio"] is not None]
+    through = [f"{m} ({x['mean_iterations_away']:.1f} iterations per step away from it, "
+               f"{x['mean_iterations_near']:.1f} near)" for m, x in v.items()
+               if x["failed_at_load_ratio"] is None]
+    s = k["step_control"]
+    quick = min(s, key=lambda m: s[m]["wall_time_s"])
+    q1 = [x for x in k["refinement"] if x["degree"] == 1][-1]
+    q2 = next(x for x in k["refinement"] if x["degree"] == 2)
+    fixed = s["fixed, 40 steps"]
+    return (
+        "* **Through a bifurcation** (buckling beam, 40 steps to 2 P_cr; the tangent is "
+        f"singular at P_cr): gave up: {'; '.join(gave_up) or 'none'}; went through: "
+        f"{' and '.join(through) or 'none'}. "
+        f"Cheapest path: {quick}, {s[quick]['wall_time_s']:.2f} s against "
+        f"{fixed['wall_time_s']:.2f} s for 40 fixed steps, tip rotation "
+        f"{s[quick]['tip_rotation_error_deg']:+.3f}° from the elastica against "
+        f"{fixed['tip_rotation_error_deg']:+.3f}°. Elements: Q2 at "
+        f"{q2['dofs']} unknowns gives P_cr to {100 * abs(q2['critical_load_rel_error']):.3f} % "
+        f"where Q1 at {q1['dofs']} is {100 * q1['critical_load_rel_error']:+.1f} % (locking).")
+
+
+def contact(c: dict) -> str:
+    m = c["same_mesh"]
+    elim, lin = m["active set, elimination"], m["linear solve"]["wall_time_s"]
+    noreuse, vi = m["active set, elimination, no reuse"], m["SNES VI (vinewtonrsls)"]
+    pen = {k: x for k, x in m.items() if k.startswith("penalty")}
+    close = [k for k, x in pen.items() if abs(x["force"] / elim["force"] - 1) < 1e-3]
+    first = close[0] if close else None
+    pen_text = (f"penalty needs {first.removeprefix('penalty ')} to come within 0.1 % of it "
+                f"({pen[first]['wall_time_s'] / elim['wall_time_s']:.1f}x the time, "
+                f"{pen[first]['iterations']} Newton iterations)" if first else
+                "no penalty tried comes within 0.1 % of it")
+    return (
+        "* **Frictionless contact** (axisymmetric punch, same mesh): the active set with "
+        f"elimination takes {elim['wall_time_s']:.2f} s ({elim['iterations']} iterations, "
+        f"{elim['factorizations']} factorizations with reuse, {noreuse['factorizations']} "
+        f"without), {elim['wall_time_s'] / lin:.1f} linear solves; SNES VI reaches the same "
+        f"force in {vi['wall_time_s'] / elim['wall_time_s']:.1f}x the time; {pen_text}. "
+        "The multiplier form gives the same force to "
+        f"{abs(m['active set, multipliers']['force'] / elim['force'] - 1):.0e} in "
+        f"{m['active set, multipliers']['wall_time_s'] / elim['wall_time_s']:.1f}x the time, "
+        "with the contact pressure as an unknown.")
+
+
+def run_times(names) -> str:
+    parts = [(n, d["benchmark_time_s"]) for n in names
+             if (d := load(n)) and "benchmark_time_s" in d]
+    total = sum(t for _, t in parts)
+    each = ", ".join(f"{n} {t / 60:.1f}" for n, t in parts)
+    return f"Run time of these benchmarks on this machine: {total / 60:.0f} min ({each} min)."
+
+
+def reading() -> str:
+    lines = []
+    if n := load("newton"):
+        lines.append(newton(n))
+    if b := load("bracket"):
+        lines += bracket(b, load("bracket_large"))
+    if k := load("buckling"):
+        lines.append(buckling(k))
+    if c := load("contact"):
+        lines.append(contact(c))
+    lines += ["", run_times(["newton", "contact", "buckling", "bracket"])]
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--update-readme", action="store_true")
+    args = ap.parse_args()
+    text = reading()
+    print(text)
+    if args.update_readme:
+        update_readme("reading", text)
+
+
+if __name__ == "__main__":
+    main()
