@@ -50,6 +50,23 @@ def pyplot():
 
 
 def save_figure(fig, path: Path) -> None:
+    """Write `fig`. Log axes: short plain labels when they span up to 1.5 decades,
+    decade labels only when they span more (minor labels would overlap)."""
+    import math
+
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    for ax in fig.axes:
+        for axis, scale, (lo, hi) in ((ax.xaxis, ax.get_xscale(), ax.get_xlim()),
+                                      (ax.yaxis, ax.get_yscale(), ax.get_ylim())):
+            if scale != "log":
+                continue
+            if math.log10(hi / lo) <= 1.5:
+                axis.set_major_formatter(plain)
+                axis.set_minor_formatter(plain)
+            else:
+                axis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     print(f"wrote {path}", flush=True)

@@ -24,6 +24,9 @@ from fenics_nl.materials import LinearElastic, NeoHookean, StVenantKirchhoff
 from fenics_nl.newton import ConvergenceError, NewtonSolver
 
 MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
+# A load path that ends unstable is redone with 4x the steps, up to this many: small steps
+# through P_cr let the imperfection pick the buckled branch.
+MAX_PATH_STEPS = 256
 
 
 class Beam:
@@ -117,7 +120,8 @@ class Beam:
         steps. Past P_cr the straight beam is an unstable equilibrium Newton can settle on;
         the tangent's eigenvalue nearest 0 (SLEPc) tells. An unstable end state is kicked
         along its unstable mode to the elastica's deflection and solved again (branch
-        switching); if Newton cannot follow, the path is redone with 4x the steps.
+        switching); if Newton cannot follow, the path is redone with 4x the steps, up to
+        MAX_PATH_STEPS.
         Returns the path and whether the branch was switched.
         """
         P = ratio * self.P_euler
@@ -127,7 +131,7 @@ class Beam:
                               atol=1e-9 * P, max_it=30 if method == "full" else 500,
                               prefix=f"beam_{method}_")
         tangent = ufl.derivative(self.residual, self.u)
-        for _ in range(3):
+        while True:
             self.u.x.array[:] = 0.0
             path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
                                        max_step=1.0 if grow else 1.0 / steps,
@@ -140,17 +144,19 @@ class Beam:
             self.kick_along(mode, elastica.tip_position(ratio)[0] * self.L)
             try:
                 result = solver.solve()
+                if lowest_tangent_mode(tangent, self.bcs, self.V)[0] >= 0:
+                    path.results.append(result)
+                    path.work.add(result.work)
+                    if on_step:
+                        on_step(1.0, result)
+                    return path, True
             except ConvergenceError:
-                steps *= 4
-                if progress:
-                    progress(f"branch switching failed: load path again with {steps} steps")
-                continue
-            if lowest_tangent_mode(tangent, self.bcs, self.V)[0] >= 0:
-                path.results.append(result)
-                path.work.add(result.work)
-                if on_step:
-                    on_step(1.0, result)
-                return path, True
+                pass
+            if steps >= MAX_PATH_STEPS:
+                break
+            steps = min(4 * steps, MAX_PATH_STEPS)
+            if progress:
+                progress(f"branch switching failed: load path again with {steps} steps")
         raise RuntimeError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
 
     def kick_along(self, mode: fem.Function, deflection: float) -> None:

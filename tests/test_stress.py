@@ -211,6 +211,70 @@ def test_near_incompressibility_p2_keeps_hertz_p1_locks(nu):
     assert abs(p2.force / ref - 1) < abs(p1.force / ref - 1)
 
 
+# -- load increments through each scene's command line -------------------------------------
+
+@pytest.mark.parametrize("args", [
+    ["--steps", "4"],  # ×10 the default increment (1.5 P_cr in 40 steps)
+    ["--load-ratio", "3.75", "--steps", "1"],  # ×100: 3.75 P_cr in one step
+])
+def test_beam_large_increments_land_on_the_elastica(tmp_path, args):
+    from test_demos import assert_on_elastica, beam
+
+    assert_on_elastica(beam(tmp_path, *args))
+
+
+def test_punch_tenfold_increment_power_law(tmp_path):
+    # ×10 the default indentation (0.01 R, one step) in one step, non-linear material:
+    # frictionless contact on a convex energy has one solution, whatever the path
+    from test_demos import punch
+
+    common = ["--material", "power-law", "--indentation", "0.1", "--refine", "0"]
+    one, ten = punch(tmp_path, *common, "--steps", "1"), punch(tmp_path, *common, "--steps", "10")
+    assert one["force"] == pytest.approx(ten["force"], rel=1e-8)
+    assert one["contact_radius"] == ten["contact_radius"]
+
+
+def test_punch_hundredfold_increment_stays_on_hertz(tmp_path):
+    # ×100: δ = R in one step, contact radius a = R. With Hertz's parabola the linear
+    # problem scales with a (the mesh is built in units of a, up to gmsh's rounding: 13536
+    # against 13390 unknowns), so Hertz holds to the same discretisation error as at
+    # δ = 0.01 R (measured +0.17 % and +0.20 %). The exact sphere lies above the parabola
+    # (more gap) out there: less force.
+    from test_demos import punch
+
+    small = punch(tmp_path, "--refine", "0")
+    big = punch(tmp_path, "--refine", "0", "--indentation", "1")
+    sphere = punch(tmp_path, "--refine", "0", "--indentation", "1", "--gap", "sphere")
+    for d in (small, big):
+        assert abs(d["force_rel_error"]) < 0.005  # the tolerance of the default punch test
+        assert abs(d["contact_radius"] - d["hertz_contact_radius"]) < d["element_size"]
+    assert 0.5 * big["force"] < sphere["force"] < big["force"]
+
+
+def test_bracket_tenfold_increment_gives_the_same_answer(tmp_path):
+    # ×10: 20 kN (ε_eq ~ 800 ε0) in one step against ten steps of the default 2 kN
+    from test_demos import bracket
+
+    common = ["--size", "14", "--force", "20000"]
+    one, ten = bracket(tmp_path, *common, "--steps", "1"), bracket(tmp_path, *common,
+                                                                   "--steps", "10")
+    assert one["load_point_displacement"] == pytest.approx(ten["load_point_displacement"],
+                                                           rel=1e-8)
+
+
+def test_bracket_hundredfold_increment_refuses_clearly(tmp_path):
+    # ×100: 200 kN in one step. Full Newton crawls (damped by the line search); after 50
+    # iterations the demo stops and says which step failed and what to do.
+    from test_demos import DEMOS, run
+
+    proc = run([DEMOS / "bracket.py", "--size", "14", "--force", "200000", "--steps", "1"],
+               tmp_path, check=False)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("error: load step 1/1 (F = 2e+05 N), full Newton: no "
+                                  "convergence in 50 iterations")
+    assert "take more --steps" in proc.stderr and "Traceback" not in proc.stderr
+
+
 # -- three ranks ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("scene,args,keys", [
