@@ -108,8 +108,12 @@ class SnesSolver:
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes = self.problem.solver
         self.snes.setConvergenceHistory(reset=True)
-        self._stamps: list[float] = []  # time of each residual norm, as NewtonResult.elapsed
-        self.snes.setMonitor(lambda snes, it, norm: self._stamps.append(time.perf_counter()))
+        # time of each residual norm, as NewtonResult.elapsed. The monitor holds the list,
+        # not self: a cycle self → snes → monitor → self would leave the PETSc objects to the
+        # garbage collector, which destroys them in a different order on each rank (hang).
+        self._stamps: list[float] = []
+        stamps = self._stamps
+        self.snes.setMonitor(lambda snes, it, norm: stamps.append(time.perf_counter()))
         self.counter = EventCounter(_all_event_names())
 
     def solve(self) -> NewtonResult:
