@@ -68,6 +68,8 @@ def parse_args(argv=None):
                    help="run every variant on the same mesh and print one table")
     p.add_argument("--force", type=float, default=8e3, help="total load on the arm's hole [N]")
     p.add_argument("--steps", type=int, default=4, help="equal load steps")
+    p.add_argument("--tolerance", type=float, default=1e-9,
+                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
     p.add_argument("--size", type=float, default=6.0, help="largest element size [mm]")
     p.add_argument("--degree", type=int, choices=[1, 2], default=2,
                    help="Lagrange degree (P1 is far too stiff here: see the README)")
@@ -100,6 +102,7 @@ def run_variant(args, newton):
                 if args.material == "power-law" else LinearElastic(args.E, args.nu))
     b = Bracket(material, size=args.size, mesh_file=args.mesh, support=args.support,
                 degree=args.degree, newton=newton, force_scale=args.force,
+                tolerance=args.tolerance,
                 linear_solver="lu" if args.solver == "direct" else "gamg")
     steps = []
     t0 = time.perf_counter()
@@ -109,8 +112,10 @@ def run_variant(args, newton):
         try:
             r = b.solver.solve()
         except ConvergenceError as err:
+            # a stall at round-off needs a looser tolerance, not smaller steps
+            advice = "raise --tolerance" if "stalls at" in str(err) else "take more --steps"
             raise ConvergenceError(f"load step {k}/{args.steps} (F = {force:.4g} N), {newton} "
-                                   f"Newton: {err}; take more --steps", err.result) from err
+                                   f"Newton: {err}; {advice}", err.result) from err
         its = getattr(r, "newton_iterations", r.iterations)
         steps.append({"force": force, "load_point_displacement": b.load_point_displacement(),
                       "newton_iterations": its, "factorizations": r.work.factorizations,

@@ -287,7 +287,8 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
                           (["--mesh", "box.msh"], "no physical group load, base"),
                           (["--mesh", "folded.msh"], "inverted (folded over a neighbour)"),
                           (["--support", "contact", "--newton", "snes"], "clamped only"),
-                          (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size")]:
+                          (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size"),
+                          (["--tolerance", "0"], "tolerance must be in")]:
         proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)
