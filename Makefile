@@ -30,7 +30,7 @@ test-mpi: $(VENV)/.installed
 
 # every benchmark at sizes for 2 cores (about 25 min), results in benchmarks/results/, the
 # README tables and the "which method when" reading regenerated from them;
-# `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 3 min);
+# `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
 BENCHMARKS := newton contact buckling bracket
 bench: $(VENV)/.installed
