@@ -11,7 +11,7 @@ variant's peak memory is its own. Three parts, each on the same meshes for all m
 * large (CG + GAMG, 2 ranks): full Newton in one load step (each CG solve costs as much as
   the linear solve, so the fewest iterations win) and one linear solve at about 1M unknowns.
 
-Two profiles. The default one fits `make bench` (about 12 min on 2 cores: meshes of 12k,
+Two profiles. The default one fits `make bench` (about 12 min on 2 cores: meshes of 22k,
 31k and 81k unknowns, 1 vs 2 ranks at 81k, no large part) and writes results/bracket.json;
 `--large` (`make bench-large`, about 75 min) measures 31k, 81k and 234k, 1 vs 2 ranks at
 300k and the ~1M iterative part, into results/bracket_large.json.

@@ -1,5 +1,5 @@
-"""What every benchmark shares: the machine facts stored with its results, and the
-README section it regenerates between `<!-- bench:NAME -->` markers."""
+"""What every benchmark shares: the machine facts and run time stored with its results,
+the README section it regenerates between `<!-- bench:NAME -->` markers, plotting."""
 
 from __future__ import annotations
 
@@ -29,6 +29,12 @@ def machine(ranks: int = 1) -> dict:
 def elapsed() -> float:
     """Seconds since the benchmark started (this module's import): its run time."""
     return time.perf_counter() - _START
+
+
+def outside_kernels(r: dict) -> float:
+    """Wall time of a Newton run (newton.json) not spent assembling, factorizing or
+    solving: the loop's own cost."""
+    return r["wall_time_s"] - sum(r["phase_time_s"].values())
 
 
 def update_readme(name: str, text: str) -> None:

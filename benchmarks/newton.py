@@ -17,7 +17,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 import ufl
-from common import elapsed, machine, pyplot, save_figure, update_readme
+from common import elapsed, machine, outside_kernels, pyplot, save_figure, update_readme
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
@@ -142,11 +142,6 @@ def main():
             plot(summary, HERE / "results" / "newton.png")
             if args.update_readme:
                 update_readme("newton", table(summary))
-
-
-def outside_kernels(r) -> float:
-    """Wall time not spent assembling, factorizing or solving: the loop's own cost."""
-    return r["wall_time_s"] - sum(r["phase_time_s"].values())
 
 
 def table(s):

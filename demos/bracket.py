@@ -44,7 +44,7 @@ from fenics_nl.bracket import Bracket
 from fenics_nl.cli import parse_with_petsc_options
 from fenics_nl.contact import ContactError
 from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.newton import ConvergenceError
+from fenics_nl.newton import ConvergenceError, stalled_at_round_off
 
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
@@ -113,7 +113,8 @@ def run_variant(args, newton):
             r = b.solver.solve()
         except ConvergenceError as err:
             # a stall at round-off needs a looser tolerance, not smaller steps
-            advice = "raise --tolerance" if "stalls at" in str(err) else "take more --steps"
+            stalled = stalled_at_round_off(err.result.residual_norms)
+            advice = "raise --tolerance" if stalled else "take more --steps"
             raise ConvergenceError(f"load step {k}/{args.steps} (F = {force:.4g} N), {newton} "
                                    f"Newton: {err}; {advice}", err.result) from err
         its = getattr(r, "newton_iterations", r.iterations)

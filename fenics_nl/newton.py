@@ -109,12 +109,17 @@ def forcing_term(relative_residual: float) -> float:
     return 1e-3 * min(1.0, max(relative_residual, 1e-11))
 
 
-def _round_off_hint(norms: list[float]) -> str:
-    """A hint when ‖R‖ has stalled far below its start: round-off, not a bad method."""
+def stalled_at_round_off(norms: list[float]) -> bool:
+    """‖R‖ flat over the last 5 iterates, far below its start: round-off, not a bad method."""
     last = norms[-5:]
-    if len(last) == 5 and max(last) < 1e-8 * max(norms) and max(last) < 10 * min(last):
-        return (f"; |R| stalls at {min(last):.1e}, the round-off of the internal forces: "
-                "set atol above it (e.g. 1e-10 times the load)")
+    return len(last) == 5 and max(last) < 1e-8 * max(norms) and max(last) < 10 * min(last)
+
+
+def _round_off_hint(norms: list[float]) -> str:
+    """The error's hint when the residual stalled at round-off."""
+    if stalled_at_round_off(norms):
+        return (f"; |R| stalls at {min(norms[-5:]):.1e}, the round-off of the internal "
+                "forces: set atol above it (e.g. 1e-10 times the load)")
     return ""
 
 
