@@ -67,7 +67,7 @@ def tip(problem):
 def run_variant(cls, opts, cells, traction, linear_solver, prefix):
     p = cantilever_3d(MATERIAL, cells=cells, size=SIZE, traction=traction)
     solver = cls(p.residual, p.u, p.bcs, linear_solver=linear_solver, prefix=prefix,
-                 rtol=1e-10, atol=1e-12, max_it=500, **opts)
+                 rtol=1e-10, max_it=500, **opts)
     MPI.COMM_WORLD.Barrier()
     t0 = time.perf_counter()
     r = solver.solve()

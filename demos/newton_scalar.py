@@ -20,14 +20,15 @@
 # ## Implementation
 
 # +
-import argparse
 import json
+import math
 import sys
 import time
 
 import mpmath
+import numpy as np
 
-from fenics_nl import scalar
+from fenics_nl import cli, scalar
 
 # Each function: r(u), a starting point, and what it models.
 FUNCTIONS = {
@@ -43,24 +44,30 @@ FUNCTIONS = {
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__ or "Scalar Newton-type iterations.",
-                                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p = cli.parser("Newton (order 2), modified Newton (order 1) and secant (order 1.618) on a "
+                   "scalar equation r(u) = 0, in many-digit arithmetic so that the orders show.")
     p.add_argument("--function", choices=FUNCTIONS, default="spring",
                    help="equation r(u) = 0 to solve (dimensionless)")
-    p.add_argument("--u0", type=float, default=None, help="starting point (default per function)")
-    p.add_argument("--slope", type=float, default=None,
-                   help="constant slope K of modified Newton (default r'(u0))")
-    p.add_argument("--digits", type=int, default=60,
+    p.add_argument("--u0", type=cli.finite, default=None,
+                   help="starting point (default: the function's own)")
+    p.add_argument("--slope", type=cli.finite, default=None,
+                   help="constant slope K of modified Newton (default: r'(u0))")
+    p.add_argument("--digits", type=cli.at_least(16), default=60,
                    help="decimal digits of the arithmetic (16 = double precision floats)")
-    p.add_argument("--maxit", type=int, default=500, help="iteration limit per method")
+    p.add_argument("--maxit", type=cli.at_least(1), default=500,
+                   help="iteration limit per method")
     p.add_argument("--json", metavar="PATH", help="write orders and iteration counts as JSON")
-    p.add_argument("--plot", metavar="PATH", help="draw |e_k| against k (log scale) to PATH")
+    p.add_argument("--plot", metavar="PATH",
+                   help="draw |e_k+1| against |e_k| (log-log: the slopes are the orders)")
     args = p.parse_args(argv)
-    if not 16 <= args.digits <= 1000:
+    if args.digits > 1000:
         p.error(f"--digits must be in [16, 1000], got {args.digits}")
     if args.slope is not None and args.slope == 0:
         p.error("--slope must be non-zero")
     return args
+
+
+EXPECTED = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
 
 
 def main(argv=None) -> int:
@@ -76,64 +83,90 @@ def main(argv=None) -> int:
         r = (lambda f: lambda u: float(f(u)))(r)
     print(f"r(u) = 0: {what}; u0 = {u0}, {args.digits} digits")
 
-    # Solve with the three methods; a failure (modified Newton with a bad K, say) is reported.
+    # Solve with the three methods. A method that fails (modified Newton with a slope less
+    # than half the true one diverges) is a result too: its iterates are shown.
     # +
-    results = {}
+    results, failures = {}, {}
     for method in scalar.METHODS:
         k = num(args.slope) if args.slope is not None else None
         try:
             results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, maxit=args.maxit)
         except scalar.ScalarSolveError as err:
-            print(f"error: {err}", file=sys.stderr)
-            return 1
+            results[method], failures[method] = err.result, str(err)
     # -
 
-    expected = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
     summary = {}
     for method, res in results.items():
         orders = [float(q) for q in res.orders]
-        order = orders[-1] if orders else float("nan")
-        summary[method] = {"order": order, "expected_order": expected[method],
-                           "iterations": res.iterations, "root": float(res.root),
-                           "orders": orders}
-        print(f"\n{method}: {res.iterations} iterations, root {mpmath.nstr(res.root, 17)}")
-        print("  k   u_k                     |r(u_k)|     q_k")
-        q = [None, None, *orders] if len(orders) + 2 <= len(res.iterates) else orders
-        for i, (u, ru) in enumerate(zip(res.iterates, res.residuals, strict=True)):
-            if i > 12 and i < len(res.iterates) - 3:
-                if i == 13:
-                    print("  ...")
-                continue
-            qi = f"{q[i]:.3f}" if i < len(q) and q[i] is not None else ""
-            print(f"  {i:<3d} {mpmath.nstr(u, 20):<23s} {float(abs(ru)):<12.3e} {qi}")
-        print(f"  observed order {order:.3f} (theory {expected[method]:.3f})")
+        summary[method] = {"converged": res.converged, "iterations": res.iterations,
+                           "order": orders[-1] if orders else None,
+                           "expected_order": EXPECTED[method], "orders": orders,
+                           "root": float(res.root) if res.converged else None}
+        table(method, res, orders, failures.get(method))
+        if method in failures:
+            summary[method]["failure"] = failures[method]
     summary["function"] = args.function
     summary["wall_time_s"] = time.perf_counter() - t0
 
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(summary, f, indent=2)
+            json.dump(summary, f, indent=2, allow_nan=False)
     if args.plot:
         plot(results, args.plot, what)
     return 0
 
 
+def table(method, res, orders, failure):
+    """Iterates, residuals and observed orders of one method (long runs elided)."""
+    state = f"root {mpmath.nstr(res.root, 17)}" if res.converged else "FAILED"
+    print(f"\n{method}: {res.iterations} iterations, {state}")
+    print("  k   u_k                     |r(u_k)|     q_k")
+    q = [None, None, *orders] if len(orders) + 2 <= len(res.iterates) else orders
+    for i, (u, ru) in enumerate(zip(res.iterates, res.residuals, strict=True)):
+        if 12 < i < len(res.iterates) - 3:
+            if i == 13:
+                print("  ...")
+            continue
+        qi = f"{q[i]:.3f}" if i < len(q) and q[i] is not None else ""
+        print(f"  {i:<3d} {mpmath.nstr(u, 20):<23s} {float(abs(ru)):<12.3e} {qi}")
+    if failure:
+        print(f"  {failure}")
+    elif orders:
+        print(f"  observed order {orders[-1]:.3f} (theory {EXPECTED[method]:.3f})")
+
+
 def plot(results, path, title):
+    """e_{k+1} against e_k, log-log: near the root the points lie on lines of slope q."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for method, res in results.items():
+    fig, ax = plt.subplots(figsize=(6, 5))
+    lo, hi = math.inf, 0.0
+    for (method, res), colour in zip(results.items(), ("C0", "C1", "C2"), strict=True):
+        if not res.converged:
+            ax.plot([], [], "x", color=colour, label=f"{method}: diverged")
+            continue
         root = res.iterates[-1]
-        err = [float(abs(u - root)) for u in res.iterates[:-1]]
-        ax.semilogy(range(len(err)), err, "o-", ms=3, label=method)
-    ax.set_xlabel("iteration k")
-    ax.set_ylabel("|u_k - u|")
-    ax.set_title(title, fontsize=9)
+        e = [float(abs(u - root)) for u in res.iterates[:-1]]
+        e = [x for x in e if x > 0]
+        if len(e) < 2:
+            continue
+        ax.loglog(e[:-1], e[1:], "o-", ms=3, color=colour,
+                  label=f"{method} (theory: slope {EXPECTED[method]:.3g})")
+        lo, hi = min(lo, *e), max(hi, *e)
+    if hi > 0:
+        x = np.geomspace(lo, hi, 50)
+        for q, style in ((1.0, ":"), ((1 + 5**0.5) / 2, "-."), (2.0, "--")):
+            ax.loglog(x, hi * (x / hi) ** q, style, color="gray", lw=0.8)
+        ax.set_xlim(lo, hi * 2)
+        ax.set_ylim(lo, hi * 2)
+    ax.set_xlabel("error |e_k| = |u_k - u*|")
+    ax.set_ylabel("next error |e_k+1|")
+    ax.set_title(f"e_k+1 against e_k (grey: slopes 1, 1.62, 2)\n{title}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     print(f"wrote {path}")

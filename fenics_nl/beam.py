@@ -128,7 +128,7 @@ class Beam:
         # rtol 1e-8: near P_cr the tangent is nearly singular and modified Newton's linear
         # rate is close to 1; tighter tolerances stall there on round-off.
         solver = NewtonSolver(self.residual, self.u, self.bcs, method=method, rtol=1e-8,
-                              atol=1e-9 * P, max_it=30 if method == "full" else 500,
+                              atol=1e-9, force_scale=P, max_it=30 if method == "full" else 500,
                               prefix=f"beam_{method}_")
         tangent = ufl.derivative(self.residual, self.u)
         while True:

@@ -22,3 +22,32 @@ def component(V: fem.FunctionSpace, i: int, facets: np.ndarray, value: float = 0
     g = fem.Function(Vi)
     g.x.array[:] = value
     return fem.dirichletbc(g, dofs, V.sub(i))
+
+
+def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np.ndarray]
+              ) -> dict[str, list[float]]:
+    """Resultant force on each facet group: Σ R(u) over its nodes, per component.
+
+    R = f_int − f_ext assembled without any Dirichlet row, at the current u: on a supported
+    group it is the force the support exerts on the body (an axisymmetric residual carries
+    2πr, so this is the force on the whole revolution). Collective.
+    """
+    from dolfinx.fem import petsc
+    from mpi4py import MPI
+    from petsc4py import PETSc
+
+    V = u.function_space
+    form = residual if isinstance(residual, fem.Form) else fem.form(residual)
+    b = petsc.assemble_vector(form)
+    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+    bs = V.dofmap.index_map_bs
+    n_owned = V.dofmap.index_map.size_local
+    R = b.array_r[: n_owned * bs].reshape(-1, bs)
+    b.destroy()
+    fdim = V.mesh.topology.dim - 1
+    out = {}
+    for name, facets in groups.items():
+        nodes = fem.locate_dofs_topological(V, fdim, facets)
+        total = R[nodes[nodes < n_owned]].sum(axis=0)
+        out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]
+    return out

@@ -28,8 +28,24 @@ GROUPS = ("bolts", "load", "base")
 GEOMETRY = Path(__file__).resolve().parents[1] / "meshes" / "bracket.py"
 
 
-def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None):
-    """MeshData from `meshes/bracket.py` (element size `size`) or from a .msh file."""
+def _geometry():
+    """The gmsh geometry module `meshes/bracket.py` (its dimensions and `build`)."""
+    spec = importlib.util.spec_from_file_location("bracket_geometry", GEOMETRY)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+THICKNESS_MM = _geometry().THICK  # the base plate's thickness
+
+
+def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None,
+              length_scale: float = 1.0):
+    """MeshData from `meshes/bracket.py` (element size `size` in mm) or from a .msh file.
+
+    The built geometry is in mm; `length_scale` (the length of 1 mm in the user's unit,
+    1e-3 for metres) scales its coordinates. A file is read in its own units.
+    """
     if path is not None:
         if not Path(path).is_file():
             raise ValueError(f"mesh file not found: {path}")
@@ -39,9 +55,7 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
             raise ValueError(f"cannot read mesh file {path}: {err}") from None
         check_cells(data.mesh, name=path)  # a file may hold anything: inverted cells too
     else:
-        spec = importlib.util.spec_from_file_location("bracket_geometry", GEOMETRY)
-        geometry = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(geometry)
+        geometry = _geometry()
         if comm.rank == 0:
             if not gmsh.isInitialized():
                 gmsh.initialize(interruptible=False)
@@ -49,6 +63,7 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
         data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
         if comm.rank == 0:
             gmsh.model.remove()
+        data.mesh.geometry.x[:] *= length_scale
     missing = [g for g in GROUPS if g not in data.physical_groups]
     if missing:
         raise ValueError(f"the mesh has no physical group {', '.join(missing)} "
@@ -68,7 +83,7 @@ class Bracket:
     def __init__(self, material, *, size: float = 5.0, mesh_file: str | None = None,
                  support: str = "clamped", degree: int = 1, newton: str = "full",
                  linear_solver: str = "lu", comm: MPI.Comm = MPI.COMM_WORLD, period: int = 3,
-                 force_scale: float = 1e4, tolerance: float = 1e-9):
+                 force_scale: float = 1e4, tolerance: float = 1e-9, length_scale: float = 1.0):
         if not 0 < tolerance < 1:
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
         if support not in ("clamped", "contact"):
@@ -76,13 +91,21 @@ class Bracket:
         if newton == "snes" and support == "contact":
             raise ValueError("--newton snes works with --support clamped only")
         self.material, self.support = material, support
-        data = load_mesh(comm, size, mesh_file)
+        data = load_mesh(comm, size, mesh_file, length_scale)
         self.mesh = data.mesh
         tags = data.facet_tags
 
         def facets(name):
             return tags.find(data.physical_groups[name].tag)
 
+        tdim = self.mesh.topology.dim
+        cells = np.arange(self.mesh.topology.index_map(tdim).size_local, dtype=np.int32)
+        self.largest_cell = comm.allreduce(float(np.max(self.mesh.h(tdim, cells), initial=0.0)),
+                                           op=MPI.MAX)
+        self.groups = {"bolts": facets("bolts")}
+        self.load_facets = facets("load")
+        if support == "contact":
+            self.groups["base"] = facets("base")
         V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
         self.V = V
         self.u = fem.Function(V, name="displacement")
@@ -100,9 +123,9 @@ class Bracket:
         # forces, which reaches 1e-10 of the load at ε_eq ~ 800 ε0 (measured: 20 kN in 10
         # steps on P2, 17k unknowns), hence 1e-9; and an active-set iteration restarts
         # Newton close to equilibrium, where rtol ‖R₀‖ means little
-        atol = tolerance * force_scale
         method = {"quasi-newton": "bfgs"}.get(newton, newton)
-        opts = {"method": method, "rtol": 1e-10, "atol": atol, "max_it": MAX_IT.get(method, 50),
+        opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
+                "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}
         if support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
@@ -112,7 +135,8 @@ class Bracket:
                 newton_options={k: v for k, v in opts.items() if k != "linear_solver"})
         elif newton == "snes":
             self.solver = SnesSolver(self.residual, self.u, bcs, prefix="bracket_snes_",
-                                     rtol=1e-10, atol=atol, max_it=MAX_IT["full"],
+                                     rtol=1e-10, atol=tolerance, force_scale=force_scale,
+                                     max_it=MAX_IT["full"],
                                      linear_solver=linear_solver)
         else:
             self.solver = NewtonSolver(self.residual, self.u, bcs, prefix="bracket_", **opts)
@@ -136,12 +160,11 @@ class Bracket:
 
     def von_mises(self) -> fem.Function:
         """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""
-        Q = fem.functionspace(self.mesh, ("DG", 0))
-        s = ufl.dev(self.material.stress(kinematics.small_strain(self.u)))
-        expr = fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)), Q.element.interpolation_points)
-        f = fem.Function(Q, name="von_mises")
-        f.interpolate(expr)
-        return f
+        return self.material.von_mises(self.u)
+
+    def reactions(self) -> dict[str, list[float]]:
+        """Resultant force on the bolts (and on the base from the floor), see `boundary`."""
+        return boundary.reactions(self.residual, self.u, self.groups)
 
     def lifted_off_area(self) -> float:
         """Area of the base not in contact with the floor [mm²] (contact support only)."""

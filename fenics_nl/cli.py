@@ -1,8 +1,88 @@
-"""Command-line helpers shared by the demos."""
+"""Command-line plumbing shared by the demos: argument types, PETSc options, the run itself.
+
+A demo parses its flags with `parser(...)` (every default shown once, numeric flags that
+refuse NaN and infinities by name), passes the rest to `PetscOptions` (only options under
+the run's own prefixes are accepted; an option no solver read ends the run with an error),
+and hands its work to `run_scene`, which turns the library's errors into one line and a
+non-zero exit, writes the JSON first and then every other output, each on its own, so that
+a failing picture never loses the numbers.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
+import math
+import os
+import sys
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from mpi4py import MPI
+
+# Errors that end a run with one line: bad parameters, solvers that cannot converge, a load
+# that cannot be reached. Anything else is a bug and keeps its traceback.
+EXPECTED_ERRORS: tuple[type[BaseException], ...] = (ValueError, RuntimeError, ArithmeticError)
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Show the default once: not when it is None, nor when the help already states it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if action.default is None or "default" in text or action.default is argparse.SUPPRESS:
+            return text
+        return super()._get_help_string(action)
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """Bad input is one line on stderr (`--help` has the usage), exit status 2."""
+
+    def error(self, message):
+        """Print `prog: error: message` alone and exit with status 2."""
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def parser(description: str, epilog: str | None = None) -> ArgumentParser:
+    """An argument parser with the demos' help format and one-line errors."""
+    return ArgumentParser(description=description, epilog=epilog, formatter_class=HelpFormatter)
+
+
+def finite(text: str) -> float:
+    """argparse type: a finite float (NaN and infinities are refused)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+def positive(text: str) -> float:
+    """argparse type: a finite float > 0."""
+    value = finite(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def at_least(minimum: int):
+    """argparse type: an integer >= `minimum`."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum}, got {value}")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
 
 
 def parse_with_petsc_options(parser: argparse.ArgumentParser, argv=None):
@@ -29,3 +109,104 @@ def _is_number(text: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+class PetscOptions:
+    """The PETSc options of one run, checked against the prefixes its solvers read.
+
+    `prefixes` maps each options prefix of the run to what reads it. An option outside
+    them is refused before anything is computed; after the run, an option that no solver
+    read (a misspelt suffix) is reported by `unused()`.
+    """
+
+    def __init__(self, argv: Sequence[str], prefixes: dict[str, str]):
+        self.names = [a[1:] for a in argv if a.startswith("-") and not _is_number(a)]
+        self.prefixes = prefixes
+        stray = [n for n in self.names if not any(n.startswith(p) for p in prefixes)]
+        if stray:
+            raise ValueError(f"PETSc option -{stray[0]} is read by no solver of this run; "
+                             f"its options prefixes are {self.describe()}")
+        from petsc4py import PETSc
+
+        PETSc.Options().insertString(" ".join(argv))
+
+    def describe(self) -> str:
+        """'-prefix_ (what reads it), ...' for messages and --help."""
+        return ", ".join(f"-{p} ({what})" for p, what in self.prefixes.items())
+
+    def unused(self) -> list[str]:
+        """The options no solver read, removed from PETSc's database."""
+        from petsc4py import PETSc
+
+        opts = PETSc.Options()
+        left = [n for n in self.names if not opts.used(n)]
+        for n in self.names:
+            opts.delValue(n)
+        return left
+
+
+def say(*args) -> None:
+    """print on rank 0 only."""
+    if MPI.COMM_WORLD.rank == 0:
+        print(*args, flush=True)
+
+
+def error(message: str) -> None:
+    """One line on stderr, rank 0 only."""
+    if MPI.COMM_WORLD.rank == 0:
+        print(f"error: {message}", file=sys.stderr, flush=True)
+
+
+def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
+              petsc_argv: Sequence[str] = (), prefixes: dict[str, str] | None = None,
+              json_path: str | None = None) -> int:
+    """Run a scene: `solve()` returns (quantities for the JSON, output writers).
+
+    Errors of the library end the run with one line and exit status 2. The JSON is written
+    first (with `wall_time_s` and `warnings`), then each writer runs on its own: a failing
+    writer is reported (exit status 1) without losing the others. PETSc options that no
+    solver read end the run with exit status 2.
+    """
+    from petsc4py import PETSc
+
+    t0 = time.perf_counter()
+    try:
+        options = PetscOptions(petsc_argv, prefixes or {})
+        out, writers = solve()
+    except (*EXPECTED_ERRORS, PETSc.Error) as err:
+        error(_one_line(err))
+        return 2
+    out["wall_time_s"] = time.perf_counter() - t0
+    out.setdefault("warnings", [])
+    for w in out["warnings"]:
+        say(f"warning: {w}")
+    status = 0
+    if json_path and MPI.COMM_WORLD.rank == 0:
+        try:
+            text = json.dumps(out, indent=2, allow_nan=False)
+        except ValueError:  # a NaN among the results: a defect, never a silent answer
+            error(f"a result is not a finite number; {json_path} not written")
+            return 2
+        Path(json_path).write_text(text)
+    for write in writers:
+        try:
+            write()
+        except Exception as err:  # an output must never take the others down
+            error(f"writing an output failed: {_one_line(err)}")
+            if MPI.COMM_WORLD.rank == 0 and "FENICS_NL_DEBUG" in os.environ:
+                traceback.print_exc()
+            status = 1
+    left = options.unused()
+    if left:
+        error(f"PETSc option -{left[0]} was read by no solver (misspelt?); this run's options "
+              f"prefixes are {options.describe()}")
+        return 2
+    say(f"wall time {out['wall_time_s']:.2f} s on {MPI.COMM_WORLD.size} rank(s)")
+    return status
+
+
+def _one_line(err: BaseException) -> str:
+    text = " ".join(str(err).split())
+    if type(err).__name__ == "Error" and "petsc4py" in type(err).__module__:
+        return f"PETSc rejected an option or failed: {text}"
+    return text or type(err).__name__

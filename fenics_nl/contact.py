@@ -129,7 +129,7 @@ class ActiveSetContact:
         self._reaction = petsc.create_vector(V)
         self._vertex_of_dof = _vertex_of_dof(self.Vn)
         self.active = self._initial_set(initial)
-        opts = {"method": "full", "rtol": 1e-10, "atol": 1e-12, "max_it": 50}
+        opts = {"method": "full", "rtol": 1e-10, "max_it": 50}
         if formulation == "elimination":
             opts["reuse_factorization"] = True
         opts.update(newton_options or {})
@@ -169,6 +169,18 @@ class ActiveSetContact:
     def _owned(self) -> np.ndarray:
         """Mask of the S_C nodes this rank owns (counts and sums use only these)."""
         return self.dofs_n < self.Vn.dofmap.index_map.size_local
+
+    owned = property(_owned, doc="Mask of the S_C nodes this rank owns.")
+
+    def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
+        """A function on the normal component's space: `values` at the S_C nodes, 0 elsewhere.
+
+        For writing out the contact pressure or the active set.
+        """
+        f = fem.Function(self.Vn, name=name)
+        f.x.array[self.dofs_n] = values
+        f.x.scatter_forward()
+        return f
 
     # -- contact quantities ------------------------------------------------------------
 
@@ -247,8 +259,10 @@ class ActiveSetContact:
             res.residual_norms = nr.residual_norms
             T_n, d = self.normal_forces(), self.normal_gap()
             scale_T = self.comm.allreduce(float(np.max(np.abs(T_n), initial=0.0)), op=MPI.MAX)
-            scale_u = self.comm.allreduce(
-                float(np.max(np.abs(self.gamma), initial=0.0)), op=MPI.MAX) or 1.0
+            # the problem's own displacement scale: the obstacle's gap, or the motion itself
+            scale_u = self.comm.allreduce(max(float(np.max(np.abs(self.gamma), initial=0.0)),
+                                              float(np.max(np.abs(self.u.x.array), initial=0.0))),
+                                          op=MPI.MAX)
             leave = self.active & (T_n > 1e-10 * scale_T)
             join = ~self.active & (d > 1e-10 * scale_u)
             new = self._sync((self.active & ~leave) | join)

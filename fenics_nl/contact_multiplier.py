@@ -26,14 +26,15 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.newton import ConvergenceError, NewtonResult
-from fenics_nl.snes import EVENTS, EventCounter, petsc_work
+from fenics_nl.snes import EVENTS, EventCounter, petsc_work, scale_absolute_tolerance
 
 
 class MultiplierSystem:
     """Block (u, λ) Newton solve for a given active set; used by ActiveSetContact."""
 
     def __init__(self, residual, u, bcs, contact, *, prefix="contact_", method="full",
-                 rtol=1e-10, atol=1e-12, max_it=50, line_search=False, stiffness_scale=1.0):
+                 rtol=1e-10, atol=1e-10, force_scale=None, max_it=50, line_search=False,
+                 stiffness_scale=1.0):
         if method != "full":
             raise ValueError("the multiplier formulation runs full Newton (SNES) only")
         self.u, self.contact = u, contact
@@ -69,12 +70,13 @@ class MultiplierSystem:
         self.weights.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         opts = {"snes_type": "newtonls", "snes_rtol": rtol,
                 "snes_linesearch_type": "bt" if line_search else "basic",
-                "snes_atol": atol, "snes_stol": 0.0, "snes_max_it": max_it,
+                "snes_stol": 0.0, "snes_max_it": max_it,
                 "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
         self.problem = petsc.NonlinearProblem(
             [F_u, F_l], [u, self.lam], bcs=list(bcs), kind="mpi", entity_maps=[emap],
             petsc_options_prefix=prefix, petsc_options=opts)
         self.problem.solver.setConvergenceHistory(reset=True)
+        scale_absolute_tolerance(self.problem.solver, atol, force_scale)
         names = [n for v in EVENTS.values() for n in ((v,) if isinstance(v, str) else v)]
         self.counter = EventCounter(names)
         self.update_gap()

@@ -18,7 +18,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_nl.newton import NewtonSolver
-from fenics_nl.snes import EVENTS, EventCounter, petsc_work
+from fenics_nl.snes import EVENTS, EventCounter, petsc_work, scale_absolute_tolerance
 
 
 def _surface_measure(punch):
@@ -35,8 +35,8 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     u.x.array[:] = 0.0
     c = punch.contact
     c.set_gap(punch._gap(delta))
-    opts = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_atol": 1e-12,
-            "snes_stol": 0.0, "snes_max_it": 100, "ksp_type": "preonly", "pc_type": "lu",
+    opts = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_stol": 0.0,
+            "snes_max_it": 100, "ksp_type": "preonly", "pc_type": "lu",
             "pc_factor_mat_solver_type": "mumps"}
     problem = petsc.NonlinearProblem(punch.residual, u, bcs=punch.bcs,
                                      petsc_options_prefix=prefix, petsc_options=opts)
@@ -46,6 +46,7 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     with upper.localForm() as up:  # u_axis ≤ sign·γ, i.e. u_n ≤ γ (sign = +1 here)
         up.array[c.dofs_V] = c.sign * c.gamma
     problem.solver.setVariableBounds(lower, upper)
+    scale_absolute_tolerance(problem.solver, 1e-12)
     counter = EventCounter([n for v in EVENTS.values() for n in ((v,) if isinstance(v, str)
                                                                   else v)])
     t0 = time.perf_counter()
@@ -76,7 +77,7 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
     w = punch.weight
     R = punch.residual + k * pen * c.sign * v[c.axis] * w * ds
     solver = NewtonSolver(R, u, punch.bcs, method="full", line_search=True, prefix=prefix,
-                          rtol=1e-10, atol=1e-14, max_it=100)
+                          rtol=1e-10, atol=1e-12, max_it=100)
     t0 = time.perf_counter()
     res = solver.solve()
     wall = time.perf_counter() - t0

@@ -87,6 +87,17 @@ class SmallStrain:
         eps_v = kinematics.small_strain(v, model)
         return ufl.inner(self.stress(eps_u), eps_v) * kinematics.measure_weight(mesh, model)
 
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u`, one value per cell (DG0 Function)."""
+        from dolfinx import fem
+
+        s = ufl.dev(self.stress(kinematics.small_strain(u, model)))
+        Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
+        f = fem.Function(Q, name="von_mises")
+        f.interpolate(fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)),
+                                     Q.element.interpolation_points))
+        return f
+
 
 class FiniteStrain:
     """Mixin: second and first Piola stresses and virtual work derived from `energy(e)`."""

@@ -1,7 +1,10 @@
 """The Newton family on PETSc KSP: full, modified, periodic and BFGS, in one loop.
 
 Solves {R(U)} = {0} for a UFL residual with Dirichlet conditions, as in the course:
-    K δU = −R,   U ← U + δU,   until ‖R‖ ≤ max(atol, rtol ‖R₀‖).
+    K δU = −R,   U ← U + δU,   until ‖R‖ ≤ max(rtol ‖R₀‖, atol F).
+Both tolerances are relative: F is a force of the problem (the load; by default the
+largest first residual the solver has seen, the first load increment's imbalance), so the
+same problem gives the same iterations in any units.
 The variants differ only by *when the tangent K is rebuilt*:
 
 * ``full``: every iteration (quadratic convergence);
@@ -119,7 +122,7 @@ def _round_off_hint(norms: list[float]) -> str:
     """The error's hint when the residual stalled at round-off."""
     if stalled_at_round_off(norms):
         return (f"; |R| stalls at {min(norms[-5:]):.1e}, the round-off of the internal "
-                "forces: set atol above it (e.g. 1e-10 times the load)")
+                "forces: raise atol (relative to the force scale) above it")
     return ""
 
 
@@ -137,15 +140,18 @@ class _Timer:
 class NewtonSolver:
     """Hand-written Newton loop for R(u; v) = 0; `solve()` updates `u` in place.
 
-    Converged when ‖R‖ ≤ max(atol, rtol ‖R₀‖), R₀ the residual at the start of the solve.
+    Converged when ‖R‖ ≤ max(rtol ‖R₀‖, atol F), R₀ the residual at the start of the solve
+    and F = `force_scale`, a force of the problem (the load), or by default the largest R₀
+    this solver has seen (the imbalance of its first load increment). ‖R‖ cannot fall
+    below the round-off of the internal forces (~1e-16 of them, times the number of
+    contributions), and a small increment, or an active-set iteration that restarts close
+    to equilibrium, makes rtol ‖R₀‖ smaller still: atol F is the floor, in the problem's
+    own units, so that the same problem converges the same way in N–mm–MPa or N–m–Pa.
 
     `reuse_factorization`: a new tangent (or new Dirichlet rows, as in contact) is not
     refactorized; CG on it is preconditioned by the last factorization, which is renewed
     only when CG needed more than REUSE_ITERATIONS iterations. Where the tangent changes by
     a low-rank term (a few constrained rows), CG converges in a handful of iterations.
-    `atol` is in the residual's force units: set it from the problem's load scale (e.g.
-    1e-10 ‖F_ext‖), since ‖R‖ cannot fall below the round-off of the internal forces and a
-    small load increment makes rtol ‖R₀‖ small too.
     """
 
     REUSE_ITERATIONS = 10
@@ -163,7 +169,8 @@ class NewtonSolver:
         linear_solver: str = "lu",
         prefix: str = "newton_",
         rtol: float = 1e-10,
-        atol: float = 1e-12,
+        atol: float = 1e-10,
+        force_scale: float | None = None,
         max_it: int = 50,
         divergence_tol: float = 1e8,
         line_search: bool = False,
@@ -177,7 +184,11 @@ class NewtonSolver:
                              f"got {constant_tangent!r}")
         if period < 1:
             raise ValueError(f"period must be >= 1, got {period}")
+        if force_scale is not None and not (force_scale > 0 and math.isfinite(force_scale)):
+            raise ValueError(f"force_scale must be a finite force > 0, got {force_scale!r}")
         self.u, self.bcs, self.method = u, list(bcs), method
+        self.force_scale = force_scale
+        self._largest_r0 = 0.0  # the default force scale
         self.rtol, self.atol, self.max_it = rtol, atol, max_it
         self.divergence_tol, self.line_search = divergence_tol, line_search
         self.period, self.bfgs_memory = period, bfgs_memory
@@ -269,7 +280,7 @@ class NewtonSolver:
             if not math.isfinite(rnorm):
                 raise ConvergenceError(f"residual is not finite at iteration {k}",
                                        result(False, "nan"))
-            if rnorm <= max(self.atol, self.rtol * norms[0]):
+            if rnorm <= self._threshold(norms[0]):
                 return result(True, "converged")
             if k >= self.max_it:
                 raise ConvergenceError(f"no convergence in {self.max_it} iterations "
@@ -296,6 +307,11 @@ class NewtonSolver:
             k += 1
 
     # -- pieces ----------------------------------------------------------------------
+
+    def _threshold(self, r0: float) -> float:
+        """max(rtol ‖R₀‖, atol F): both relative to forces of the problem itself."""
+        self._largest_r0 = max(self._largest_r0, r0)
+        return max(self.rtol * r0, self.atol * (self.force_scale or self._largest_r0))
 
     def _needs_tangent(self, k: int) -> bool:
         if self._tangent_fixed and self._tangent_ready:

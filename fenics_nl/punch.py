@@ -82,6 +82,10 @@ class Punch:
         def facets(name):
             return data.facet_tags.find(data.physical_groups[name].tag)
 
+        # the constrained groups, whose reactions are reported (the side is free)
+        names = ["contact", "bottom", "symmetry_x"] + (["symmetry_y"] if dim == 3 else [])
+        self.groups = {name: facets(name) for name in names}
+
         bcs = [boundary.component(V, 0, facets("symmetry_x")),
                boundary.component(V, self.vertical, facets("bottom"))]
         if dim == 3:
@@ -89,7 +93,14 @@ class Punch:
         self.bcs, self.contact_facets = bcs, facets("contact")
         # force of the whole body from the modelled part (2πr is in the weight)
         self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
-        opts = {"line_search": not getattr(material, "is_linear", False)}
+        # the force scale of Newton's absolute tolerance: Hertz's force for the expected a
+        # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length)
+        E_star = hertz.effective_modulus(material.E, material.nu)
+        force = (np.pi / 4 if model == "plane-strain" else 4 / 3) * E_star * a**3 / radius
+        if model == "plane-strain":
+            force /= a
+        opts = {"line_search": not getattr(material, "is_linear", False),
+                "force_scale": force / self.symmetry_factor}
         opts.update(newton_options or {})
         self.contact = ActiveSetContact(
             residual, self.u, bcs, facets("contact"), self._gap(0.0), normal_axis=self.vertical,
@@ -105,16 +116,16 @@ class Punch:
     def _radius(self, x):
         return np.sqrt(x[0] ** 2 + x[1] ** 2) if self.model == "3d" else np.abs(x[0])
 
-    def _gap(self, delta: float):
+    def gap_at(self, r, delta: float):
+        """γ(r) = the punch's height above the undeformed surface at distance r, minus δ."""
         R = self.R
+        r = np.asarray(r, dtype=float)
+        if self.gap_shape == "parabola":
+            return r**2 / (2 * R) - delta
+        return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
 
-        def gap(x):
-            r = self._radius(x)
-            if self.gap_shape == "parabola":
-                return r**2 / (2 * R) - delta
-            return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
-
-        return gap
+    def _gap(self, delta: float):
+        return lambda x: self.gap_at(self._radius(x), delta)
 
     def indent(self, delta: float) -> Indentation:
         """Press the punch down by δ (from the last state's active set)."""
@@ -153,6 +164,43 @@ class Punch:
             d0, s0 = d1, s1
             d1 = d1 * (force / s1.force) ** (1 / slope)
         raise RuntimeError(f"force {force:g} not reached in {max_it} indentations")
+
+    def surface_profile(self):
+        """(r, p, active) of every S_C node, gathered on rank 0 and sorted by r (else None).
+
+        p is the nodal contact pressure (positive in compression), r the distance from the
+        axis (the half-width coordinate in plane strain).
+        """
+        c = self.contact
+        owned = c.owned
+        local = (self._radius(c.x[owned].T), c.pressure(self.weight)[owned], c.active[owned])
+        parts = self.mesh.comm.gather(local, root=0)
+        if self.mesh.comm.rank != 0:
+            return None
+        r, p, active = (np.concatenate([x[i] for x in parts]) for i in range(3))
+        order = np.argsort(r)
+        return r[order], p[order], active[order]
+
+    def nodes_in_contact(self) -> int:
+        """Global number of active S_C nodes."""
+        c = self.contact
+        return self.mesh.comm.allreduce(int(np.sum(c.active & c.owned)))
+
+    def von_mises(self) -> fem.Function:
+        """σ_eq per cell (DG0), with the hoop strain in the axisymmetric model."""
+        return self.material.von_mises(self.u, self.kinematics)
+
+    def contact_fields(self) -> list[fem.Function]:
+        """Nodal contact pressure and active set (1/0) on S_C, to write out."""
+        c = self.contact
+        return [c.nodal_field(c.pressure(self.weight), "contact_pressure"),
+                c.nodal_field(c.active.astype(float), "active_set")]
+
+    def reactions(self) -> dict[str, list[float]]:
+        """Resultant force on each constrained group of the modelled part (`boundary`); a
+        node shared by two groups (a corner) counts in both.
+        """
+        return boundary.reactions(self.residual, self.u, self.groups)
 
     def hertz(self, state: Indentation) -> dict[str, float]:
         """Hertz's values for this state (sphere: from δ; cylinder: from the computed P)."""

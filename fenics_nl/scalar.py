@@ -18,10 +18,16 @@ from dataclasses import dataclass, field
 from fenics_nl.convergence import observed_orders
 
 METHODS = ("newton", "modified", "secant")
+DIVERGED = 1e8  # |r(u_k)| / |r(u_0)| beyond which the iteration is declared divergent
 
 
 class ScalarSolveError(ArithmeticError):
-    """The iteration failed: zero slope, a non-finite value or no convergence."""
+    """The iteration failed: zero slope, a non-finite value or no convergence.
+
+    `result` holds the iterates up to the failure (what a divergence looks like).
+    """
+
+    result: ScalarResult | None = None
 
 
 @dataclass
@@ -73,12 +79,24 @@ def solve(r: Callable[[float], float], u0: float, method: str = "newton",
         k = dr(u0) if k is None else k
     r = _guarded(r, method)
     us, rs = [u0], [r(u0)]
+    try:
+        return _iterate(r, dr, method, k, us, rs, tol, maxit)
+    except ScalarSolveError as err:
+        err.result = ScalarResult(us, rs, False)
+        raise
+
+
+def _iterate(r, dr, method, k, us, rs, tol, maxit) -> ScalarResult:
+    """The loop of `solve`, appending to `us` and `rs` in place."""
     for _ in range(maxit):
         u, ru = us[-1], rs[-1]
         if not (math.isfinite(float(u)) and math.isfinite(float(ru))):
             raise ScalarSolveError(f"{method}: non-finite value at u = {u!r}, r = {ru!r}")
         if abs(ru) <= tol:
             return ScalarResult(us, rs, True, _orders(us, r, dr))
+        if abs(ru) > DIVERGED * abs(rs[0]):
+            raise ScalarSolveError(f"{method}: diverges (|r| grew from {float(abs(rs[0])):.3g} "
+                                   f"to {float(abs(ru)):.3g} in {len(us) - 1} iterations)")
         if method == "newton" or (method == "secant" and len(us) == 1):
             slope = dr(u)
         elif method == "modified":

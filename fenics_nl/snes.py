@@ -71,17 +71,37 @@ def _all_event_names():
     return out
 
 
+def scale_absolute_tolerance(snes: PETSc.SNES, atol: float, force_scale: float | None = None
+                             ) -> None:
+    """SNES's absolute tolerance as NewtonSolver's: atol × a force of the problem.
+
+    The force is `force_scale`, or the largest first residual ‖F₀‖ of this SNES's solves.
+    Set by a monitor at iteration 0, which PETSc calls before the convergence test. The
+    monitor holds no reference to a Python solver object (see SnesSolver).
+    """
+    largest = [0.0]
+
+    def monitor(snes, it, norm):
+        if it == 0:
+            largest[0] = max(largest[0], norm)
+            snes.setTolerances(atol=atol * (force_scale or largest[0]))
+
+    snes.setMonitor(monitor)
+
+
 class SnesSolver:
     """Newton through SNES `newtonls` with a plain full step (no line search by default).
 
     `method`: ``full`` (lag 1), ``modified`` (Jacobian once per solve) or ``periodic``
-    (lag = `period`). Convergence on ‖F‖ ≤ max(atol, rtol ‖F₀‖) as in `NewtonSolver`.
+    (lag = `period`). Convergence on ‖F‖ ≤ max(rtol ‖F₀‖, atol F) as in `NewtonSolver`
+    (F = `force_scale`, or the largest ‖F₀‖ seen).
     """
 
     def __init__(self, residual: ufl.Form, u: fem.Function, bcs: Sequence[fem.DirichletBC] = (),
                  *, method: str = "full", tangent: ufl.Form | None = None, period: int = 3,
                  linear_solver: str = "lu", prefix: str = "snes_", rtol: float = 1e-10,
-                 atol: float = 1e-12, max_it: int = 50, line_search: str = "basic"):
+                 atol: float = 1e-10, force_scale: float | None = None, max_it: int = 50,
+                 line_search: str = "basic"):
         lags = {"full": 1, "modified": -2, "periodic": period}
         if method not in lags:
             raise ValueError(f"SNES method must be one of {', '.join(lags)}, got {method!r}")
@@ -92,7 +112,6 @@ class SnesSolver:
             "snes_type": "newtonls",
             "snes_linesearch_type": line_search,
             "snes_rtol": rtol,
-            "snes_atol": atol,
             "snes_stol": 0.0,
             "snes_max_it": max_it,
             "snes_lag_jacobian": lags[method],
@@ -108,6 +127,7 @@ class SnesSolver:
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes = self.problem.solver
         self.snes.setConvergenceHistory(reset=True)
+        scale_absolute_tolerance(self.snes, atol, force_scale)
         # time of each residual norm, as NewtonResult.elapsed. The monitor holds the list,
         # not self: a cycle self → snes → monitor → self would leave the PETSc objects to the
         # garbage collector, which destroys them in a different order on each rank (hang).

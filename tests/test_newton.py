@@ -133,7 +133,7 @@ def test_failures_raise_clear_errors_and_load_stepping_recovers():
     assert not err.value.result.converged and err.value.result.reason == "max_it"
     # adaptive steps from the unloaded state reach the same load
     p.u.x.array[:] = 0.0
-    solver.max_it, solver.atol = 6, 1e-10  # ‖R‖'s round-off floor grows with the load
+    solver.max_it = 6
     path = solve_incrementally(solver, lambda t: p.load.value.__setitem__(2, t * 40 * LOAD),
                                steps=1)
     assert path.failures >= 1 and path.factors[-1] == pytest.approx(1.0)

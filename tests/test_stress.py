@@ -60,20 +60,21 @@ def test_hundredfold_increment_reaches_the_answer():
     # full Newton on this convex energy takes it at once (adaptive stepping would cut the
     # step otherwise); the answer is checked against
     # the same load reached in 40 small steps. Residuals stall at ~1e-12 at this load, so
-    # atol is set from the load (1e-10 |F_ext|), as the NewtonSolver docstring asks.
-    atol = 1e-10 * abs(10 * LOAD)
+    # the force scale is the load (atol 1e-10 |F_ext|), not the first small increment's R0.
+    scale = dict(atol=1e-10, force_scale=abs(10 * LOAD))
     p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
-    s = NewtonSolver(p.residual, p.u, p.bcs, prefix="x100_", max_it=30, atol=atol)
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix="x100_", max_it=30, **scale)
     solve_incrementally(s, lambda t: loaded(p, 10 * t), 1)
     q = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
-    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="x100ref_", max_it=30, atol=atol)
+    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="x100ref_", max_it=30, **scale)
     solve_incrementally(sq, lambda t: loaded(q, 10 * t), 40, adaptive=False)
     assert abs(tip(p) - tip(q)) < 1e-8 * abs(tip(q))  # (measured: 6 iterations, no cut)
 
 
 def test_round_off_stall_is_named_in_the_error():
     q = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
-    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="stall_", max_it=30)
+    # atol 1e-14 of the first increment's imbalance: below the round-off at 10x the load
+    sq = NewtonSolver(q.residual, q.u, q.bcs, prefix="stall_", max_it=30, atol=1e-14)
     with pytest.raises(LoadStepError, match=r"stalls at .* round-off of the internal forces"):
         solve_incrementally(sq, lambda t: loaded(q, 10 * t), 40, adaptive=False)
 
@@ -99,7 +100,7 @@ def test_poor_initial_guess(reference, scale):
         p.u.x.array[:] = scale * abs(reference) * rng.standard_normal(p.u.x.array.size)
         s = NewtonSolver(p.residual, p.u, p.bcs, prefix=f"guess{scale}{line_search}_",
                          max_it=60, line_search=line_search, rtol=0.0,
-                         atol=1e-10 * abs(LOAD))
+                         atol=1e-10, force_scale=abs(LOAD))
         if line_search:
             assert s.solve().converged
             assert abs(tip(p) - reference) < 1e-8 * abs(reference)

@@ -1,0 +1,150 @@
+"""What a scene hands to its user: VTX fields for ParaView, whole meshes for pictures.
+
+* `write_fields`: one ADIOS2 VTX file per function (any Lagrange degree, on any mesh
+  degree: P2 on quadrilaterals included), which ParaView opens directly.
+* `gather_grid`: the mesh of a Lagrange space, its nodal and cell fields, collected from
+  every rank on rank 0, so that a picture shows the whole body whatever the number of ranks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+
+def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path]:
+    """`folder`/<name>.bp for each function (collective); returns the paths."""
+    from dolfinx.io import VTXWriter
+
+    folder = Path(folder)
+    comm = functions[0].function_space.mesh.comm
+    if comm.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
+    comm.barrier()
+    paths = []
+    for f in functions:
+        path = folder / f"{f.name}.bp"
+        with VTXWriter(comm, path, [f]) as w:
+            w.write(0.0)
+        paths.append(path)
+    return paths
+
+
+@dataclass
+class Grid:
+    """A whole mesh on rank 0: VTK cells (n, i0, i1, ...), VTK cell types, points, fields."""
+
+    cells: np.ndarray
+    cell_types: np.ndarray
+    points: np.ndarray  # (N, 3)
+    point_data: dict[str, np.ndarray]
+    cell_data: dict[str, np.ndarray]
+
+    def pyvista(self):
+        """The grid as a pyvista UnstructuredGrid."""
+        import pyvista
+
+        grid = pyvista.UnstructuredGrid(self.cells, self.cell_types, self.points)
+        for k, v in self.point_data.items():
+            grid.point_data[k] = v
+        for k, v in self.cell_data.items():
+            grid.cell_data[k] = v
+        return grid
+
+    def corner_cells(self) -> np.ndarray:
+        """(n_cells, k) node indices of each cell's vertices (the first k VTK nodes)."""
+        n = self.cells[0]
+        table = self.cells.reshape(-1, n + 1)[:, 1:]
+        corners = {6: 3, 9: 4, 10: 4, 3: 3, 4: 4}.get(n, n)  # P2/Q2 nodes list corners first
+        return table[:, :corners]
+
+
+def gather_grid(V: fem.FunctionSpace, point_data: dict[str, fem.Function] | None = None,
+                cell_data: dict[str, np.ndarray] | None = None) -> Grid | None:
+    """The mesh of the Lagrange space V with fields, gathered on rank 0 (None elsewhere).
+
+    `point_data`: functions on V (any block size); `cell_data`: arrays over this rank's
+    owned cells. Nodes on partition boundaries appear once per rank that holds them, which
+    a picture does not mind.
+    """
+    from dolfinx import plot
+
+    comm = V.mesh.comm
+    topology, types, x = plot.vtk_mesh(V)
+    n_cells = len(types)
+    cells = topology.reshape(n_cells, -1) if n_cells else np.zeros((0, 1), dtype=np.int32)
+    bs = V.dofmap.index_map_bs
+    points = {k: f.x.array.reshape(-1, bs) if bs > 1 else f.x.array.copy()
+              for k, f in (point_data or {}).items()}
+    local = (cells, types, x, points, {k: np.asarray(v)[:n_cells]
+                                       for k, v in (cell_data or {}).items()})
+    parts = comm.gather(local, root=0)
+    if comm.rank != 0:
+        return None
+    offset, all_cells = 0, []
+    for c, _, xx, _, _ in parts:
+        c = c.copy()
+        c[:, 1:] += offset
+        all_cells.append(c)
+        offset += len(xx)
+    return Grid(np.concatenate(all_cells).ravel(), np.concatenate([p[1] for p in parts]),
+                np.concatenate([p[2] for p in parts]),
+                {k: np.concatenate([p[3][k] for p in parts]) for k in parts[0][3]},
+                {k: np.concatenate([p[4][k] for p in parts]) for k in parts[0][4]})
+
+
+def owned_cell_values(f: fem.Function) -> np.ndarray:
+    """A DG0 function's values on this rank's owned cells, in cell order."""
+    tdim = f.function_space.mesh.topology.dim
+    n = f.function_space.mesh.topology.index_map(tdim).size_local
+    return f.x.array[f.function_space.dofmap.list[:n, 0]]
+
+
+def global_max(comm: MPI.Comm, values: np.ndarray) -> float:
+    """max over every rank (0 for empty arrays)."""
+    return comm.allreduce(float(np.max(values, initial=0.0)), op=MPI.MAX)
+
+
+def section(u: fem.Function, cell_field: fem.Function, normal_axis: int | None = None):
+    """A plane picture of the body on rank 0 (None elsewhere), for matplotlib.
+
+    2D meshes as they are; 3D meshes cut by the plane x_{normal_axis} = 0⁺ (just inside a
+    symmetry plane). Returns (x, z, u_x, u_z, triangles, values): in-plane coordinates and
+    displacement of the nodes, triangles, and `cell_field` (DG0) on each triangle. `u`
+    is drawn through its vertex values (P1).
+    """
+    V = u.function_space
+    msh = V.mesh
+    if V.element.basix_element.degree != 1:
+        V1 = fem.functionspace(msh, ("Lagrange", 1, (msh.geometry.dim,)))
+        u1 = fem.Function(V1)
+        u1.interpolate(u)
+        u, V = u1, V1
+    grid = gather_grid(V, {"u": u}, {"f": owned_cell_values(cell_field)})
+    if grid is None:
+        return None
+    dim = msh.geometry.dim
+    if dim == 2:
+        cells = grid.corner_cells()
+        values = grid.cell_data["f"]
+        if cells.shape[1] == 4:  # quadrilaterals (VTK order): two triangles each
+            cells = np.vstack([cells[:, [0, 1, 2]], cells[:, [0, 2, 3]]])
+            values = np.concatenate([values, values])
+        pts, disp = grid.points, grid.point_data["u"]
+        return pts[:, 0], pts[:, 1], disp[:, 0], disp[:, 1], cells, values
+    vtk = grid.pyvista()
+    extent = np.ptp(grid.points[:, normal_axis])
+    origin = [0.0, 0.0, 0.0]
+    origin[normal_axis] = 1e-7 * extent
+    normal = [0.0, 0.0, 0.0]
+    normal[normal_axis] = 1.0
+    cut = vtk.slice(normal=normal, origin=origin).triangulate()
+    tri = cut.faces.reshape(-1, 4)[:, 1:]
+    inplane = [i for i in range(3) if i != normal_axis]
+    pts, disp = cut.points, cut.point_data["u"]
+    return (pts[:, inplane[0]], pts[:, inplane[1]], disp[:, inplane[0]], disp[:, inplane[1]],
+            tri, cut.cell_data["f"])

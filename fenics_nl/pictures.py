@@ -1,0 +1,120 @@
+"""Scene pictures drawn with pyvista off-screen, from meshes gathered on rank 0."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from dolfinx import fem
+
+from fenics_nl.output import gather_grid, owned_cell_values
+
+
+def off_screen():
+    """pyvista, set for off-screen rendering without the VTK X-server noise."""
+    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
+    import pyvista
+    import vtk
+
+    vtk.vtkObject.GlobalWarningDisplayOff()  # "bad X server connection" is not an error
+    pyvista.OFF_SCREEN = True
+    return pyvista
+
+
+def gather_points(x: np.ndarray, values: np.ndarray, comm):
+    """Rows of `x` and `values` from every rank, on rank 0 (None elsewhere)."""
+    parts = comm.gather((x, values), root=0)
+    if comm.rank != 0:
+        return None
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def facet_points(msh, facets: np.ndarray) -> np.ndarray:
+    """Coordinates of the vertices of this rank's `facets`."""
+    from dolfinx import mesh as dmesh
+
+    fdim = msh.topology.dim - 1
+    msh.topology.create_connectivity(fdim, 0)
+    nodes = dmesh.entities_to_geometry(msh, fdim, facets)
+    return msh.geometry.x[np.unique(nodes.ravel())]
+
+
+def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float) -> None:
+    """The deformed bracket in two views, σ_eq clipped at its 99th percentile (said so).
+
+    The load arrow on the loaded hole, the clamped bolt holes, and with a floor support the
+    floor and a view from below with each base node's contact status. Collective; rank 0
+    writes `path`.
+    """
+    comm = b.mesh.comm
+    V1 = fem.functionspace(b.mesh, ("Lagrange", 1, (3,)))
+    u1 = fem.Function(V1)
+    u1.interpolate(b.u)
+    grid = gather_grid(V1, {"u": u1}, {"vm": owned_cell_values(vm)})
+    bolts = gather_points(facet_points(b.mesh, b.groups["bolts"]), np.zeros(0), comm)
+    load = gather_points(facet_points(b.mesh, b.load_facets), np.zeros(0), comm)
+    status = None
+    if b.support == "contact":
+        c = b.solver
+        status = gather_points(c.x[c.owned], c.active[c.owned], comm)
+    if comm.rank != 0:
+        return
+    pv = off_screen()
+    mesh = grid.pyvista()
+    size = np.ptp(grid.points, axis=0).max()
+    u_max = np.abs(grid.point_data["u"]).max()
+    scale = max(1.0, 0.05 * size / max(u_max, 1e-300))  # the largest motion ≥ 5 % of the part
+    warped = mesh.warp_by_vector("u", factor=scale)
+    vm_cells = grid.cell_data["vm"]
+    top = float(np.percentile(vm_cells, 99))
+    views = [((1.0, -1.6, 0.9), "view from the front"), ((0.0, -1.0, 0.0), "side view (along y)")]
+    if status is not None:
+        views.append(((0.0, 0.0, -1.0),
+                      "from below: base nodes in contact (blue), lifted off (orange)"))
+    pl = pv.Plotter(off_screen=True, shape=(1, len(views)),
+                    window_size=(800 * len(views), 750), border=False)
+    for i, (direction, label) in enumerate(views):
+        pl.subplot(0, i)
+        if i == 2:
+            _contact_status_view(pl, pv, warped, status, size)
+        else:
+            pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.08)
+            pl.add_mesh(warped, scalars="vm", cmap="turbo", clim=(0, top), show_edges=False,
+                        show_scalar_bar=i == 1, scalar_bar_args={
+                            "title": f"von Mises stress [N/{units}²]\n(colours clipped at the "
+                                     f"99th percentile; max {vm_cells.max():.4g})",
+                            "vertical": False, "position_x": 0.15, "position_y": 0.04,
+                            "width": 0.7, "height": 0.08, "title_font_size": 14,
+                            "label_font_size": 12, "fmt": "%.0f"})
+            centre = load[0].mean(axis=0)
+            pl.add_arrows(centre[None, :] - [0.25 * size, 0, 0], np.array([[1.0, 0, 0]]),
+                          mag=0.25 * size, color="red")
+            pl.add_point_labels([centre - [0.25 * size, 0, -0.04 * size]],
+                                [f"F = {force / 1e3:.3g} kN"], font_size=14, text_color="red",
+                                shape=None, show_points=False)
+            pl.add_points(bolts[0], color="black", point_size=6, render_points_as_spheres=True)
+            if status is not None:
+                lo, hi = grid.points.min(axis=0), grid.points.max(axis=0)
+                pl.add_mesh(pv.Plane(center=((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.0),
+                                     i_size=1.3 * (hi[0] - lo[0]), j_size=1.3 * (hi[1] - lo[1])),
+                            color="tan", opacity=0.5)
+        pl.view_vector(direction)
+        pl.add_text(label, font_size=10, position="upper_left")
+    pl.subplot(0, 0)
+    legend = (f"deformed x{scale:.3g} (grey: undeformed); black: clamped bolt holes"
+              + ("; floor: base nodes in contact blue, lifted off orange"
+                 if status is not None else ""))
+    pl.add_text(f"bracket, {b.support} support, F = {force / 1e3:.3g} kN\n{legend}",
+                font_size=10, position="lower_left")
+    pl.screenshot(path)
+    pl.close()
+
+
+def _contact_status_view(pl, pv, warped, status, size) -> None:
+    """The base seen from below, each floor-contact node marked in contact or lifted off."""
+    x, active = status
+    pl.add_mesh(warped, color="lightgray")
+    for on, colour in ((True, "blue"), (False, "orange")):
+        if np.any(active == on):
+            pl.add_points(x[active == on] - [0, 0, 0.01 * size], color=colour, point_size=8,
+                          render_points_as_spheres=True)
