@@ -27,12 +27,8 @@
 # ## Implementation
 
 # +
-import argparse
-import json
 import math
 import sys
-import time
-from pathlib import Path
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -41,52 +37,48 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl import elastica
+from fenics_nl import cli, elastica, output
 from fenics_nl.beam import Beam
-from fenics_nl.cli import parse_with_petsc_options
-from fenics_nl.loading import LoadStepError
-from fenics_nl.newton import ConvergenceError
+from fenics_nl.cli import say
 
 comm = MPI.COMM_WORLD
-
-
-def say(*args):
-    if comm.rank == 0:
-        print(*args, flush=True)
 # -
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(
-        description="Buckling of a compressed cantilever: SLEPc critical load and the "
-                    "post-buckling path against the elastica.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
-        epilog="PETSc options (-ksp_view, -buckling_eps_view, ...) are passed through.")
-    p.add_argument("--length", type=float, default=1.0, help="beam length L [m]")
-    p.add_argument("--thickness", type=float, default=0.02, help="beam height h [m]")
-    p.add_argument("--E", type=float, default=1e3, help="Young's modulus [Pa]")
-    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio [-]")
+    p = cli.parser(
+        "Buckling of a compressed cantilever: SLEPc critical load and the post-buckling path "
+        "against the elastica. Units are the user's, consistent (e.g. N, m, Pa).",
+        epilog="PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
+               "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
+               "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
+               "the pre-stress). An option no solver reads is an error.")
+    p.add_argument("--length", type=cli.positive, default=1.0, help="beam length L [length]")
+    p.add_argument("--thickness", type=cli.positive, default=0.02,
+                   help="beam height h [length]")
+    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
     p.add_argument("--plane", choices=["stress", "strain"], default="stress",
                    help="plane stress or plane strain (unit width)")
     p.add_argument("--material", choices=["svk", "neo-hookean"], default="svk",
                    help="St Venant-Kirchhoff or compressible neo-Hookean (plane strain)")
-    p.add_argument("--load-ratio", type=float, default=1.5, help="final load P / P_cr (Euler)")
-    p.add_argument("--steps", type=int, default=40,
+    p.add_argument("--load-ratio", type=cli.positive, default=1.5,
+                   help="final load P / P_cr (Euler), at most 20")
+    p.add_argument("--steps", type=cli.at_least(1), default=40,
                    help="load steps (the largest step; cut in half on failure)")
     p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"], default="full",
                    help="Newton variant of each load step")
-    p.add_argument("--imperfection", type=float, default=1e-4,
-                   help="lateral end load as a fraction of P [-]")
-    p.add_argument("--refine", type=int, default=0,
+    p.add_argument("--imperfection", type=cli.finite, default=1e-4,
+                   help="lateral end load as a fraction of P [-], in [0, 0.1)")
+    p.add_argument("--refine", type=cli.at_least(0), default=0,
                    help="mesh: 2·2^refine Q2 elements through the height, square elements")
     p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
-    p.add_argument("--output", metavar="DIR", help="write the final displacement (XDMF)")
-    p.add_argument("--png", metavar="PATH", help="deformed shapes along the load path")
+    p.add_argument("--output", metavar="DIR", help="write the final displacement (VTX)")
+    p.add_argument("--png", metavar="PATH",
+                   help="deformed shapes along the path, with the elastica's")
     p.add_argument("--plot", metavar="PATH", help="P/P_cr against tip rotation and deflection")
-    args, petsc_args = parse_with_petsc_options(p, argv)
-    if args.steps < 1:
-        p.error(f"--steps must be >= 1, got {args.steps}")
-    if not 0 < args.load_ratio <= 20:
+    args, petsc_args = cli.parse_with_petsc_options(p, argv)
+    if args.load_ratio > 20:
         p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")
     if not 0 <= args.imperfection < 0.1:
         p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
@@ -95,21 +87,22 @@ def parse_args(argv=None):
 
 def main(argv=None) -> int:
     args, petsc_args = parse_args(argv)
-    from petsc4py import PETSc
+    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
+                         prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
 
-    PETSc.Options().insertString(" ".join(petsc_args))
-    t0 = time.perf_counter()
-    try:
-        out = run(args)
-    except (ValueError, ConvergenceError, LoadStepError, RuntimeError) as err:
-        if comm.rank == 0:
-            print(f"error: {err}", file=sys.stderr)
-        return 2
-    out["wall_time_s"] = time.perf_counter() - t0
-    say(f"wall time {out['wall_time_s']:.2f} s on {comm.size} rank(s)")
-    if args.json and comm.rank == 0:
-        Path(args.json).write_text(json.dumps(out, indent=2))
-    return 0
+
+def progress(steps):
+    """Show about ten of the path's step lines, and every cut or branch switch."""
+    every = max(1, steps // 10)
+
+    def show(message):
+        if message.startswith("step "):
+            k = int(message.split()[1].rstrip(":"))
+            if k % every:
+                return
+        say("  " + message)
+
+    return show
 
 
 def run(args):
@@ -144,8 +137,9 @@ def run(args):
         if args.png:
             shapes.append((r, centreline(beam)))
 
+    say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
     path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                     on_step=record, progress=lambda m: say("  " + m))
+                                     on_step=record, progress=progress(args.steps))
     # -
 
     tip = beam.tip()
@@ -167,27 +161,28 @@ def run(args):
         "load_steps": len(path.factors), "step_cuts": path.failures,
         "newton_iterations": sum(r.iterations for r in path.results),
         "factorizations": path.work.factorizations, "branch_switched": switched,
-        "newton": args.newton, "dofs": beam.dofs, "ranks": comm.size,
+        "newton": args.newton, "reactions": beam.reactions(),
+        "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
         "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
                  for h in history],
+        "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
+                     "by O((h/L)²)"],
     }
+    writers = []
     if args.output:
-        from dolfinx.io import XDMFFile
-
-        Path(args.output).mkdir(parents=True, exist_ok=True)
-        with XDMFFile(comm, Path(args.output) / "beam.xdmf", "w") as f:
-            f.write_mesh(beam.mesh)
-            f.write_function(beam.u)
-        say(f"wrote {Path(args.output) / 'beam.xdmf'}")
-    if args.plot and comm.rank == 0:
-        plot(history, args)
+        def fields():
+            paths = output.write_fields(args.output, [beam.u])
+            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
+        writers.append(fields)
+    if args.plot:
+        writers.append(lambda: plot(history, args))
     if args.png:
-        picture(shapes, args)
-    return out
+        writers.append(lambda: picture(shapes, args))
+    return out, writers
 
 
 def centreline(beam):
-    """Deformed centreline points (x + u) of this rank's dofs on y = 0, sorted by x."""
+    """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
     X = beam.V.tabulate_dof_coordinates()
     on = np.isclose(X[:, 1], 0.0)
     u = beam.u.x.array.reshape(-1, 2)[on]
@@ -201,38 +196,6 @@ def centreline(beam):
 
 
 def plot(history, args):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    h = np.array(history)
-    alpha = np.linspace(1e-3, math.radians(min(170, 2 * max(h[:, 1].max(), 10))), 300)
-    ratio = np.array([elastica.load_ratio(a) for a in alpha])
-    k = np.sin(alpha / 2)
-    from scipy.special import ellipk
-
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    a1.plot(np.degrees(alpha), ratio, "-", label="elastica")
-    a1.plot(h[:, 1], h[:, 0], "o", ms=3, label="finite strain FE")
-    a1.set_xlabel("tip rotation α [deg]")
-    a1.set_ylabel("P / P_cr")
-    a2.plot(2 * k / ellipk(k * k) * args.length, ratio, "-", label="elastica")
-    a2.plot(h[:, 2], h[:, 0], "o", ms=3, label="finite strain FE")
-    a2.set_xlabel("lateral tip deflection [m]")
-    for a in (a1, a2):
-        a.axhline(1.0, color="gray", lw=0.5)
-        a.set_ylim(0, max(h[:, 0].max(), 1.1) * 1.05)
-        a.grid(alpha=0.3)
-        a.legend()
-    fig.suptitle(f"cantilever, L/h = {args.length / args.thickness:g}, "
-                 f"imperfection {args.imperfection:g} P")
-    fig.tight_layout()
-    fig.savefig(args.plot, dpi=120)
-    print(f"wrote {args.plot}")
-
-
-def picture(shapes, args):
     if comm.rank != 0:
         return
     import matplotlib
@@ -240,17 +203,70 @@ def picture(shapes, args):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 6))
-    ax.plot([0, args.length], [0, 0], "k--", lw=0.8, label="undeformed")
-    picks = shapes[:: max(1, len(shapes) // 8)] + shapes[-1:]
+    h = np.array(history)
+    top = max(h[:, 0].max(), 1.1) * 1.05
+    alpha_top = math.radians(min(179, 1.15 * max(h[:, 1].max(), 10)))
+    alpha = np.linspace(1e-3, alpha_top, 300)
+    ratio = np.array([elastica.load_ratio(a) for a in alpha])
+    keep = ratio <= top
+    k = np.sin(alpha / 2)
+    from scipy.special import ellipk
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    a1.plot(np.degrees(alpha[keep]), ratio[keep], "-", label="elastica")
+    a1.plot(h[:, 1], h[:, 0], "o", ms=3, label="finite strain FE")
+    a1.set_xlabel("tip rotation α [deg]")
+    a2.plot((2 * k / ellipk(k * k) * args.length)[keep], ratio[keep], "-", label="elastica")
+    a2.plot(h[:, 2], h[:, 0], "o", ms=3, label="finite strain FE")
+    a2.set_xlabel("lateral tip deflection [length]")
+    for a in (a1, a2):
+        a.axhline(1.0, color="gray", lw=0.5)
+        a.set_ylim(0, top)
+        a.set_xlim(left=0)
+        a.set_ylabel("P / P_cr (Euler)")
+        a.grid(alpha=0.3)
+        a.legend()
+    fig.suptitle(f"cantilever, L/h = {args.length / args.thickness:g}, imperfection "
+                 f"{args.imperfection:g} P: P/P_cr = {args.load_ratio:g}, α = {h[-1, 1]:.2f}° "
+                 f"(elastica {math.degrees(elastica.tip_rotation(args.load_ratio)):.2f}°)")
+    fig.tight_layout()
+    fig.savefig(args.plot, dpi=120)
+    print(f"wrote {args.plot}")
+
+
+def picture(shapes, args):
+    """Computed centrelines past P_cr (solid) on the elastica's (dashed), same colours."""
+    if comm.rank != 0:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 6))
+    L = args.length
+    ax.plot([0, L], [0, 0], "k:", lw=0.8, label="undeformed")
+    # below P_cr the beam stays straight: one shape stands for them all
+    buckled = [s for s in shapes if s[0] > 1.0]
+    picks = buckled[:: max(1, len(buckled) // 6)] + shapes[-1:]
+    picks = list({round(r, 6): (r, pts) for r, pts in picks}.values())
     cmap = plt.get_cmap("viridis")
     top = max(s[0] for s in picks)
     for r, pts in picks:
-        ax.plot(pts[:, 0], pts[:, 1], color=cmap(r / top), label=f"P/P_cr = {r:.2f}")
+        colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
+        sign = 1 if pts[-1, 1] >= 0 else -1
+        ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
+        xe, ye = elastica.shape(r)
+        ax.plot(xe * L, sign * ye * L, "--", color="k", lw=0.8)
+    ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
+    ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
+                arrowprops={"arrowstyle": "->"})
     ax.set_aspect("equal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.legend(fontsize=7)
+    ax.set_xlabel("x [length]")
+    ax.set_ylabel("y [length]")
+    ax.set_title(f"buckled cantilever: P/P_cr up to {args.load_ratio:g} (dead load at the "
+                 f"free end)", fontsize=10)
+    ax.legend(fontsize=8, loc="best")
     ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(args.png, dpi=120)

@@ -65,6 +65,7 @@ class Beam:
         end = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], length))
         tags = mesh.meshtags(self.mesh, fdim, end, np.ones(len(end), dtype=np.int32))
         self.bcs = [boundary.fixed(V, clamped)]
+        self.groups = {"clamp": clamped}
         self.ds_end = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
         self.traction = fem.Constant(self.mesh, np.zeros(2))
         v = ufl.TestFunction(V)
@@ -103,14 +104,14 @@ class Beam:
         from dolfinx.fem.petsc import LinearProblem
 
         LinearProblem(a, ufl.dot(t, v) * self.ds_end, u=u0, bcs=self.bcs,
-                      petsc_options_prefix="prestress_",
+                      petsc_options_prefix="beam_prestress_",
                       petsc_options={"ksp_type": "preonly", "pc_type": "lu",
                                      "pc_factor_mat_solver_type": "mumps"}).solve()
         sigma0 = lin.stress(eps(u0, self.model))
         a_G = geometric_stiffness(sigma0, du, v,  # embedded 3x3 ∇ matches a 3x3 σ₀
                                   lambda w: kinematics.displacement_gradient(w, self.model))
         a_G = a_G * self.dx
-        return critical_loads(a, a_G, self.bcs, self.V, n=n)
+        return critical_loads(a, a_G, self.bcs, self.V, n=n, prefix="beam_buckling_")
 
     def solve_path(self, ratio: float, steps: int = 40, method: str = "full", *,
                    grow: bool = False, on_step=None, progress=None) -> tuple[LoadPath, bool]:
@@ -136,7 +137,7 @@ class Beam:
             path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
                                        max_step=1.0 if grow else 1.0 / steps,
                                        on_step=on_step, progress=progress)
-            lam, mode = lowest_tangent_mode(tangent, self.bcs, self.V)
+            lam, mode = lowest_tangent_mode(tangent, self.bcs, self.V, "beam_stability_")
             if lam >= 0:
                 return path, False
             if progress:
@@ -144,7 +145,7 @@ class Beam:
             self.kick_along(mode, elastica.tip_position(ratio)[0] * self.L)
             try:
                 result = solver.solve()
-                if lowest_tangent_mode(tangent, self.bcs, self.V)[0] >= 0:
+                if lowest_tangent_mode(tangent, self.bcs, self.V, "beam_stability_")[0] >= 0:
                     path.results.append(result)
                     path.work.add(result.work)
                     if on_step:
@@ -158,6 +159,10 @@ class Beam:
             if progress:
                 progress(f"branch switching failed: load path again with {steps} steps")
         raise RuntimeError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
+
+    def reactions(self) -> dict[str, list[float]]:
+        """Resultant force of the clamp on the beam (per unit width), see `boundary`."""
+        return boundary.reactions(self.residual, self.u, self.groups)
 
     def kick_along(self, mode: fem.Function, deflection: float) -> None:
         """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`."""

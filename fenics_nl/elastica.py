@@ -36,3 +36,27 @@ def tip_position(ratio: float) -> tuple[float, float]:
     k = math.sin(tip_rotation(ratio) / 2)
     K, Ek = ellipk(k * k), ellipe(k * k)
     return 2 * k / K, 2 * Ek / K - 1
+
+
+def shape(ratio: float, points: int = 200):
+    """Deformed centreline (x/L, y/L) of the elastica at P/P_cr = ratio (straight below 1).
+
+    EI θ'' = −P sin θ with θ(L) = α and θ'(L) = 0, integrated from the free end to the
+    clamp (θ(0) = 0 follows from α = tip_rotation(ratio)); x = ∫cos θ, y = ∫sin θ.
+    """
+    import numpy as np
+    from scipy.integrate import solve_ivp
+
+    s = np.linspace(0.0, 1.0, points)
+    alpha = tip_rotation(ratio)
+    if alpha == 0.0:
+        return s, np.zeros_like(s)
+    lam2 = ratio * math.pi**2 / 4  # λ²L² = P L²/EI
+
+    def rhs(_, y):  # y = (θ, θ', x, y), in s/L, integrated backwards
+        return [y[1], -lam2 * math.sin(y[0]), math.cos(y[0]), math.sin(y[0])]
+
+    sol = solve_ivp(rhs, (1.0, 0.0), [alpha, 0.0, 0.0, 0.0], t_eval=s[::-1], rtol=1e-10,
+                    atol=1e-12)
+    x, y = sol.y[2][::-1], sol.y[3][::-1]
+    return x - x[0], y - y[0]

@@ -197,8 +197,9 @@ class Punch:
                 c.nodal_field(c.active.astype(float), "active_set")]
 
     def reactions(self) -> dict[str, list[float]]:
-        """Resultant force on each constrained group of the modelled part (`boundary`); a
-        node shared by two groups (a corner) counts in both.
+        """Resultant force on each constrained group of the modelled part (`boundary`).
+
+        A node shared by two groups (a corner) counts in both.
         """
         return boundary.reactions(self.residual, self.u, self.groups)
 
