@@ -187,7 +187,11 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
         except ValueError:  # a NaN among the results: a defect, never a silent answer
             error(f"a result is not a finite number; {json_path} not written")
             return 2
-        Path(json_path).write_text(text)
+        try:
+            Path(json_path).write_text(text)
+        except OSError as err:
+            error(f"cannot write {json_path}: {err.strerror}")
+            status = 1
     for write in writers:
         try:
             write()

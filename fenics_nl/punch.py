@@ -204,10 +204,9 @@ class Punch:
         return boundary.reactions(self.residual, self.u, self.groups)
 
     def hertz(self, state: Indentation) -> dict[str, float]:
-        """Hertz's values for this state (sphere: from δ; cylinder: from the computed P)."""
+        """Hertz's values for this state (sphere: from δ; cylinder: a and p0 from the computed
+        P, no force)."""
         E, nu = self.material.E, self.material.nu
-        if self.model == "plane-strain":
-            ref = hertz.cylinder_from_force(E, nu, self.R, state.force)
-            ref["force"] = state.force
-            return ref
+        if self.model == "plane-strain":  # a cylinder: no force-indentation law to check
+            return hertz.cylinder_from_force(E, nu, self.R, state.force)
         return hertz.sphere_from_indentation(E, nu, self.R, state.indentation)

@@ -42,12 +42,36 @@ def test_newton_scalar_plot_in_double_precision(tmp_path):
     (["--digits", "3"], "--digits"),
     (["--function", "nope"], "invalid choice"),
     (["--slope", "0"], "--slope"),
-    (["--function", "hardening"], "modified"),  # modified Newton diverges: one clear line
+    (["--maxit", "0"], "--maxit: must be >= 1"),
+    (["--u0", "nan"], "--u0: must be a finite number"),
 ])
 def test_newton_scalar_bad_input(tmp_path, args, message):
     proc = run([DEMOS / "newton_scalar.py", *args], tmp_path, check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1  # one line, no usage block
+
+
+def test_newton_scalar_divergence_is_a_result(tmp_path):
+    # modified Newton with K = r'(u0) = 1.75 on u + u³ = 3 (r'(u*) = 5.4): the rate
+    # 1 − r'(u*)/K = −2.1 diverges; the table shows it, the others converge as usual
+    out = tmp_path / "h.json"
+    proc = run([DEMOS / "newton_scalar.py", "--function", "hardening", "--json", out,
+                "--plot", tmp_path / "h.png"], tmp_path)
+    d = json.loads(out.read_text())
+    assert not d["modified"]["converged"] and "diverges" in d["modified"]["failure"]
+    assert "diverges" in proc.stdout
+    assert d["newton"]["converged"] and abs(d["newton"]["order"] - 2) < 0.15
+    assert abs(d["secant"]["order"] - (1 + 5**0.5) / 2) < 0.15
+
+
+@pytest.mark.parametrize("demo", ["newton_scalar.py", "punch.py", "buckling_beam.py",
+                                  "bracket.py"])
+def test_help_describes_the_demo_and_states_defaults_once(tmp_path, demo):
+    text = run([DEMOS / demo, "--help"], tmp_path).stdout
+    assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
+    if demo != "newton_scalar.py":
+        assert "prefix" in text  # the PETSc options prefixes are documented
 
 
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
@@ -90,6 +114,61 @@ def test_punch_plane_strain_half_width_and_pressure(tmp_path):
     d = punch(tmp_path, "--model", "plane-strain")
     assert abs(d["contact_radius_rel_error"]) < 0.02
     assert abs(d["max_pressure_rel_error"]) < 0.02
+    # the force is not compared with itself: no Hertz force, and the JSON says why
+    assert "force_rel_error" not in d and "hertz_force" not in d
+    assert any("force is not checked" in w for w in d["warnings"])
+
+
+def test_punch_force_control_at_a_realistic_modulus(tmp_path):
+    # steel-like E with a 100 N load: Newton's absolute floor scales with the load
+    d = punch(tmp_path, "--E", "210e9", "--radius", "0.01", "--force", "100")
+    assert d["force"] == pytest.approx(100, rel=1e-9)
+    assert abs(d["force_rel_error"]) < 0.005
+
+
+def test_punch_reactions_balance_the_contact_force(tmp_path):
+    d = punch(tmp_path, "--nu", "0.25")
+    r = d["reactions"]
+    assert r["contact"][1] == pytest.approx(-d["force"], rel=1e-12)
+    assert r["bottom"][1] == pytest.approx(d["force"], rel=1e-8)  # vertical equilibrium
+    assert d["warnings"] == []
+
+
+def test_punch_petsc_option_reaches_its_solver(tmp_path):
+    proc = run([DEMOS / "punch.py", "--refine", "0", "-punch_axisymmetric_elim_ksp_view"],
+               tmp_path)
+    assert "KSP Object: (punch_axisymmetric_elim_)" in proc.stdout
+
+
+def test_punch_every_output_is_written(tmp_path):
+    out = tmp_path / "o.json"
+    run([DEMOS / "punch.py", "--refine", "0", "--json", out, "--output", tmp_path / "f",
+         "--png", tmp_path / "p.png", "--plot", tmp_path / "c.png"], tmp_path)
+    for name in ("displacement", "contact_pressure", "active_set", "von_mises"):
+        assert (tmp_path / "f" / f"{name}.bp").is_dir()
+    assert (tmp_path / "p.png").stat().st_size > 20_000 and out.exists()
+
+
+def test_a_failing_picture_keeps_the_json(tmp_path):
+    proc = run([DEMOS / "punch.py", "--refine", "0", "--json", "o.json", "--png",
+                "no/such/dir/p.png"], tmp_path, check=False)
+    assert proc.returncode == 1 and "writing an output failed" in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert json.loads((tmp_path / "o.json").read_text())["force"] > 0
+
+
+def test_punch_picture_is_the_same_on_two_ranks(tmp_path):
+    import matplotlib.image as mpimg
+
+    for ranks in (1, 2):
+        cmd = [sys.executable, DEMOS / "punch.py", "--refine", "0", "--png",
+               tmp_path / f"p{ranks}.png"]
+        subprocess.run([MPIEXEC, "-n", str(ranks), *cmd], cwd=tmp_path, check=True,
+                       capture_output=True, timeout=600)
+    one, two = (mpimg.imread(tmp_path / f"p{n}.png") for n in (1, 2))
+    assert one.shape == two.shape
+    # the whole mesh on both: only anti-aliasing at duplicated partition nodes may differ
+    assert np.mean(np.abs(one - two)) < 2e-3
 
 
 def test_punch_3d_quarter_model(tmp_path):
@@ -127,9 +206,16 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["--nu", "0.5"], "nu must be in"), (["--radius", "-1"], "radius must be > 0"),
-    (["--E", "-3"], "E must be in"), (["--steps", "0"], "--steps"),
+    (["--nu", "0.5"], "nu must be in"), (["--radius", "-1"], "--radius: must be > 0"),
+    (["--E", "-3"], "--E: must be > 0"), (["--steps", "0"], "--steps"),
     (["--bogus", "1"], "unrecognized"), (["--force", "-1"], "--force"),
+    (["--indentation", "nan"], "--indentation: must be a finite number"),
+    (["--E", "inf"], "--E: must be a finite number"),
+    (["--refine", "30"], "--refine must be <= 6"),
+    (["-ksp_view"], "-ksp_view is read by no solver of this run; its options prefixes are "
+                    "-punch_axisymmetric_elim_"),
+    (["-punch_axisymmetric_elim_ksp_veiw"], "was read by no solver (misspelt?)"),
+    (["-punch_axisymmetric_elim_pc_type", "nonsense"], "PETSc rejected an option"),
 ])
 def test_punch_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "punch.py", *args], tmp_path, check=False)
@@ -173,6 +259,18 @@ def test_beam_accuracy_holds_for_other_parameters(tmp_path, args):
     assert_on_elastica(beam(tmp_path, *args, "--load-ratio", "1.2"))
 
 
+def test_beam_every_output_and_the_clamp_reaction(tmp_path):
+    # --output used to crash at the end (XDMF cannot hold P2 on quadrilaterals), losing
+    # the other outputs of the run
+    d = beam(tmp_path, "--load-ratio", "1.2", "--output", "f", "--png", "b.png",
+             "--plot", "c.png")
+    assert (tmp_path / "f" / "displacement.bp").is_dir()
+    assert (tmp_path / "b.png").exists() and (tmp_path / "c.png").exists()
+    P = 1.2 * d["euler_critical_load"]
+    rx, ry = d["reactions"]["clamp"]
+    assert rx == pytest.approx(P, rel=1e-7) and ry == pytest.approx(-1e-4 * P, rel=1e-4)
+
+
 def test_beam_below_euler_stays_straight(tmp_path):
     # Only the imperfection bends it: linear theory gives α ≈ ε r π²/8 / (1 − r) rad.
     d = beam(tmp_path, "--load-ratio", "0.9")
@@ -201,6 +299,7 @@ def test_beam_two_ranks_match_serial(tmp_path):
     (["--thickness", "0.5"], "slender"), (["--nu", "0.5"], "nu must be in"),
     (["--load-ratio", "-1"], "--load-ratio"), (["--steps", "0"], "--steps"),
     (["--material", "neo-hookean"], "plane strain only"), (["--oops"], "unrecognized"),
+    (["--E", "nan"], "--E: must be a finite number"), (["-ksp_view"], "-beam_"),
 ])
 def test_beam_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "buckling_beam.py", *args], tmp_path, check=False)
@@ -238,6 +337,17 @@ def test_bracket_contact_support_lifts_off(tmp_path):
     assert 0 < c["lifted_off_area"] < base_area
     # the floor only adds support: the arm moves less than with the bolts alone
     assert c["load_point_displacement"] < k["load_point_displacement"]
+
+
+def test_bracket_outputs_and_bolt_reaction(tmp_path):
+    d = bracket(tmp_path, "--size", "20", "--steps", "1", "--output", "f", "--png", "b.png",
+                "--plot", "c.png")
+    assert (tmp_path / "f" / "displacement.bp").is_dir()
+    assert (tmp_path / "f" / "von_mises.bp").is_dir()
+    assert (tmp_path / "b.png").stat().st_size > 50_000 and (tmp_path / "c.png").exists()
+    fx, fy, fz = d["reactions"]["bolts"]  # the bolts hold the whole 8 kN along -x
+    assert fx == pytest.approx(-8e3, rel=1e-8) and max(abs(fy), abs(fz)) < 1e-8 * 8e3
+    assert any("coarser than the default" in w for w in d["warnings"])
 
 
 def test_bracket_iterative_solver_matches_direct(tmp_path):
@@ -288,7 +398,11 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
                           (["--mesh", "folded.msh"], "inverted (folded over a neighbour)"),
                           (["--support", "contact", "--newton", "snes"], "clamped only"),
                           (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size"),
-                          (["--tolerance", "0"], "tolerance must be in")]:
+                          (["--tolerance", "0"], "tolerance must be in"),
+                          (["--size", "1e6"], "more than twice the plate thickness"),
+                          (["--mesh", "box.msh", "--size", "3"], "contradict"),
+                          (["--compare", "--png", "x.png"], "--compare"),
+                          (["--force", "nan"], "--force: must be a finite number")]:
         proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)

@@ -1,5 +1,6 @@
 import math
 
+import numpy as np
 import pytest
 
 from fenics_nl import elastica
@@ -23,3 +24,14 @@ def test_small_rotation_asymptote_and_straight_branch():
     assert elastica.load_ratio(a) == pytest.approx(1 + a * a / 8, rel=1e-8)
     assert elastica.tip_rotation(0.9) == 0.0
     assert elastica.euler_load(2.0, 3.0, 1.5) == pytest.approx(math.pi**2 * 6 / 9)
+
+
+def test_shape_ends_at_the_tip_position():
+    from fenics_nl import elastica
+
+    for ratio in (1.05, 1.5, 3.0):
+        x, y = elastica.shape(ratio)
+        d, xl = elastica.tip_position(ratio)
+        assert abs(x[-1] - xl) < 1e-8 and abs(y[-1] - d) < 1e-8
+        # inextensible: the centreline keeps its length
+        assert np.sum(np.hypot(np.diff(x), np.diff(y))) == pytest.approx(1.0, rel=1e-4)

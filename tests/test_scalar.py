@@ -42,8 +42,11 @@ def test_modified_rate_is_one_minus_slope_ratio():
 def test_errors_are_clear():
     with pytest.raises(scalar.ScalarSolveError, match="slope"):
         scalar.solve(lambda u: u * u + 1, 0.0, "newton", dr=lambda u: 2 * u)
-    with pytest.raises(scalar.ScalarSolveError, match="no convergence"):
+    with pytest.raises(scalar.ScalarSolveError, match="no convergence in 2 iterations"):
+        scalar.solve(lambda u: u**3 - 2 * u - 5, 2.0, "newton", maxit=2)
+    with pytest.raises(scalar.ScalarSolveError, match="diverges") as err:
         scalar.solve(lambda u: u * u + 1, 1.0, "newton", maxit=20)  # no real root
+    assert not err.value.result.converged and len(err.value.result.iterates) > 2
     with pytest.raises(scalar.ScalarSolveError, match="r\\(u\\) failed"):
         scalar.solve(lambda u: math.exp(u) - 2, 0.0, "modified", k=1e-300)  # exp overflows
     with pytest.raises(scalar.ScalarSolveError, match="non-finite"):

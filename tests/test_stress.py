@@ -276,6 +276,46 @@ def test_bracket_hundredfold_increment_refuses_clearly(tmp_path):
     assert "take more --steps" in proc.stderr and "Traceback" not in proc.stderr
 
 
+# -- the same problem in two unit systems ------------------------------------------------
+# N–mm–MPa against N–m–Pa: lengths ×1e-3, moduli ×1e6, forces unchanged. Every tolerance is
+# relative to a force or a length of the problem, so the dimensionless answers agree to the
+# solvers' tolerances (1e-10), far inside 1e-6.
+
+def test_punch_gives_the_same_answer_in_mm_and_in_m(tmp_path):
+    from test_demos import punch
+
+    common = ["--force", "100", "--refine", "0", "--steps", "2"]
+    mm = punch(tmp_path, *common, "--E", "1e5", "--radius", "1")
+    m = punch(tmp_path, *common, "--E", "1e11", "--radius", "1e-3")
+    assert m["force_rel_error"] == pytest.approx(mm["force_rel_error"], abs=1e-6)
+    assert m["contact_radius"] / 1e-3 == pytest.approx(mm["contact_radius"], rel=1e-6)
+    assert m["indentation"] / 1e-3 == pytest.approx(mm["indentation"], rel=1e-6)
+    assert m["max_pressure"] * 1e-6 == pytest.approx(mm["max_pressure"], rel=1e-6)
+
+
+def test_beam_gives_the_same_answer_in_mm_and_in_m(tmp_path):
+    from test_demos import beam
+
+    common = ["--load-ratio", "1.2", "--steps", "20"]
+    mm = beam(tmp_path, *common, "--length", "1000", "--thickness", "20", "--E", "1e3")
+    m = beam(tmp_path, *common, "--length", "1", "--thickness", "0.02", "--E", "1e9")
+    for key in ("critical_load_rel_error", "tip_rotation_deg"):
+        assert m[key] == pytest.approx(mm[key], rel=1e-6, abs=1e-9)
+    assert m["tip_deflection"] * 1e3 == pytest.approx(mm["tip_deflection"], rel=1e-6)
+
+
+def test_bracket_gives_the_same_answer_in_mm_and_in_m(tmp_path):
+    from test_demos import bracket
+
+    common = ["--steps", "1", "--support", "contact"]
+    mm = bracket(tmp_path, *common, "--size", "20")
+    m = bracket(tmp_path, *common, "--units", "m", "--size", "0.02")
+    assert m["load_point_displacement"] * 1e3 == pytest.approx(mm["load_point_displacement"],
+                                                               rel=1e-6)
+    assert m["lifted_off_area"] * 1e6 == pytest.approx(mm["lifted_off_area"], rel=1e-6)
+    assert m["max_von_mises"] * 1e-6 == pytest.approx(mm["max_von_mises"], rel=1e-6)
+
+
 # -- three ranks ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("scene,args,keys", [
