@@ -204,8 +204,7 @@ class Punch:
         return boundary.reactions(self.residual, self.u, self.groups)
 
     def hertz(self, state: Indentation) -> dict[str, float]:
-        """Hertz's values for this state (sphere: from δ; cylinder: a and p0 from the computed
-        P, no force)."""
+        """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""
         E, nu = self.material.E, self.material.nu
         if self.model == "plane-strain":  # a cylinder: no force-indentation law to check
             return hertz.cylinder_from_force(E, nu, self.R, state.force)
