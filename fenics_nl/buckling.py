@@ -27,6 +27,11 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
     """The `n` smallest positive load factors λ and their modes (normalised, max |φ| = 1)."""
     K = petsc.assemble_matrix(fem.form(a_K), bcs=bcs, diag=1.0)
     K.assemble()
+    # Dirichlet rows at the stiffness's own scale (a diagonal of 1 would depend on the units)
+    dmax = K.getDiagonal().max()[1]
+    K.zeroEntries()
+    petsc.assemble_matrix(K, fem.form(a_K), bcs=bcs, diag=dmax)
+    K.assemble()
     G = petsc.assemble_matrix(fem.form(-a_G), bcs=bcs, diag=0.0)
     G.assemble()
     eps = SLEPc.EPS().create(V.mesh.comm)

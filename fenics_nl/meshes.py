@@ -39,7 +39,12 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     physical group ``contact``; ``symmetry_x`` (x = 0), ``symmetry_y`` (3D, y = 0),
     ``bottom`` and ``side`` complete it. Element size h_fine inside `fine_radius` of the
     origin, then growing by `growth` per unit distance (geometric-like grading).
+
+    gmsh works in units of `fine_radius` (its tolerances are absolute) and the coordinates
+    are scaled back, so the mesh is the same, up to scale, in any unit system.
     """
+    unit = fine_radius
+    width, depth, h_fine, fine_radius = width / unit, depth / unit, h_fine / unit, 1.0
     if comm.rank == 0:
         _start(f"block{dim}d")
         occ = gmsh.model.occ
@@ -73,4 +78,5 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
     if comm.rank == 0:
         gmsh.model.remove()
+    data.mesh.geometry.x[:] *= unit
     return data
