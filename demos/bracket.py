@@ -87,7 +87,8 @@ def parse_args(argv=None):
     p.add_argument("--n", type=cli.positive, default=0.2, help="power law exponent [-]")
     p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
     p.add_argument("--output", metavar="DIR",
-                   help="displacement and von Mises stress (VTX, ParaView)")
+                   help="displacement, von Mises stress, with --support contact the floor "
+                        "pressure and active set (VTX, ParaView)")
     p.add_argument("--png", metavar="PATH",
                    help="deformed bracket coloured by von Mises stress, load and supports drawn")
     p.add_argument("--plot", metavar="PATH", help="load against load-point displacement")
@@ -243,7 +244,8 @@ def writers(b, vm, steps, args):
     todo = []
     if args.output:
         def fields():
-            paths = output.write_fields(args.output, [b.u, vm])
+            extra = b.contact_fields() if args.support == "contact" else []
+            paths = output.write_fields(args.output, [b.u, vm, *extra])
             say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
         todo.append(fields)
     if args.plot:

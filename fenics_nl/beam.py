@@ -19,6 +19,7 @@ from mpi4py import MPI
 from fenics_nl import boundary, elastica, kinematics
 from fenics_nl.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.elastica import euler_load
+from fenics_nl.errors import SolveError
 from fenics_nl.loading import LoadPath, solve_incrementally
 from fenics_nl.materials import LinearElastic, NeoHookean, StVenantKirchhoff
 from fenics_nl.newton import ConvergenceError, NewtonSolver
@@ -103,10 +104,13 @@ class Beam:
         t = fem.Constant(self.mesh, np.array([-1.0 / self.h, 0.0]))
         from dolfinx.fem.petsc import LinearProblem
 
+        from fenics_nl.snes import unless_set
+
         LinearProblem(a, ufl.dot(t, v) * self.ds_end, u=u0, bcs=self.bcs,
                       petsc_options_prefix="beam_prestress_",
-                      petsc_options={"ksp_type": "preonly", "pc_type": "lu",
-                                     "pc_factor_mat_solver_type": "mumps"}).solve()
+                      petsc_options=unless_set("beam_prestress_", {
+                          "ksp_type": "preonly", "pc_type": "lu",
+                          "pc_factor_mat_solver_type": "mumps"})).solve()
         sigma0 = lin.stress(eps(u0, self.model))
         a_G = geometric_stiffness(sigma0, du, v,  # embedded 3x3 ∇ matches a 3x3 σ₀
                                   lambda w: kinematics.displacement_gradient(w, self.model))
@@ -158,7 +162,7 @@ class Beam:
             steps = min(4 * steps, MAX_PATH_STEPS)
             if progress:
                 progress(f"branch switching failed: load path again with {steps} steps")
-        raise RuntimeError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
+        raise SolveError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""

@@ -83,7 +83,8 @@ class Bracket:
     def __init__(self, material, *, size: float = 5.0, mesh_file: str | None = None,
                  support: str = "clamped", degree: int = 1, newton: str = "full",
                  linear_solver: str = "lu", comm: MPI.Comm = MPI.COMM_WORLD, period: int = 3,
-                 force_scale: float = 1e4, tolerance: float = 1e-9, length_scale: float = 1.0):
+                 force_scale: float | None = None, tolerance: float = 1e-9,
+                 length_scale: float = 1.0):
         if not 0 < tolerance < 1:
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
         if support not in ("clamped", "contact"):
@@ -152,11 +153,21 @@ class Bracket:
         """Total force `force` [N] along +x, spread uniformly over the loaded hole."""
         self.traction.value[:] = [force / self.load_area, 0.0, 0.0]
 
-    def load_point_displacement(self) -> float:
-        """|mean displacement of the loaded hole| [mm]."""
+    def load_point_motion(self) -> np.ndarray:
+        """Mean displacement vector of the loaded hole."""
         comm = self.mesh.comm
-        mean = [comm.allreduce(fem.assemble_scalar(f)) / self.load_area for f in self._mean_u]
-        return float(np.linalg.norm(mean))
+        return np.array([comm.allreduce(fem.assemble_scalar(f)) / self.load_area
+                         for f in self._mean_u])
+
+    def load_point_displacement(self) -> float:
+        """|mean displacement of the loaded hole| (in the mesh's length unit)."""
+        return float(np.linalg.norm(self.load_point_motion()))
+
+    def contact_fields(self) -> list[fem.Function]:
+        """Nodal floor pressure and active set (1/0) on the base (contact support only)."""
+        c = self.solver
+        return [c.nodal_field(c.pressure(), "contact_pressure"),
+                c.nodal_field(c.active.astype(float), "active_set")]
 
     def von_mises(self) -> fem.Function:
         """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""

@@ -28,7 +28,9 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
     K = petsc.assemble_matrix(fem.form(a_K), bcs=bcs, diag=1.0)
     K.assemble()
     # Dirichlet rows at the stiffness's own scale (a diagonal of 1 would depend on the units)
-    dmax = K.getDiagonal().max()[1]
+    diagonal = K.getDiagonal()
+    dmax = diagonal.max()[1]
+    diagonal.destroy()  # not left to the garbage collector (MPI: same order on every rank)
     K.zeroEntries()
     petsc.assemble_matrix(K, fem.form(a_K), bcs=bcs, diag=dmax)
     K.assemble()
@@ -80,7 +82,9 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     """
     K = petsc.assemble_matrix(fem.form(a_T), bcs=bcs, diag=1.0)
     K.assemble()
-    dmax = K.getDiagonal().max()[1]
+    diagonal = K.getDiagonal()
+    dmax = diagonal.max()[1]
+    diagonal.destroy()  # not left to the garbage collector (MPI: same order on every rank)
     K.zeroEntries()
     petsc.assemble_matrix(K, fem.form(a_T), bcs=bcs, diag=dmax)
     K.assemble()

@@ -14,6 +14,7 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
 import time
 import traceback
@@ -22,9 +23,12 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from fenics_nl.errors import SolveError
+
 # Errors that end a run with one line: bad parameters, solvers that cannot converge, a load
-# that cannot be reached. Anything else is a bug and keeps its traceback.
-EXPECTED_ERRORS: tuple[type[BaseException], ...] = (ValueError, RuntimeError, ArithmeticError)
+# that cannot be reached (and PETSc refusing an option). Anything else is a bug and keeps
+# its traceback.
+EXPECTED_ERRORS: tuple[type[BaseException], ...] = (ValueError, SolveError)
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -41,8 +45,9 @@ class ArgumentParser(argparse.ArgumentParser):
     """Bad input is one line on stderr (`--help` has the usage), exit status 2."""
 
     def error(self, message):
-        """Print `prog: error: message` alone and exit with status 2."""
-        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+        """Print `prog: error: message` alone (rank 0) and exit with status 2."""
+        text = f"{self.prog}: error: {message} (see --help)\n"
+        self.exit(2, text if MPI.COMM_WORLD.rank == 0 else None)
 
 
 def parser(description: str, epilog: str | None = None) -> ArgumentParser:
@@ -170,23 +175,27 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
     from petsc4py import PETSc
 
     t0 = time.perf_counter()
+    options = None
     try:
         options = PetscOptions(petsc_argv, prefixes or {})
         out, writers = solve()
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
         error(_one_line(err))
+        if options is not None:
+            options.unused()  # leaves PETSc's database as it was
         return 2
     out["wall_time_s"] = time.perf_counter() - t0
     out.setdefault("warnings", [])
     for w in out["warnings"]:
         say(f"warning: {w}")
     status = 0
+    try:  # on every rank, so that every rank stops here together
+        text = json.dumps(out, indent=2, allow_nan=False)
+    except ValueError:  # a NaN among the results: a defect, never a silent answer
+        error("a result is not a finite number: no output written")
+        options.unused()
+        return 2
     if json_path and MPI.COMM_WORLD.rank == 0:
-        try:
-            text = json.dumps(out, indent=2, allow_nan=False)
-        except ValueError:  # a NaN among the results: a defect, never a silent answer
-            error(f"a result is not a finite number; {json_path} not written")
-            return 2
         try:
             Path(json_path).write_text(text)
         except OSError as err:
@@ -212,5 +221,8 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
 def _one_line(err: BaseException) -> str:
     text = " ".join(str(err).split())
     if type(err).__name__ == "Error" and "petsc4py" in type(err).__module__:
+        # PETSc's stack: keep its messages, drop the "function() at file:line" frames
+        parts = [p.strip() for p in re.split(r"\[\d+\]", text)]
+        text = "; ".join(p for p in parts if p and " at /" not in p)
         return f"PETSc rejected an option or failed: {text}"
     return text or type(err).__name__

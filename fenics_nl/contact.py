@@ -41,6 +41,7 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_nl.errors import SolveError
 from fenics_nl.newton import NewtonSolver, WorkCounts
 
 log = logging.getLogger(__name__)
@@ -48,7 +49,7 @@ log = logging.getLogger(__name__)
 FORMULATIONS = ("elimination", "multiplier")
 
 
-class ContactError(RuntimeError):
+class ContactError(SolveError):
     """The active-set iteration cycled or did not settle within its limit."""
 
 

@@ -26,7 +26,7 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.newton import ConvergenceError, NewtonResult
-from fenics_nl.snes import EVENTS, EventCounter, petsc_work, scale_absolute_tolerance
+from fenics_nl.snes import EVENTS, EventCounter, petsc_work, scale_absolute_tolerance, unless_set
 
 
 class MultiplierSystem:
@@ -74,7 +74,7 @@ class MultiplierSystem:
                 "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
         self.problem = petsc.NonlinearProblem(
             [F_u, F_l], [u, self.lam], bcs=list(bcs), kind="mpi", entity_maps=[emap],
-            petsc_options_prefix=prefix, petsc_options=opts)
+            petsc_options_prefix=prefix, petsc_options=unless_set(prefix, opts))
         self.problem.solver.setConvergenceHistory(reset=True)
         scale_absolute_tolerance(self.problem.solver, atol, force_scale)
         names = [n for v in EVENTS.values() for n in ((v,) if isinstance(v, str) else v)]

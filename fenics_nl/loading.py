@@ -16,12 +16,13 @@ import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from fenics_nl.errors import SolveError
 from fenics_nl.newton import ConvergenceError, NewtonResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
 
-class LoadStepError(RuntimeError):
+class LoadStepError(SolveError):
     """The load could not be reached: the step was cut below its minimum."""
 
 

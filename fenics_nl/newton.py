@@ -38,6 +38,7 @@ from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.convergence import observed_orders
+from fenics_nl.errors import SolveError
 from fenics_nl.linear_solver import create_ksp, rigid_body_modes
 
 log = logging.getLogger(__name__)
@@ -46,7 +47,7 @@ METHODS = ("full", "modified", "periodic", "bfgs")
 PHASES = ("residual", "tangent", "factorization", "solve")
 
 
-class ConvergenceError(RuntimeError):
+class ConvergenceError(SolveError):
     """A non-linear solve failed; `result` holds what was done up to the failure."""
 
     def __init__(self, message: str, result: NewtonResult):

@@ -22,9 +22,7 @@ def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path
 
     folder = Path(folder)
     comm = functions[0].function_space.mesh.comm
-    if comm.rank == 0:
-        folder.mkdir(parents=True, exist_ok=True)
-    comm.barrier()
+    folder.mkdir(parents=True, exist_ok=True)  # every rank: an error is raised on all of them
     paths = []
     for f in functions:
         path = folder / f"{f.name}.bp"
@@ -76,7 +74,7 @@ def gather_grid(V: fem.FunctionSpace, point_data: dict[str, fem.Function] | None
     comm = V.mesh.comm
     topology, types, x = plot.vtk_mesh(V)
     n_cells = len(types)
-    cells = topology.reshape(n_cells, -1) if n_cells else np.zeros((0, 1), dtype=np.int32)
+    cells = topology.reshape(n_cells, V.dofmap.dof_layout.num_dofs + 1)  # also for 0 cells
     bs = V.dofmap.index_map_bs
     points = {k: f.x.array.reshape(-1, bs) if bs > 1 else f.x.array.copy()
               for k, f in (point_data or {}).items()}

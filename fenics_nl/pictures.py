@@ -53,6 +53,7 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
     grid = gather_grid(V1, {"u": u1}, {"vm": owned_cell_values(vm)})
     bolts = gather_points(facet_points(b.mesh, b.groups["bolts"]), np.zeros(0), comm)
     load = gather_points(facet_points(b.mesh, b.load_facets), np.zeros(0), comm)
+    load_motion = b.load_point_motion()
     status = None
     if b.support == "contact":
         c = b.solver
@@ -86,7 +87,7 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
                             "vertical": False, "position_x": 0.15, "position_y": 0.04,
                             "width": 0.7, "height": 0.08, "title_font_size": 14,
                             "label_font_size": 12, "fmt": "%.0f"})
-            centre = load[0].mean(axis=0)
+            centre = load[0].mean(axis=0) + scale * load_motion  # on the deformed hole
             pl.add_arrows(centre[None, :] - [0.25 * size, 0, 0], np.array([[1.0, 0, 0]]),
                           mag=0.25 * size, color="red")
             pl.add_point_labels([centre - [0.25 * size, 0, -0.04 * size]],

@@ -28,6 +28,7 @@ from mpi4py import MPI
 
 from fenics_nl import boundary, hertz, kinematics
 from fenics_nl.contact import ActiveSetContact
+from fenics_nl.errors import SolveError
 from fenics_nl.meshes import graded_block
 
 MODELS = ("axisymmetric", "3d", "plane-strain")
@@ -163,7 +164,7 @@ class Punch:
             slope = math.log(s1.force / s0.force) / math.log(d1 / d0)
             d0, s0 = d1, s1
             d1 = d1 * (force / s1.force) ** (1 / slope)
-        raise RuntimeError(f"force {force:g} not reached in {max_it} indentations")
+        raise SolveError(f"force {force:g} not reached in {max_it} indentations")
 
     def surface_profile(self):
         """(r, p, active) of every S_C node, gathered on rank 0 and sorted by r (else None).

@@ -47,7 +47,7 @@ class ScalarResult:
     @property
     def iterations(self) -> int:
         """Number of updates performed."""
-        return len(self.iterates) - 1
+        return max(len(self.iterates) - 1, 0)
 
 
 def _derivative(r: Callable[[float], float], u: float) -> float:
@@ -74,16 +74,19 @@ def solve(r: Callable[[float], float], u0: float, method: str = "newton",
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    dr = dr or (lambda u: _derivative(r, u))
-    if method == "modified":
-        k = dr(u0) if k is None else k
     r = _guarded(r, method)
-    us, rs = [u0], [r(u0)]
+    dr = dr or (lambda u: _derivative(r, u))
+    us, rs = [u0], []
     try:
+        rs.append(r(u0))
+        if method == "modified":
+            k = dr(u0) if k is None else k
         return _iterate(r, dr, method, k, us, rs, tol, maxit)
-    except ScalarSolveError as err:
-        err.result = ScalarResult(us, rs, False)
-        raise
+    except (ScalarSolveError, ArithmeticError) as err:
+        failure = err if isinstance(err, ScalarSolveError) else ScalarSolveError(
+            f"{method}: arithmetic failed at u = {us[-1]!r}: {err}")
+        failure.result = ScalarResult(us[: len(rs)], rs, False)
+        raise failure from (None if failure is err else err)
 
 
 def _iterate(r, dr, method, k, us, rs, tol, maxit) -> ScalarResult:

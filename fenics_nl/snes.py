@@ -71,6 +71,16 @@ def _all_event_names():
     return out
 
 
+def unless_set(prefix: str, options: dict) -> dict:
+    """`options` without those the command line set under `prefix`: the user's value wins.
+
+    dolfinx's NonlinearProblem and LinearProblem write their `petsc_options` over the
+    database and delete them afterwards; an option the user passed would be lost.
+    """
+    db = PETSc.Options()
+    return {k: v for k, v in options.items() if not db.hasName(prefix + k)}
+
+
 def scale_absolute_tolerance(snes: PETSc.SNES, atol: float, force_scale: float | None = None
                              ) -> None:
     """SNES's absolute tolerance as NewtonSolver's: atol × a force of the problem.
@@ -79,6 +89,8 @@ def scale_absolute_tolerance(snes: PETSc.SNES, atol: float, force_scale: float |
     Set by a monitor at iteration 0, which PETSc calls before the convergence test. The
     monitor holds no reference to a Python solver object (see SnesSolver).
     """
+    if PETSc.Options().hasName(f"{snes.getOptionsPrefix() or ''}snes_atol"):
+        return  # the command line's -<prefix>snes_atol stays
     largest = [0.0]
 
     def monitor(snes, it, norm):
@@ -121,7 +133,8 @@ class SnesSolver:
         }
         J = ufl.derivative(residual, u) if tangent is None else tangent
         self.problem = petsc.NonlinearProblem(residual, u, bcs=self.bcs, J=J,
-                                              petsc_options_prefix=prefix, petsc_options=opts)
+                                              petsc_options_prefix=prefix,
+                                              petsc_options=unless_set(prefix, opts))
         if linear_solver == "cholesky":
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)

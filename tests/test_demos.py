@@ -70,8 +70,10 @@ def test_newton_scalar_divergence_is_a_result(tmp_path):
 def test_help_describes_the_demo_and_states_defaults_once(tmp_path, demo):
     text = run([DEMOS / demo, "--help"], tmp_path).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
-    if demo != "newton_scalar.py":
-        assert "prefix" in text  # the PETSc options prefixes are documented
+    prefix = {"punch.py": "-punch_axisymmetric_elim_ksp_view", "buckling_beam.py":
+              "-beam_buckling_", "bracket.py": "-bracket_elim_"}.get(demo)
+    if prefix:  # the PETSc options prefixes are documented
+        assert prefix in " ".join(text.split())
 
 
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
@@ -128,9 +130,8 @@ def test_punch_force_control_at_a_realistic_modulus(tmp_path):
 
 def test_punch_reactions_balance_the_contact_force(tmp_path):
     d = punch(tmp_path, "--nu", "0.25")
-    r = d["reactions"]
-    assert r["contact"][1] == pytest.approx(-d["force"], rel=1e-12)
-    assert r["bottom"][1] == pytest.approx(d["force"], rel=1e-8)  # vertical equilibrium
+    # vertical equilibrium of the block: the base holds what the punch pushes
+    assert d["reactions"]["bottom"][1] == pytest.approx(d["force"], rel=1e-8)
     assert d["warnings"] == []
 
 
@@ -215,7 +216,7 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path):
     (["-ksp_view"], "-ksp_view is read by no solver of this run; its options prefixes are "
                     "-punch_axisymmetric_elim_"),
     (["-punch_axisymmetric_elim_ksp_veiw"], "was read by no solver (misspelt?)"),
-    (["-punch_axisymmetric_elim_pc_type", "nonsense"], "PETSc rejected an option"),
+    (["-punch_axisymmetric_elim_pc_type", "nonsense"], "nonsense"),
 ])
 def test_punch_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "punch.py", *args], tmp_path, check=False)
