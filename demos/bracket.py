@@ -84,7 +84,8 @@ def parse_args(argv=None):
     p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
     p.add_argument("--sigma0", type=cli.positive, default=None,
                    help="power law: reference stress (default 200 MPa, in N/unit²)")
-    p.add_argument("--n", type=cli.positive, default=0.2, help="power law exponent [-]")
+    p.add_argument("--n", type=cli.positive, default=None,
+                   help="power law exponent [-] (default 0.2)")
     p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
     p.add_argument("--output", metavar="DIR",
                    help="displacement, von Mises stress, with --support contact the floor "
@@ -100,7 +101,7 @@ def parse_args(argv=None):
         p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
     mm = MM[args.units]
     args.E = args.E if args.E is not None else 200e3 / mm**2
-    args.sigma0 = args.sigma0 if args.sigma0 is not None else 200.0 / mm**2
+    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
     if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
         p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
                 f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")

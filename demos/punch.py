@@ -80,9 +80,10 @@ def parse_args(argv=None):
                    help="punch shape: Hertz's parabola or the exact sphere")
     p.add_argument("--material", choices=["linear", "power-law"], default="linear",
                    help="linear elastic (Hertz applies), or the power law (Newton inside)")
-    p.add_argument("--sigma0", type=cli.positive, default=0.01,
-                   help="power law: stress where it turns non-linear [stress]")
-    p.add_argument("--n", type=cli.positive, default=0.3, help="power law exponent [-]")
+    p.add_argument("--sigma0", type=cli.positive, default=None,
+                   help="power law: stress where it turns non-linear [stress] (default 0.01)")
+    p.add_argument("--n", type=cli.positive, default=None,
+                   help="power law exponent [-] (default 0.3)")
     p.add_argument("--refine", type=cli.at_least(0), default=1,
                    help=f"element size under the punch a/(20·2^refine) (3D: a/(6·2^refine)), "
                         f"at most {MAX_REFINE}")
@@ -96,6 +97,7 @@ def parse_args(argv=None):
                         "pressure, against Hertz")
     p.add_argument("--plot", metavar="PATH", help="force-indentation and pressure against Hertz")
     args, petsc_args = cli.parse_with_petsc_options(p, argv)
+    cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
     if args.refine > MAX_REFINE:
         p.error(f"--refine must be <= {MAX_REFINE}, got {args.refine}")
     if args.indentation is not None and args.indentation == 0:

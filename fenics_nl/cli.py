@@ -90,6 +90,16 @@ def at_least(minimum: int):
     return parse
 
 
+def power_law_flags(parser: argparse.ArgumentParser, args, **defaults) -> None:
+    """Fill --sigma0/--n with their defaults; giving them with a linear material is an error."""
+    given = [f"--{k}" for k in defaults if getattr(args, k) is not None]
+    if args.material == "linear" and given:
+        parser.error(f"{', '.join(given)} set the power law, not --material linear")
+    for k, v in defaults.items():
+        if getattr(args, k) is None:
+            setattr(args, k, v)
+
+
 def parse_with_petsc_options(parser: argparse.ArgumentParser, argv=None):
     """The demo's own arguments, and the PETSc options (``-name [value]``) to pass through.
 

@@ -158,6 +158,21 @@ def test_a_failing_picture_keeps_the_json(tmp_path):
     assert json.loads((tmp_path / "o.json").read_text())["force"] > 0
 
 
+def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve():
+    # the check behind every punch report, called in-process on a state with 3 nodes in
+    # contact (the CLI's --refine bound keeps a default run far from it)
+    import importlib.util
+    from types import SimpleNamespace
+
+    spec = importlib.util.spec_from_file_location("punch_demo", DEMOS / "punch.py")
+    demo = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(demo)
+    state = SimpleNamespace(force=1.0, contact_radius=0.1)
+    with pytest.raises(ValueError, match=r"only 3 node.* cannot resolve the contact zone"):
+        demo.check_against_hertz(SimpleNamespace(h=0.05), state, None,
+                                 {"nodes_in_contact": 3, "warnings": []})
+
+
 def test_punch_picture_is_the_same_on_two_ranks(tmp_path):
     import matplotlib.image as mpimg
 
@@ -196,6 +211,8 @@ def test_punch_two_ranks_match_serial(tmp_path):
     assert p["ranks"] == 2
     assert p["force"] == pytest.approx(s["force"], rel=1e-8)
     assert p["contact_radius"] == pytest.approx(s["contact_radius"], rel=1e-12)
+    for group, r in s["reactions"].items():  # summed over the ranks' owned nodes
+        assert np.allclose(p["reactions"][group], r, rtol=1e-8, atol=1e-10 * s["force"])
 
 
 def test_punch_that_never_touches_gives_zero_force(tmp_path):
@@ -213,6 +230,7 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path):
     (["--indentation", "nan"], "--indentation: must be a finite number"),
     (["--E", "inf"], "--E: must be a finite number"),
     (["--refine", "30"], "--refine must be <= 6"),
+    (["--n", "0.5"], "--n set the power law, not --material linear"),
     (["-ksp_view"], "-ksp_view is read by no solver of this run; its options prefixes are "
                     "-punch_axisymmetric_elim_"),
     (["-punch_axisymmetric_elim_ksp_veiw"], "was read by no solver (misspelt?)"),
@@ -341,8 +359,10 @@ def test_bracket_contact_support_lifts_off(tmp_path):
 
 
 def test_bracket_outputs_and_bolt_reaction(tmp_path):
-    d = bracket(tmp_path, "--size", "20", "--steps", "1", "--output", "f", "--png", "b.png",
-                "--plot", "c.png")
+    proc = run([DEMOS / "bracket.py", "--size", "20", "--steps", "1", "--output", "f", "--png",
+                "b.png", "--plot", "c.png", "--json", "b.json"], tmp_path)
+    assert "X server" not in proc.stderr and proc.stderr == ""  # off-screen, no VTK noise
+    d = json.loads((tmp_path / "b.json").read_text())
     assert (tmp_path / "f" / "displacement.bp").is_dir()
     assert (tmp_path / "f" / "von_mises.bp").is_dir()
     assert (tmp_path / "b.png").stat().st_size > 50_000 and (tmp_path / "c.png").exists()
@@ -367,6 +387,8 @@ def test_bracket_two_ranks_match_serial(tmp_path, support):
     p = bracket(tmp_path, "--support", support, ranks=2)
     assert p["ranks"] == 2 and p["dofs"] == s["dofs"]
     assert p["load_point_displacement"] == pytest.approx(s["load_point_displacement"], rel=1e-8)
+    for group, r in s["reactions"].items():
+        assert np.allclose(p["reactions"][group], r, rtol=1e-7, atol=1e-9 * 8e3)
 
 
 def _box_without_groups(path, fold=False):
@@ -403,7 +425,8 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
                           (["--size", "1e6"], "more than twice the plate thickness"),
                           (["--mesh", "box.msh", "--size", "3"], "contradict"),
                           (["--compare", "--png", "x.png"], "--compare"),
-                          (["--force", "nan"], "--force: must be a finite number")]:
+                          (["--force", "nan"], "--force: must be a finite number"),
+                          (["--material", "linear", "--sigma0", "100"], "set the power law")]:
         proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)
