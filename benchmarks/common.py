@@ -76,3 +76,34 @@ def save_figure(fig, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     print(f"wrote {path}", flush=True)
+
+
+def timed_linear_solve(a, L, bcs, kind: str, prefix: str, x=None) -> float:
+    """Seconds (slowest rank) to assemble K and F, factorize (or set up GAMG) and solve once.
+
+    The reference of every benchmark's ratio: what one linear solve of the same mesh costs.
+    """
+    import fenics_nl  # noqa: F401
+
+    # isort: split
+    from dolfinx.fem import petsc
+    from mpi4py import MPI
+    from petsc4py import PETSc
+
+    from fenics_nl.linear_solver import create_ksp
+
+    comm = MPI.COMM_WORLD
+    comm.Barrier()
+    t0 = time.perf_counter()
+    A = petsc.assemble_matrix(a, bcs=bcs)
+    A.assemble()
+    b = petsc.assemble_vector(L)
+    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+    petsc.set_bc(b, bcs)
+    ksp = create_ksp(A, kind, prefix=prefix)
+    x = b.duplicate() if x is None else x
+    ksp.solve(b, x)
+    seconds = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    for obj in (ksp, A, b):
+        obj.destroy()
+    return seconds

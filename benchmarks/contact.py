@@ -20,15 +20,12 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import ufl
-from common import elapsed, machine, pyplot, save_figure, update_readme
+from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, update_readme
 from dolfinx import fem
-from dolfinx.fem import petsc
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from fenics_nl import hertz
 from fenics_nl.contact_peers import solve_penalty, solve_snes_vi
-from fenics_nl.linear_solver import create_ksp
 from fenics_nl.materials import LinearElastic
 from fenics_nl.punch import Punch
 
@@ -58,17 +55,7 @@ def linear_solve_time(p):
     a = fem.form(ufl.derivative(p.residual, p.u, du))
     ds = ufl.Measure("ds", domain=p.mesh)
     L = fem.form(-1.0 * v[p.vertical] * p.weight * ds)
-    comm.Barrier()
-    t0 = time.perf_counter()
-    Amat = petsc.assemble_matrix(a, bcs=p.bcs)
-    Amat.assemble()
-    b = petsc.assemble_vector(L)
-    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-    petsc.set_bc(b, p.bcs)
-    ksp = create_ksp(Amat, "lu", prefix="lin_")
-    x = b.duplicate()
-    ksp.solve(b, x)
-    return comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    return timed_linear_solve(a, L, p.bcs, "lu", "lin_")
 
 
 def errors(s):

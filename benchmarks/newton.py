@@ -17,13 +17,18 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 import ufl
-from common import elapsed, machine, outside_kernels, pyplot, save_figure, update_readme
+from common import (
+    elapsed,
+    machine,
+    outside_kernels,
+    pyplot,
+    save_figure,
+    timed_linear_solve,
+    update_readme,
+)
 from dolfinx import fem
-from dolfinx.fem import petsc
 from mpi4py import MPI
-from petsc4py import PETSc
 
-from fenics_nl.linear_solver import create_ksp
 from fenics_nl.materials import LinearElastic, PowerLaw
 from fenics_nl.newton import NewtonSolver
 from fenics_nl.problems import cantilever_3d
@@ -88,16 +93,7 @@ def linear_solve_time(cells, linear_solver):
     V = p.u.function_space
     a = fem.form(ufl.derivative(p.residual, p.u))
     L = fem.form(-ufl.replace(p.residual, {p.u: fem.Function(V)}))
-    MPI.COMM_WORLD.Barrier()
-    t0 = time.perf_counter()
-    A = petsc.assemble_matrix(a, bcs=p.bcs)
-    A.assemble()
-    b = petsc.assemble_vector(L)
-    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-    petsc.set_bc(b, p.bcs)
-    ksp = create_ksp(A, linear_solver, prefix="linear_")
-    ksp.solve(b, p.u.x.petsc_vec)
-    return MPI.COMM_WORLD.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    return timed_linear_solve(a, L, p.bcs, linear_solver, "linear_", x=p.u.x.petsc_vec)
 
 
 def main():

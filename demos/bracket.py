@@ -86,13 +86,10 @@ def parse_args(argv=None):
                    help="power law: reference stress (default 200 MPa, in N/unit²)")
     p.add_argument("--n", type=cli.positive, default=None,
                    help="power law exponent [-] (default 0.2)")
-    p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
-    p.add_argument("--output", metavar="DIR",
-                   help="displacement, von Mises stress, with --support contact the floor "
-                        "pressure and active set (VTX, ParaView)")
-    p.add_argument("--png", metavar="PATH",
-                   help="deformed bracket coloured by von Mises stress, load and supports drawn")
-    p.add_argument("--plot", metavar="PATH", help="load against load-point displacement")
+    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
+                              "floor pressure and active set",
+                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
+                    plot="load against load-point displacement")
     args, petsc_args = cli.parse_with_petsc_options(p, argv)
     if args.compare and (args.png or args.plot or args.output):
         p.error("--compare prints a table of the variants: --png, --plot and --output "

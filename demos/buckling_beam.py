@@ -72,11 +72,9 @@ def parse_args(argv=None):
                    help="lateral end load as a fraction of P [-], in [0, 0.1)")
     p.add_argument("--refine", type=cli.at_least(0), default=0,
                    help="mesh: 2·2^refine Q2 elements through the height, square elements")
-    p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
-    p.add_argument("--output", metavar="DIR", help="write the final displacement (VTX)")
-    p.add_argument("--png", metavar="PATH",
-                   help="deformed shapes along the path, with the elastica's")
-    p.add_argument("--plot", metavar="PATH", help="P/P_cr against tip rotation and deflection")
+    cli.add_outputs(p, output="the final displacement",
+                    png="deformed shapes along the path, with the elastica's",
+                    plot="P/P_cr against tip rotation and deflection")
     args, petsc_args = cli.parse_with_petsc_options(p, argv)
     if args.load_ratio > 20:
         p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")

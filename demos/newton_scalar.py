@@ -56,9 +56,8 @@ def parse_args(argv=None):
                    help="decimal digits of the arithmetic (16 = double precision floats)")
     p.add_argument("--maxit", type=cli.at_least(1), default=500,
                    help="iteration limit per method")
-    p.add_argument("--json", metavar="PATH", help="write orders and iteration counts as JSON")
-    p.add_argument("--plot", metavar="PATH",
-                   help="draw |e_k+1| against |e_k| (log-log: the slopes are the orders)")
+    cli.add_outputs(p, json="orders and iteration counts",
+                    plot="draw |e_k+1| against |e_k| (log-log: the slopes are the orders)")
     args = p.parse_args(argv)
     if args.digits > 1000:
         p.error(f"--digits must be in [16, 1000], got {args.digits}")

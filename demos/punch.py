@@ -89,13 +89,10 @@ def parse_args(argv=None):
                         f"at most {MAX_REFINE}")
     p.add_argument("--block", type=cli.positive, default=None,
                    help="block size in contact radii, >= 10 (default 1000, 3D 100)")
-    p.add_argument("--json", metavar="PATH", help="write the quantities of interest as JSON")
-    p.add_argument("--output", metavar="DIR",
-                   help="write displacement, contact pressure and active set (VTX, ParaView)")
-    p.add_argument("--png", metavar="PATH",
-                   help="the deformed contact zone (von Mises stress) beside the contact "
-                        "pressure, against Hertz")
-    p.add_argument("--plot", metavar="PATH", help="force-indentation and pressure against Hertz")
+    cli.add_outputs(p, output="displacement, von Mises stress, contact pressure and active set",
+                    png="the deformed contact zone (von Mises stress) beside the contact "
+                        "pressure, against Hertz",
+                    plot="force-indentation and pressure against Hertz")
     args, petsc_args = cli.parse_with_petsc_options(p, argv)
     cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
     if args.refine > MAX_REFINE:

@@ -14,6 +14,7 @@ import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
+from petsc4py import PETSc
 from slepc4py import SLEPc
 
 
@@ -22,28 +23,43 @@ def geometric_stiffness(stress, du, v, gradient=ufl.grad):
     return ufl.inner(stress, gradient(du).T * gradient(v))
 
 
-def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: int = 3,
-                   prefix: str = "buckling_") -> tuple[list[float], list[fem.Function]]:
-    """The `n` smallest positive load factors λ and their modes (normalised, max |φ| = 1)."""
-    K = petsc.assemble_matrix(fem.form(a_K), bcs=bcs, diag=1.0)
+def _stiffness(a: ufl.Form, bcs) -> PETSc.Mat:
+    """K with its Dirichlet rows scaled to its largest diagonal entry.
+
+    A diagonal of 1 would put their (spurious) eigenvalues anywhere, depending on the units;
+    at the stiffness's own scale they stay away from the target, in any unit system.
+    """
+    form = fem.form(a)
+    K = petsc.assemble_matrix(form, bcs=bcs, diag=1.0)
     K.assemble()
-    # Dirichlet rows at the stiffness's own scale (a diagonal of 1 would depend on the units)
     diagonal = K.getDiagonal()
     dmax = diagonal.max()[1]
     diagonal.destroy()  # not left to the garbage collector (MPI: same order on every rank)
     K.zeroEntries()
-    petsc.assemble_matrix(K, fem.form(a_K), bcs=bcs, diag=dmax)
+    petsc.assemble_matrix(K, form, bcs=bcs, diag=dmax)
     K.assemble()
-    G = petsc.assemble_matrix(fem.form(-a_G), bcs=bcs, diag=0.0)
-    G.assemble()
-    eps = SLEPc.EPS().create(V.mesh.comm)
+    return K
+
+
+def _nearest_zero(comm, prefix: str, n: int, A: PETSc.Mat, B: PETSc.Mat | None = None,
+                  tol: float | None = None) -> SLEPc.EPS:
+    """An EPS for the `n` eigenvalues of A x = λ B x (or A x = λ x) nearest 0.
+
+    Shift-and-invert at 0 with MUMPS LU; `-{prefix}eps_...` options are read last.
+    """
+    eps = SLEPc.EPS().create(comm)
     eps.setOptionsPrefix(prefix)
-    eps.setOperators(K, G)
-    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+    if B is not None:
+        eps.setOperators(A, B)
+    else:
+        eps.setOperators(A)
+    if tol is not None:
+        eps.setTolerances(tol, 200)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP if B is not None
+                       else SLEPc.EPS.ProblemType.HEP)
     eps.setDimensions(n)
     eps.setTarget(0.0)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-    eps.setTolerances(1e-12, 200)
     st = eps.getST()
     st.setType("sinvert")
     st.setShift(0.0)
@@ -52,6 +68,16 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
     ksp.getPC().setType("lu")
     ksp.getPC().setFactorSolverType("mumps")
     eps.setFromOptions()
+    return eps
+
+
+def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: int = 3,
+                   prefix: str = "buckling_") -> tuple[list[float], list[fem.Function]]:
+    """The `n` smallest positive load factors λ and their modes (normalised, max |φ| = 1)."""
+    K = _stiffness(a_K, bcs)
+    G = petsc.assemble_matrix(fem.form(-a_G), bcs=bcs, diag=0.0)
+    G.assemble()
+    eps = _nearest_zero(V.mesh.comm, prefix, n, K, G, tol=1e-12)
     eps.solve()
     values, modes = [], []
     vr = K.createVecRight()
@@ -80,28 +106,8 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     Dirichlet rows are identity rows (eigenvalue 1), kept away from the target by scaling
     them to the largest diagonal entry.
     """
-    K = petsc.assemble_matrix(fem.form(a_T), bcs=bcs, diag=1.0)
-    K.assemble()
-    diagonal = K.getDiagonal()
-    dmax = diagonal.max()[1]
-    diagonal.destroy()  # not left to the garbage collector (MPI: same order on every rank)
-    K.zeroEntries()
-    petsc.assemble_matrix(K, fem.form(a_T), bcs=bcs, diag=dmax)
-    K.assemble()
-    eps = SLEPc.EPS().create(V.mesh.comm)
-    eps.setOptionsPrefix(prefix)
-    eps.setOperators(K)
-    eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
-    eps.setDimensions(1)
-    eps.setTarget(0.0)
-    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-    st = eps.getST()
-    st.setType("sinvert")
-    ksp = st.getKSP()
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    eps.setFromOptions()
+    K = _stiffness(a_T, bcs)
+    eps = _nearest_zero(V.mesh.comm, prefix, 1, K)
     eps.solve()
     vr = K.createVecRight()
     lam = eps.getEigenpair(0, vr).real

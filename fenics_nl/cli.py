@@ -55,6 +55,18 @@ def parser(description: str, epilog: str | None = None) -> ArgumentParser:
     return ArgumentParser(description=description, epilog=epilog, formatter_class=HelpFormatter)
 
 
+def add_outputs(p: argparse.ArgumentParser, *, json: str = "the quantities of interest",
+                output: str | None = None, png: str | None = None, plot: str | None = None
+                ) -> None:
+    """The output flags of a demo: --json always, --output/--png/--plot where it has them."""
+    p.add_argument("--json", metavar="PATH", help=f"write {json} as JSON")
+    if output:
+        p.add_argument("--output", metavar="DIR", help=f"{output} (ADIOS2 VTX, for ParaView)")
+    for flag, text in (("--png", png), ("--plot", plot)):
+        if text:
+            p.add_argument(flag, metavar="PATH", help=text)
+
+
 def finite(text: str) -> float:
     """argparse type: a finite float (NaN and infinities are refused)."""
     try:

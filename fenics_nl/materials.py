@@ -9,6 +9,7 @@ the materials that support it use the plane-stress Lamé constant `λ* = 2λμ/(
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import ufl
@@ -60,15 +61,29 @@ class Isotropic:
             raise ValueError(f"{type(self).__name__} does not support the plane-stress model")
 
 
-class SmallStrain:
-    """Mixin: stress, tangent and virtual work derived from `energy(ε)`."""
+class Material(ABC):
+    """A material law: a free energy, and the internal virtual work derived from it.
+
+    `is_linear`: the residual is linear in u (Newton converges in one step, no line
+    search needed). `finite_strain`: the energy is written in the Green–Lagrange strain.
+    """
+
+    finite_strain: bool = False
+    is_linear: bool = False
+
+    @abstractmethod
+    def energy(self, strain):
+        """Free-energy density of the strain (ε in small strain, e in finite strain)."""
+
+    @abstractmethod
+    def internal_work(self, u, v, model: str = "3d"):
+        """Integrand of the internal virtual work of `u` in the direction `v`."""
+
+
+class SmallStrain(Material):
+    """Stress, tangent and virtual work derived from `energy(ε)`."""
 
     finite_strain = False
-    is_linear = False  # True only where the residual is linear in u (Newton: one step)
-
-    def energy(self, eps):
-        """Free-energy density φ(ε)."""
-        raise NotImplementedError
 
     def stress(self, eps):
         """Cauchy stress σ = ∂φ/∂ε."""
@@ -99,15 +114,10 @@ class SmallStrain:
         return f
 
 
-class FiniteStrain:
-    """Mixin: second and first Piola stresses and virtual work derived from `energy(e)`."""
+class FiniteStrain(Material):
+    """Second and first Piola stresses and virtual work derived from `energy(e)`."""
 
     finite_strain = True
-    is_linear = False
-
-    def energy(self, e):
-        """Free-energy density φ(e) per unit reference volume."""
-        raise NotImplementedError
 
     def second_piola(self, e):
         """S = ∂φ/∂e."""

@@ -100,7 +100,7 @@ class Punch:
         force = (np.pi / 4 if model == "plane-strain" else 4 / 3) * E_star * a**3 / radius
         if model == "plane-strain":
             force /= a
-        opts = {"line_search": not getattr(material, "is_linear", False),
+        opts = {"line_search": not material.is_linear,
                 "force_scale": force / self.symmetry_factor}
         opts.update(newton_options or {})
         self.contact = ActiveSetContact(

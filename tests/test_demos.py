@@ -4,21 +4,10 @@ import json
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-ROOT = Path(__file__).resolve().parents[1]
-DEMOS = ROOT / "demos"
-
-
-def run(args, tmp_path, check=True):
-    proc = subprocess.run([sys.executable, *args], cwd=tmp_path, capture_output=True, text=True,
-                          timeout=600)
-    if check:
-        assert proc.returncode == 0, proc.stderr
-    return proc
+from scenes import DEMOS, MPIEXEC, assert_on_elastica, beam, bracket, punch, run
 
 
 def test_newton_scalar_orders(tmp_path):
@@ -74,21 +63,6 @@ def test_help_describes_the_demo_and_states_defaults_once(tmp_path, demo):
               "-beam_buckling_", "bracket.py": "-bracket_elim_"}.get(demo)
     if prefix:  # the PETSc options prefixes are documented
         assert prefix in " ".join(text.split())
-
-
-MPIEXEC = Path(sys.executable).parent / "mpiexec"
-
-
-def punch(tmp_path, *args, ranks=1):
-    out = tmp_path / f"punch{ranks}{'_'.join(args)}.json".replace("/", "")
-    cmd = [DEMOS / "punch.py", *args, "--json", out]
-    if ranks > 1:
-        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=900)
-        assert proc.returncode == 0, proc.stderr
-    else:
-        run(cmd, tmp_path)
-    return json.loads(out.read_text())
 
 
 def test_punch_axisymmetric_default_matches_hertz(tmp_path):
@@ -173,6 +147,18 @@ def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve():
                                  {"nodes_in_contact": 3, "warnings": []})
 
 
+def test_punch_outputs_and_options_on_two_ranks(tmp_path):
+    proc = run([DEMOS / "punch.py", "--refine", "0", "--output", "f", "--png", "p.png",
+                "--plot", "c.png", "--json", "o.json", "-punch_axisymmetric_elim_ksp_type",
+                "cg"], tmp_path, ranks=2)
+    assert proc.stdout.count("wall time") == 1  # rank 0 speaks
+    for name in ("displacement", "contact_pressure", "active_set"):
+        assert (tmp_path / "f" / f"{name}.bp").is_dir()
+    assert json.loads((tmp_path / "o.json").read_text())["ranks"] == 2
+    bad = run([DEMOS / "punch.py", "-ksp_view"], tmp_path, check=False, ranks=2)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+
+
 def test_punch_picture_is_the_same_on_two_ranks(tmp_path):
     import matplotlib.image as mpimg
 
@@ -242,26 +228,6 @@ def test_punch_bad_input_one_clear_line(tmp_path, args, message):
     assert message in proc.stderr and "Traceback" not in proc.stderr
 
 
-def beam(tmp_path, *args, ranks=1):
-    out = tmp_path / ("beam" + "_".join(args).replace("-", "").replace(".", "p") + f"{ranks}.json")
-    cmd = [DEMOS / "buckling_beam.py", *args, "--json", out]
-    if ranks > 1:
-        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=900)
-        assert proc.returncode == 0, proc.stderr
-    else:
-        run(cmd, tmp_path)
-    return json.loads(out.read_text())
-
-
-def assert_on_elastica(d):
-    assert abs(d["critical_load_rel_error"]) < 0.005
-    da = abs(d["tip_rotation_deg"] - d["elastica_tip_rotation_deg"])
-    assert da < max(0.5, 0.01 * d["elastica_tip_rotation_deg"]), d
-    assert d["tip_deflection"] == pytest.approx(d["elastica_tip_deflection"], rel=0.01)
-    assert all(math.isfinite(p["tip_rotation_deg"]) for p in d["path"])
-
-
 @pytest.mark.parametrize("ratio", ["1.05", "1.2", "2.0"])
 def test_beam_follows_the_elastica(tmp_path, ratio):
     assert_on_elastica(beam(tmp_path, "--load-ratio", ratio))
@@ -324,18 +290,6 @@ def test_beam_bad_input_one_clear_line(tmp_path, args, message):
     proc = run([DEMOS / "buckling_beam.py", *args], tmp_path, check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
-
-
-def bracket(tmp_path, *args, ranks=1):
-    out = tmp_path / ("bracket" + "_".join(args).replace("-", "") + f"{ranks}.json")
-    cmd = [DEMOS / "bracket.py", *args, "--json", out]
-    if ranks > 1:
-        proc = subprocess.run([MPIEXEC, "-n", str(ranks), sys.executable, *cmd], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=900)
-        assert proc.returncode == 0, proc.stderr
-    else:
-        run(cmd, tmp_path)
-    return json.loads(out.read_text())
 
 
 def test_bracket_newton_variants_agree(tmp_path):

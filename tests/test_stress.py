@@ -219,7 +219,7 @@ def test_near_incompressibility_p2_keeps_hertz_p1_locks(nu):
     ["--load-ratio", "3.75", "--steps", "1"],  # ×100: 3.75 P_cr in one step
 ])
 def test_beam_large_increments_land_on_the_elastica(tmp_path, args):
-    from test_demos import assert_on_elastica, beam
+    from scenes import assert_on_elastica, beam
 
     assert_on_elastica(beam(tmp_path, *args))
 
@@ -227,7 +227,7 @@ def test_beam_large_increments_land_on_the_elastica(tmp_path, args):
 def test_punch_tenfold_increment_power_law(tmp_path):
     # ×10 the default indentation (0.01 R, one step) in one step, non-linear material:
     # frictionless contact on a convex energy has one solution, whatever the path
-    from test_demos import punch
+    from scenes import punch
 
     common = ["--material", "power-law", "--indentation", "0.1", "--refine", "0"]
     one, ten = punch(tmp_path, *common, "--steps", "1"), punch(tmp_path, *common, "--steps", "10")
@@ -241,7 +241,7 @@ def test_punch_hundredfold_increment_stays_on_hertz(tmp_path):
     # against 13390 unknowns), so Hertz holds to the same discretisation error as at
     # δ = 0.01 R (measured +0.17 % and +0.20 %). The exact sphere lies above the parabola
     # (more gap) out there: less force.
-    from test_demos import punch
+    from scenes import punch
 
     small = punch(tmp_path, "--refine", "0")
     big = punch(tmp_path, "--refine", "0", "--indentation", "1")
@@ -254,7 +254,7 @@ def test_punch_hundredfold_increment_stays_on_hertz(tmp_path):
 
 def test_bracket_tenfold_increment_gives_the_same_answer(tmp_path):
     # ×10: 20 kN (ε_eq ~ 800 ε0) in one step against ten steps of the default 2 kN
-    from test_demos import bracket
+    from scenes import bracket
 
     common = ["--size", "14", "--force", "20000"]
     one, ten = bracket(tmp_path, *common, "--steps", "1"), bracket(tmp_path, *common,
@@ -266,7 +266,7 @@ def test_bracket_tenfold_increment_gives_the_same_answer(tmp_path):
 def test_bracket_hundredfold_increment_refuses_clearly(tmp_path):
     # ×100: 200 kN in one step. Full Newton crawls (damped by the line search); after 50
     # iterations the demo stops and says which step failed and what to do.
-    from test_demos import DEMOS, run
+    from scenes import DEMOS, run
 
     proc = run([DEMOS / "bracket.py", "--size", "14", "--force", "200000", "--steps", "1"],
                tmp_path, check=False)
@@ -282,7 +282,7 @@ def test_bracket_hundredfold_increment_refuses_clearly(tmp_path):
 # solvers' tolerances (1e-10), far inside 1e-6.
 
 def test_punch_gives_the_same_answer_in_mm_and_in_m(tmp_path):
-    from test_demos import punch
+    from scenes import punch
 
     common = ["--force", "100", "--refine", "0", "--steps", "2"]
     mm = punch(tmp_path, *common, "--E", "1e5", "--radius", "1")
@@ -296,7 +296,7 @@ def test_punch_gives_the_same_answer_in_mm_and_in_m(tmp_path):
 
 
 def test_beam_gives_the_same_answer_in_mm_and_in_m(tmp_path):
-    from test_demos import beam
+    from scenes import beam
 
     common = ["--load-ratio", "1.2", "--steps", "20"]
     mm = beam(tmp_path, *common, "--length", "1000", "--thickness", "20", "--E", "1e3")
@@ -309,7 +309,7 @@ def test_beam_gives_the_same_answer_in_mm_and_in_m(tmp_path):
 
 
 def test_bracket_gives_the_same_answer_in_mm_and_in_m(tmp_path):
-    from test_demos import bracket
+    from scenes import bracket
 
     common = ["--steps", "1", "--support", "contact"]
     mm = bracket(tmp_path, *common, "--size", "20")
@@ -329,9 +329,9 @@ def test_bracket_gives_the_same_answer_in_mm_and_in_m(tmp_path):
                                                           "lifted_off_area"]),
 ])
 def test_three_ranks_give_the_serial_answer(tmp_path, scene, args, keys):
-    import test_demos
+    import scenes
 
-    run = getattr(test_demos, scene)
+    run = getattr(scenes, scene)
     s, p = run(tmp_path, *args), run(tmp_path, *args, ranks=3)
     assert p["ranks"] == 3
     for k in keys:  # the 2-rank tests use the same tolerances
