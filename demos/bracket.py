@@ -1,10 +1,11 @@
 # # A 3D bracket in a non-linear material: Newton variants side by side
 #
-# An L-shaped steel-like bracket (gmsh geometry in `meshes/bracket.py`) is bolted through its
-# base and pulled at a hole in its arm. The material is the power law of `fenics_nl`:
-# linear (E, ν) at small strain, $\sigma_{eq} \approx \sigma_0 (\varepsilon_{eq}/\varepsilon_0)^n$
-# beyond $\varepsilon_0 = \sigma_0/(3\mu)$. The default 8 kN is about 1.3 times the load at
-# which a perfectly plastic base plate would hinge ($M_p = \sigma_0 b t^2/4$ against
+# An L-shaped steel-like bracket (gmsh geometry in `fenics_nl/bracket_geometry.py`) is
+# bolted through its base and pulled at a hole in its arm. The material is the power law
+# of `fenics_nl`: linear (E, ν) at small strain,
+# $\sigma_{eq} \approx \sigma_0 (\varepsilon_{eq}/\varepsilon_0)^n$ beyond
+# $\varepsilon_0 = \sigma_0/(3\mu)$. The default 8 kN is about 1.3 times the load at which
+# a perfectly plastic base plate would hinge ($M_p = \sigma_0 b t^2/4$ against
 # $F \times 50$ mm): the whole plate between the arm and the bolts is past $\sigma_0$, and
 # beside the bolt holes (the net section) $\sigma_{eq} \approx 1.7\,\sigma_0$, i.e.
 # $\varepsilon_{eq} \approx 14\,\varepsilon_0$, where the tangent shear stiffness is
@@ -39,8 +40,9 @@ from mpi4py import MPI
 from fenics_nl import cli, output
 from fenics_nl.bracket import THICKNESS_MM, Bracket
 from fenics_nl.cli import say
+from fenics_nl.loading import LoadStepError, solve_incrementally
 from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.newton import ConvergenceError, stalled_at_round_off
+from fenics_nl.newton import stalled_at_round_off
 
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
@@ -142,26 +144,32 @@ def run_variant(args, newton):
                 linear_solver="lu" if args.solver == "direct" else "gamg")
     say(f"{b.dofs} unknowns (P{args.degree}), {newton} Newton, {args.steps} load steps")
     steps = []
-    t0 = time.perf_counter()
-    for k in range(1, args.steps + 1):
-        force = args.force * k / args.steps
-        b.set_load(force)
-        try:
-            r = b.solver.solve()
-        except ConvergenceError as err:
-            # a stall at round-off needs a looser tolerance, not smaller steps
-            stalled = stalled_at_round_off(err.result.residual_norms)
-            advice = "raise --tolerance" if stalled else "take more --steps"
-            raise ConvergenceError(f"load step {k}/{args.steps} (F = {force:.4g} N), {newton} "
-                                   f"Newton: {err}; {advice}", err.result) from err
-        its = getattr(r, "newton_iterations", r.iterations)
-        steps.append({"force": force, "load_point_displacement": b.load_point_displacement(),
-                      "newton_iterations": its, "factorizations": r.work.factorizations,
+
+    def record(t, r):
+        steps.append({"force": t * args.force,
+                      "load_point_displacement": b.load_point_displacement(),
+                      "newton_iterations": r.iterations, "factorizations": r.work.factorizations,
                       "tangent_assemblies": r.work.tangent_assemblies,
                       "krylov_iterations": r.work.krylov_iterations,
                       "residual_norms": list(r.residual_norms)})
-        say(f"  {newton}: step {k}/{args.steps}, F = {force:.4g} N, {its} iterations, "
-            f"|u_load| = {steps[-1]['load_point_displacement']:.6g} {args.units}")
+        say(f"  {newton}: step {len(steps)}/{args.steps}, F = {t * args.force:.4g} N, "
+            f"{r.iterations} iterations, |u_load| = "
+            f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
+
+    # equal steps, each from the last converged state (no predictor, no step control)
+    # +
+    t0 = time.perf_counter()
+    try:
+        solve_incrementally(b.solver, lambda t: b.set_load(t * args.force), args.steps,
+                            adaptive=False, predictor=False, on_step=record)
+    except LoadStepError as err:
+        # a stall at round-off needs a looser tolerance, not smaller steps
+        norms = err.result.residual_norms if err.result is not None else []
+        advice = "raise --tolerance" if stalled_at_round_off(norms) else "take more --steps"
+        k = len(steps) + 1
+        raise LoadStepError(f"load step {k}/{args.steps} (F = {err.target * args.force:.4g} N), "
+                            f"{newton} Newton: {err.__cause__}; {advice}", err.result) from err
+    # -
     wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     return b, steps, wall
 

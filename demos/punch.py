@@ -43,8 +43,9 @@ from mpi4py import MPI
 
 from fenics_nl import cli, hertz, output
 from fenics_nl.cli import say
+from fenics_nl.loading import solve_incrementally
 from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.punch import Punch
+from fenics_nl.punch import Punch, PunchLoad
 
 comm = MPI.COMM_WORLD
 MAX_REFINE = 6  # a/1280 under the punch in 2D: ~1e6 unknowns
@@ -136,19 +137,18 @@ def run(args):
 
     # Load steps: δ (or P) grows linearly; each step starts from the last active set.
     # +
-    states = []
-    for k in range(1, args.steps + 1):
-        t = k / args.steps
-        if args.force is not None:
-            guess = states[-1].indentation * t ** (2 / 3) / ((k - 1) / args.steps) ** (2 / 3) \
-                if states else a * a / args.radius * t ** (2 / 3)
-            s, _ = punch.push(t * args.force, guess)
-        else:
-            s = punch.indent(t * args.indentation)
-        states.append(s)
-        say(f"step {k}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
+    load = PunchLoad(punch, indentation=args.indentation, force=args.force,
+                     first_guess=a * a / args.radius)
+    states = load.states
+
+    def report(t, result):
+        s = states[-1]
+        say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
             f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
             f"{s.active_set_iterations} active-set iterations")
+
+    solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
+                        on_step=report)
     # -
 
     last = states[-1]

@@ -16,7 +16,7 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import boundary, elastica, kinematics
+from fenics_nl import boundary, elastica, kinematics, output
 from fenics_nl.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.elastica import euler_load
 from fenics_nl.errors import SolveError
@@ -81,7 +81,7 @@ class Beam:
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
-        return self.V.dofmap.index_map.size_global * 2
+        return output.dofs(self.V)
 
     def set_load(self, P: float) -> None:
         """Dead end load: axial compression P and the lateral imperfection ε P."""

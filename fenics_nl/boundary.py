@@ -15,7 +15,12 @@ def fixed(V: fem.FunctionSpace, facets: np.ndarray) -> fem.DirichletBC:
 
 def component(V: fem.FunctionSpace, i: int, facets: np.ndarray, value: float = 0.0
               ) -> fem.DirichletBC:
-    """u_i = value on `facets` (located through the collapsed sub-space, see CONVENTIONS)."""
+    """u_i = value on `facets`.
+
+    On a blocked space, `locate_dofs_topological(V, ...)` returns block indices; one
+    component is located through the pair (V.sub(i), its collapsed space), whose dofs
+    `dirichletbc` expects (passing unrolled indices instead corrupts memory).
+    """
     fdim = V.mesh.topology.dim - 1
     Vi, _ = V.sub(i).collapse()
     dofs = fem.locate_dofs_topological((V.sub(i), Vi), fdim, facets)

@@ -1,6 +1,6 @@
 """The bracket scene: a 3D gmsh part, a power-law material, bolts and a rigid floor.
 
-The mesh comes from `meshes/bracket.py` (built on rank 0, distributed) or from a user's
+The mesh comes from `fenics_nl.bracket_geometry` (built on rank 0, distributed) or from a user's
 .msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
 a uniform traction of total force F along +x; the bolt holes are clamped, and with
 ``support="contact"`` the base also rests on a rigid floor (frictionless, may lift off).
@@ -8,7 +8,6 @@ a uniform traction of total force F along +x; the bolt holes are clamped, and wi
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import gmsh
@@ -18,30 +17,19 @@ from dolfinx import fem
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-from fenics_nl import boundary, kinematics
+from fenics_nl import boundary, bracket_geometry, kinematics, output
 from fenics_nl.contact import ActiveSetContact
 from fenics_nl.mesh_check import check_cells
 from fenics_nl.newton import NewtonSolver
 from fenics_nl.snes import SnesSolver
 
 GROUPS = ("bolts", "load", "base")
-GEOMETRY = Path(__file__).resolve().parents[1] / "meshes" / "bracket.py"
-
-
-def _geometry():
-    """The gmsh geometry module `meshes/bracket.py` (its dimensions and `build`)."""
-    spec = importlib.util.spec_from_file_location("bracket_geometry", GEOMETRY)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-THICKNESS_MM = _geometry().THICK  # the base plate's thickness
+THICKNESS_MM = bracket_geometry.THICK  # the base plate's thickness
 
 
 def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None,
               length_scale: float = 1.0):
-    """MeshData from `meshes/bracket.py` (element size `size` in mm) or from a .msh file.
+    """MeshData from `bracket_geometry` (element size `size` in mm) or from a .msh file.
 
     The built geometry is in mm; `length_scale` (the length of 1 mm in the user's unit,
     1e-3 for metres) scales its coordinates. A file is read in its own units.
@@ -55,11 +43,10 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
             raise ValueError(f"cannot read mesh file {path}: {err}") from None
         check_cells(data.mesh, name=path)  # a file may hold anything: inverted cells too
     else:
-        geometry = _geometry()
         if comm.rank == 0:
             if not gmsh.isInitialized():
                 gmsh.initialize(interruptible=False)
-            geometry.build(size)
+            bracket_geometry.build(size)
         data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
         if comm.rank == 0:
             gmsh.model.remove()
@@ -147,7 +134,7 @@ class Bracket:
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
-        return self.V.dofmap.index_map.size_global * 3
+        return output.dofs(self.V)
 
     def set_load(self, force: float) -> None:
         """Total force `force` [N] along +x, spread uniformly over the loaded hole."""

@@ -32,17 +32,17 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
-from dolfinx import fem, la, mesh
+from dolfinx import fem, mesh
 from dolfinx.fem import petsc
-from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_nl.contact_surface import ContactSurface, global_max
 from fenics_nl.errors import SolveError
-from fenics_nl.newton import NewtonSolver, WorkCounts
+from fenics_nl.newton import NewtonSolver
+from fenics_nl.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
@@ -53,32 +53,53 @@ class ContactError(SolveError):
     """The active-set iteration cycled or did not settle within its limit."""
 
 
-@dataclass
-class ContactResult:
-    """Outcome of one contact solve."""
+class EliminationSystem:
+    """One active-set iteration with the active normal displacements as Dirichlet rows.
 
-    iterations: int
-    active_sizes: list[int]  # global number of active nodes after each iteration
-    newton_iterations: int
-    linear_solves: int
-    factorizations: int
-    wall_time: float
-    force: float = 0.0  # total normal contact force, −Σ T_n (positive in compression)
-    history: list[dict] = field(default_factory=list)
-    work: WorkCounts = field(default_factory=WorkCounts)  # summed over the inner solves
-    residual_norms: list[float] = field(default_factory=list)  # of the last inner solve
-
-
-class ActiveSetContact:
-    """Active-set contact solver on a flat candidate surface with normal ±e_axis.
-
-    With ``newton_options={"reuse_factorization": True}`` (elimination), an iteration
-    that changes at most SMALL_CHANGE nodes keeps the last factorization as a CG
-    preconditioner: the new matrix differs by a few rows and columns, so CG needs about
-    two iterations per changed node.
+    The contact forces are the residual's reactions on S_C. With
+    ``reuse_factorization`` (the default) an iteration that changes at most SMALL_CHANGE
+    nodes keeps the last factorization as a CG preconditioner: the new matrix differs by a
+    few rows and columns, so CG needs about two iterations per changed node.
     """
 
     SMALL_CHANGE = 8
+
+    def __init__(self, residual: ufl.Form, u: fem.Function, bcs: Sequence[fem.DirichletBC],
+                 surface: ContactSurface, *, prefix: str, **newton_options):
+        self.u, self.bcs, self.surface = u, list(bcs), surface
+        self._R = fem.form(residual)
+        self._reaction = petsc.create_vector(u.function_space)
+        opts = {"reuse_factorization": True, **newton_options}
+        self.newton = NewtonSolver(residual, u, self.bcs, prefix=prefix, **opts)
+
+    def set_active(self, active: np.ndarray, changes: int | None) -> None:
+        """u_n = γ on the active nodes; `changes`: nodes changed since the last solve."""
+        small = changes is not None and changes <= self.SMALL_CHANGE
+        self.newton.set_bcs([*self.bcs, self.surface.dirichlet(active)], small_change=small)
+
+    def solve(self) -> SolveResult:
+        """Newton on the current set."""
+        return self.newton.solve()
+
+    def normal_forces(self) -> np.ndarray:
+        """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
+        b = self._reaction
+        with b.localForm() as loc:
+            loc.set(0.0)
+        petsc.assemble_vector(b, self._R)
+        b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        with b.localForm() as loc:
+            return self.surface.sign * loc.array_r[self.surface.dofs_V].copy()
+
+
+class ActiveSetContact:
+    """The course's active-set loop over a contact surface and one formulation.
+
+    The formulation (``elimination`` or ``multiplier``) solves one iteration for a given
+    set: `set_active(active, changes)`, `solve() -> SolveResult`, `normal_forces()`.
+    The loop, the set's update rules and its meshtags are written once, here.
+    """
 
     def __init__(
         self,
@@ -104,229 +125,121 @@ class ActiveSetContact:
         V = u.function_space
         if V.element.basix_element.degree != 1 and formulation == "multiplier":
             raise ValueError("the multiplier formulation needs a P1 displacement space")
-        self.u, self.bcs, self.gap_fn = u, list(bcs), gap
-        self.axis, self.sign = normal_axis, int(np.sign(normal_sign))
-        self.formulation, self.max_iterations = formulation, max_iterations
-        self.mesh = V.mesh
-        self.comm = self.mesh.comm
-        fdim = self.mesh.topology.dim - 1
-        self.facets = np.asarray(facets, dtype=np.int32)
-        if self.comm.allreduce(len(self.facets)) == 0:
-            raise ValueError("the contact surface has no facets (missing or wrong tag?)")
-        if V.dofmap.index_map_bs == 1:  # one component (a bar): no sub-space to extract
-            self.Vn, self._Vsub = V, V
-            self.dofs_V = self.dofs_n = fem.locate_dofs_topological(V, fdim, self.facets)
-        else:
-            self._Vsub = V.sub(self.axis)
-            self.Vn, _ = self._Vsub.collapse()
-            dofs = fem.locate_dofs_topological((self._Vsub, self.Vn), fdim, self.facets)
-            self.dofs_V, self.dofs_n = dofs[0], dofs[1]
-        self.x = self.Vn.tabulate_dof_coordinates()[self.dofs_n]
-        self.gamma = np.asarray(gap(self.x.T), dtype=float)  # γ at the S_C nodes
-        self.g = fem.Function(self.Vn)  # prescribed u_axis = sign·γ on active nodes
-        self.g.x.array[self.dofs_n] = self.sign * self.gamma
-        self._flags = la.vector(self.Vn.dofmap.index_map)  # 1.0 = active, synced to ghosts
-        self._R = fem.form(residual)
-        self._reaction = petsc.create_vector(V)
-        self._vertex_of_dof = _vertex_of_dof(self.Vn)
+        self.u, self.formulation, self.max_iterations = u, formulation, max_iterations
+        self.surface = ContactSurface(V, facets, gap, normal_axis=normal_axis,
+                                      normal_sign=normal_sign)
+        self.comm = self.surface.comm
         self.active = self._initial_set(initial)
-        opts = {"method": "full", "rtol": 1e-10, "max_it": 50}
-        if formulation == "elimination":
-            opts["reuse_factorization"] = True
-        opts.update(newton_options or {})
+        self.force = 0.0  # total normal contact force of the last solve (compression > 0)
+        opts = {"method": "full", "rtol": 1e-10, "max_it": 50, **(newton_options or {})}
         prefix += formulation[:4] + "_"  # each formulation reads its own PETSc options
         if formulation == "elimination":
-            self.solver = NewtonSolver(residual, u, self._bcs(), prefix=prefix, **opts)
+            self.system = EliminationSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         else:
             from fenics_nl.contact_multiplier import MultiplierSystem
 
-            self.solver = MultiplierSystem(residual, u, self.bcs, self, prefix=prefix, **opts)
+            self.system = MultiplierSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
+        self.system.set_active(self.active, None)
 
-    # -- set bookkeeping ---------------------------------------------------------------
+    # -- the surface's quantities, for the current state --------------------------------
 
-    def _sync(self, local: np.ndarray) -> np.ndarray:
-        """Owners' values of a nodal flag array pushed to the ghosts."""
-        self._flags.array[:] = 0.0
-        self._flags.array[self.dofs_n] = local
-        self._flags.scatter_forward()
-        return self._flags.array[self.dofs_n] > 0.5
+    @property
+    def x(self) -> np.ndarray:
+        """Coordinates of the S_C nodes."""
+        return self.surface.x
 
-    def _initial_set(self, initial: str) -> np.ndarray:
-        if initial == "all":  # the course's S_C^(0) = S_C
-            return np.ones(len(self.dofs_n), dtype=bool)
-        if initial == "none":
-            return np.zeros(len(self.dofs_n), dtype=bool)
-        u_n = self.sign * self.u.x.array[self.dofs_V]
-        return self._sync(u_n - self.gamma >= 0)
-
-    def _bcs(self) -> list[fem.DirichletBC]:
-        a = self.active
-        if self._Vsub is self.Vn:
-            bc = fem.dirichletbc(self.g, self.dofs_V[a])
-        else:
-            bc = fem.dirichletbc(self.g, [self.dofs_V[a], self.dofs_n[a]], self._Vsub)
-        return [*self.bcs, bc]
-
-    def _owned(self) -> np.ndarray:
-        """Mask of the S_C nodes this rank owns (counts and sums use only these)."""
-        return self.dofs_n < self.Vn.dofmap.index_map.size_local
-
-    owned = property(_owned, doc="Mask of the S_C nodes this rank owns.")
-
-    def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
-        """A function on the normal component's space: `values` at the S_C nodes, 0 elsewhere.
-
-        For writing out the contact pressure or the active set.
-        """
-        f = fem.Function(self.Vn, name=name)
-        f.x.array[self.dofs_n] = values
-        f.x.scatter_forward()
-        return f
-
-    # -- contact quantities ------------------------------------------------------------
+    @property
+    def owned(self) -> np.ndarray:
+        """Mask of the S_C nodes this rank owns."""
+        return self.surface.owned
 
     def normal_forces(self) -> np.ndarray:
-        """Nodal normal contact forces T_n = n·(f_int − f_ext) at the S_C nodes.
-
-        The residual without any condition on S_C is the force the obstacle exerts there.
-        Negative in compression.
-        """
-        if self.formulation == "multiplier":
-            return self.solver.normal_forces()
-        b = self._reaction
-        with b.localForm() as loc:
-            loc.set(0.0)
-        petsc.assemble_vector(b, self._R)
-        b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-        b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        with b.localForm() as loc:
-            return self.sign * loc.array_r[self.dofs_V].copy()
-
-    def nodal_areas(self, weight=1.0) -> np.ndarray:
-        """Lumped areas m_j = ∫_{S_C} φ_j w ds at the S_C nodes (w = 2πr if axisymmetric)."""
-        if not hasattr(self, "_areas"):
-            V = self.u.function_space
-            fdim = self.mesh.topology.dim - 1
-            tags = mesh.meshtags(self.mesh, fdim, np.sort(self.facets),
-                                 np.ones(len(self.facets), dtype=np.int32))
-            ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
-            v = ufl.TestFunction(V)
-            b = petsc.assemble_vector(fem.form(v[self.axis] * weight * ds))
-            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-            with b.localForm() as loc:
-                self._areas = loc.array_r[self.dofs_V].copy()
-        return self._areas
-
-    def pressure(self, weight=1.0) -> np.ndarray:
-        """Nodal contact pressure p_j = −T_n,j / m_j (positive in compression)."""
-        return -self.normal_forces() / self.nodal_areas(weight)
+        """Nodal normal contact forces T_n at the S_C nodes (negative in compression)."""
+        return self.system.normal_forces()
 
     def normal_gap(self) -> np.ndarray:
         """u_n − γ at the S_C nodes (positive = penetration)."""
-        return self.sign * self.u.x.array[self.dofs_V] - self.gamma
+        return self.surface.normal_gap(self.u)
+
+    def pressure(self, weight=1.0) -> np.ndarray:
+        """Nodal contact pressure p_j = −T_n,j / m_j (positive in compression)."""
+        return -self.normal_forces() / self.surface.nodal_areas(weight)
 
     def total_force(self, T_n: np.ndarray | None = None) -> float:
-        """−Σ T_n over owned S_C nodes, summed over ranks (positive in compression)."""
-        T_n = self.normal_forces() if T_n is None else T_n
-        return 0.0 - self.comm.allreduce(float(np.sum(T_n[self._owned()])))  # no −0.0
+        """−Σ T_n over S_C, summed over ranks (positive in compression)."""
+        return 0.0 - self.surface.total(self.normal_forces() if T_n is None else T_n)
 
     def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
         """New obstacle position (a load step); the active set is kept as a warm start."""
-        self.gap_fn = gap
-        self.gamma = np.asarray(gap(self.x.T), dtype=float)
-        self.g.x.array[self.dofs_n] = self.sign * self.gamma
+        self.surface.set_gap(gap)  # the formulation reads γ at its next set_active
 
-    # -- the loop ----------------------------------------------------------------------
-
-    def solve(self) -> ContactResult:
-        """Run the active-set iteration to a fixed set; raise ContactError if it cannot."""
-        t0 = time.perf_counter()
-        seen = set()
-        res = ContactResult(0, [], 0, 0, 0, 0.0)
-        owned = self._owned()
-        changes = None  # nodes that changed since the last solve (None: unknown, many)
-        for k in range(1, self.max_iterations + 1):
-            if self.formulation == "elimination":
-                small = changes is not None and changes <= self.SMALL_CHANGE
-                self.solver.set_bcs(self._bcs(), small_change=small)
-            else:
-                self.solver.set_active(self.active)
-            nr = self.solver.solve()
-            res.newton_iterations += nr.iterations
-            res.linear_solves += nr.work.linear_solves
-            res.factorizations += nr.work.factorizations
-            res.work.add(nr.work)
-            res.residual_norms = nr.residual_norms
-            T_n, d = self.normal_forces(), self.normal_gap()
-            scale_T = self.comm.allreduce(float(np.max(np.abs(T_n), initial=0.0)), op=MPI.MAX)
-            # the problem's own displacement scale: the obstacle's gap, or the motion itself
-            scale_u = self.comm.allreduce(max(float(np.max(np.abs(self.gamma), initial=0.0)),
-                                              float(np.max(np.abs(self.u.x.array), initial=0.0))),
-                                          op=MPI.MAX)
-            leave = self.active & (T_n > 1e-10 * scale_T)
-            join = ~self.active & (d > 1e-10 * scale_u)
-            new = self._sync((self.active & ~leave) | join)
-            changes = self.comm.allreduce(int(np.sum((new != self.active)[owned])))
-            n_active = self.comm.allreduce(int(np.sum(new[owned])))
-            res.iterations, res.active_sizes = k, [*res.active_sizes, n_active]
-            res.history.append({"active": n_active, "left": self.comm.allreduce(
-                int(np.sum(leave[owned]))), "joined": self.comm.allreduce(int(np.sum(join[owned]))),
-                "newton_iterations": nr.iterations})
-            log.info("active set iteration %d: %d active, %d changes", k, n_active, changes)
-            if changes == 0:
-                res.force = self.total_force(T_n)
-                res.wall_time = time.perf_counter() - t0
-                return res
-            key = self._fingerprint(new)
-            if key in seen:
-                raise ContactError(f"active set cycles (iteration {k}, {n_active} active nodes)")
-            seen.add(key)
-            self.active = new
-        raise ContactError(f"active set did not settle in {self.max_iterations} iterations")
-
-    def _fingerprint(self, mask: np.ndarray) -> tuple[int, int]:
-        """Global signature of a set: its size and the sum of its nodes' global indices."""
-        im = self.Vn.dofmap.index_map
-        gidx = im.local_to_global(self.dofs_n[mask & self._owned()].astype(np.int32))
-        total = int(np.sum(gidx, dtype=np.int64))
-        return self.comm.allreduce(len(gidx)), self.comm.allreduce(total)
-
-    # -- meshtags ----------------------------------------------------------------------
+    def add_penetrating(self) -> None:
+        """Warm start for a new load: the current set, plus every node now penetrating."""
+        self.active = self.surface.sync(self.active | (self.normal_gap() > 0))
 
     def active_vertices(self) -> mesh.MeshTags:
         """Vertex meshtags of the active nodes (value 1)."""
-        verts = self._vertex_of_dof[self.dofs_n[self.active]]
-        verts = verts[verts >= 0]
-        order = np.argsort(verts)
-        return mesh.meshtags(self.mesh, 0, verts[order].astype(np.int32),
-                             np.ones(len(verts), dtype=np.int32))
+        return self.surface.vertex_tags(self.active)
 
     def active_facets(self) -> mesh.MeshTags:
         """Facet meshtags of S_C: 1 where all the facet's vertices are active, else 0."""
-        fdim = self.mesh.topology.dim - 1
-        self.mesh.topology.create_connectivity(fdim, 0)
-        f2v = self.mesh.topology.connectivity(fdim, 0)
-        active_v = np.zeros(self.mesh.topology.index_map(0).size_local
-                            + self.mesh.topology.index_map(0).num_ghosts, dtype=bool)
-        verts = self._vertex_of_dof[self.dofs_n[self.active]]
-        active_v[verts[verts >= 0]] = True
-        values = np.array([active_v[f2v.links(f)].all() for f in self.facets], dtype=np.int32)
-        order = np.argsort(self.facets)
-        return mesh.meshtags(self.mesh, fdim, self.facets[order], values[order])
+        return self.surface.facet_tags(self.active)
 
+    def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
+        """`values` at the S_C nodes as a function, for output."""
+        return self.surface.nodal_field(values, name)
 
-def _vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
-    """Mesh vertex of each dof of a scalar Lagrange space, −1 for dofs not at a vertex.
+    def _initial_set(self, initial: str) -> np.ndarray:
+        n = len(self.surface.dofs_n)
+        if initial == "all":  # the course's S_C^(0) = S_C
+            return np.ones(n, dtype=bool)
+        if initial == "none":
+            return np.zeros(n, dtype=bool)
+        return self.surface.sync(self.normal_gap() >= 0)
 
-    A Lagrange cell numbers its vertex dofs first, in the order of the cell's vertices.
-    """
-    topo = V.mesh.topology
-    tdim = topo.dim
-    topo.create_connectivity(tdim, 0)
-    c2v = topo.connectivity(tdim, 0).array.reshape(-1, tdim + 1)
-    dofs = V.dofmap.list[:, : tdim + 1]
-    out = np.full(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, -1,
-                  dtype=np.int32)
-    out[dofs.ravel()] = c2v[: dofs.shape[0]].ravel()
-    return out
+    # -- the loop ----------------------------------------------------------------------
+
+    def solve(self) -> SolveResult:
+        """Run the active-set iteration to a fixed set; raise ContactError if it cannot.
+
+        The result counts the Newton iterations and the work of every inner solve, the
+        active-set iterations, and keeps the last inner solve's residual history; the total
+        contact force is left in `force`.
+        """
+        t0 = time.perf_counter()
+        seen = set()
+        res = SolveResult(False, "active set", 0, [], WorkCounts())
+        S = self.surface
+        changes = None  # nodes that changed since the last solve (None: unknown, many)
+        for k in range(1, self.max_iterations + 1):
+            self.system.set_active(self.active, changes)
+            nr = self.system.solve()
+            res.iterations += nr.iterations
+            res.work.add(nr.work)
+            res.residual_norms = nr.residual_norms
+            T_n, d = self.normal_forces(), self.normal_gap()
+            # thresholds from the problem's own scales: the largest contact force, and the
+            # obstacle's gap or the motion itself
+            scale_T = global_max(self.comm, T_n)
+            scale_u = max(global_max(self.comm, S.gamma), global_max(self.comm, self.u.x.array))
+            leave = self.active & (T_n > 1e-10 * scale_T)
+            join = ~self.active & (d > 1e-10 * scale_u)
+            new = S.sync((self.active & ~leave) | join)
+            changes = S.count(new != self.active)
+            n_active = S.count(new)
+            res.active_set_iterations, res.active_sizes = k, [*res.active_sizes, n_active]
+            res.history.append({"active": n_active, "left": S.count(leave),
+                                "joined": S.count(join), "newton_iterations": nr.iterations})
+            log.info("active set iteration %d: %d active, %d changes", k, n_active, changes)
+            if changes == 0:
+                self.force = self.total_force(T_n)
+                res.converged, res.reason = True, "active set fixed"
+                res.wall_time = time.perf_counter() - t0
+                return res
+            key = S.fingerprint(new)
+            if key in seen:
+                raise ContactError(f"active set cycles (iteration {k}, {n_active} active nodes)",
+                                   res)
+            seen.add(key)
+            self.active = new
+        raise ContactError(f"active set did not settle in {self.max_iterations} iterations", res)

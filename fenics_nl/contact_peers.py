@@ -18,7 +18,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_nl.newton import NewtonSolver
-from fenics_nl.snes import EVENTS, EventCounter, petsc_work, scale_absolute_tolerance
+from fenics_nl.snes import EventCounter, all_event_names, petsc_work, scale_absolute_tolerance
 
 
 def _surface_measure(punch):
@@ -34,7 +34,7 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     u = punch.u
     u.x.array[:] = 0.0
     c = punch.contact
-    c.set_gap(punch._gap(delta))
+    c.set_gap(punch.gap(delta))
     opts = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_stol": 0.0,
             "snes_max_it": 100, "ksp_type": "preonly", "pc_type": "lu",
             "pc_factor_mat_solver_type": "mumps"}
@@ -44,11 +44,10 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     lower.set(PETSc.NINFINITY)
     upper.set(PETSc.INFINITY)
     with upper.localForm() as up:  # u_axis ≤ sign·γ, i.e. u_n ≤ γ (sign = +1 here)
-        up.array[c.dofs_V] = c.sign * c.gamma
+        up.array[c.surface.dofs_V] = c.surface.sign * c.surface.gamma
     problem.solver.setVariableBounds(lower, upper)
     scale_absolute_tolerance(problem.solver, 1e-12)
-    counter = EventCounter([n for v in EVENTS.values() for n in ((v,) if isinstance(v, str)
-                                                                  else v)])
+    counter = EventCounter(all_event_names())
     t0 = time.perf_counter()
     problem.solve()
     wall = time.perf_counter() - t0
@@ -64,7 +63,7 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
     """The punch at indentation δ with a penalty stiffness k [Pa/m] on the penetration."""
     u, c = punch.u, punch.contact
     u.x.array[:] = 0.0
-    c.set_gap(punch._gap(delta))
+    c.set_gap(punch.gap(delta))
     x = ufl.SpatialCoordinate(punch.mesh)
     r2 = x[0] ** 2 + (x[1] ** 2 if punch.model == "3d" else 0)
     gamma = r2 / (2 * punch.R) - delta
@@ -72,10 +71,10 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
         raise ValueError("the penalty peer is written for the parabolic gap")
     v = ufl.TestFunction(u.function_space)
     k = fem.Constant(punch.mesh, float(stiffness))
-    pen = ufl.max_value(c.sign * u[c.axis] - gamma, 0.0)
+    pen = ufl.max_value(c.surface.sign * u[c.surface.axis] - gamma, 0.0)
     ds = _surface_measure(punch)
     w = punch.weight
-    R = punch.residual + k * pen * c.sign * v[c.axis] * w * ds
+    R = punch.residual + k * pen * c.surface.sign * v[c.surface.axis] * w * ds
     solver = NewtonSolver(R, u, punch.bcs, method="full", line_search=True, prefix=prefix,
                           rtol=1e-10, atol=1e-12, max_it=100)
     t0 = time.perf_counter()

@@ -7,4 +7,12 @@ Bad parameters are `ValueError`. Anything else is a bug and keeps its traceback.
 
 
 class SolveError(RuntimeError):
-    """A solve failed: the problem as posed could not be solved by the chosen method."""
+    """A solve failed: the problem as posed could not be solved by the chosen method.
+
+    `result` (a `fenics_nl.result.SolveResult`, or None) holds what was done up to the
+    failure: iterations, work counts, residual history.
+    """
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result

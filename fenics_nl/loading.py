@@ -5,6 +5,12 @@ the state by extrapolating the last two converged ones (secant predictor), calls
 and on failure restores the last converged state and halves the step. After an easy step
 (few iterations) the step grows. Below `min_step` it stops with a clear error.
 
+Any solver fits that has `u` (the unknown Function) and `solve()` returning a
+`SolveResult` or raising a `SolveError`: NewtonSolver, SnesSolver, ActiveSetContact.
+Path-dependent state that the solver itself does not hold (internal variables at
+quadrature points, slip at contact nodes) is kept right by two hooks: `commit()` after each
+converged step, `restore()` when a step is cut (the displacement is restored here).
+
 The predictor matters past a bifurcation: from the last state alone Newton can settle on a
 nearby unstable branch (a column that stays straight above its Euler load); extrapolation
 carries the growing buckling mode into the next step.
@@ -17,13 +23,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fenics_nl.errors import SolveError
-from fenics_nl.newton import ConvergenceError, NewtonResult, WorkCounts
+from fenics_nl.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
 
 class LoadStepError(SolveError):
-    """The load could not be reached: the step was cut below its minimum."""
+    """The load could not be reached: the step was cut below its minimum.
+
+    `reached` is the last converged load factor, `target` the one that failed.
+    """
+
+    def __init__(self, message: str, result=None, *, reached: float = 0.0, target: float = 0.0):
+        super().__init__(message, result)
+        self.reached, self.target = reached, target
 
 
 @dataclass
@@ -31,7 +44,7 @@ class LoadPath:
     """Converged load factors and their solve results."""
 
     factors: list[float] = field(default_factory=list)
-    results: list[NewtonResult] = field(default_factory=list)
+    results: list[SolveResult] = field(default_factory=list)
     failures: int = 0
     work: WorkCounts = field(default_factory=WorkCounts)
 
@@ -51,8 +64,10 @@ def solve_incrementally(
     max_step: float = 1.0,
     easy_iterations: int = 4,
     predictor: bool = True,
-    on_step: Callable[[float, NewtonResult], None] | None = None,
+    on_step: Callable[[float, SolveResult], None] | None = None,
     progress: Callable[[str], None] | None = None,
+    commit: Callable[[], None] | None = None,
+    restore: Callable[[], None] | None = None,
 ) -> LoadPath:
     """Drive the load factor from 0 to 1, starting with `steps` equal increments."""
     if steps < 1:
@@ -71,21 +86,26 @@ def solve_incrementally(
             x.ghostUpdate()
         try:
             result = solver.solve()
-        except ConvergenceError as err:
+        except SolveError as err:
             path.failures += 1
-            path.work.add(err.result.work)
+            if err.result is not None:
+                path.work.add(err.result.work)
             saved.copy(x)
             x.ghostUpdate()
+            if restore:
+                restore()
             if not adaptive or dt / 2 < min_step:
                 set_load(t)
                 raise LoadStepError(f"load factor {t + dt:.4g} not reached from {t:.4g}: {err}"
-                                    + ("" if not adaptive else f"; step cut below {min_step:g}")
-                                    ) from err
+                                    + ("" if not adaptive else f"; step cut below {min_step:g}"),
+                                    err.result, reached=t, target=t + dt) from err
             dt /= 2
             if progress:
                 progress(f"  step to t = {t + 2 * dt:.4g} failed ({err}); cut to dt = {dt:.4g}")
             continue
         t += dt
+        if commit:
+            commit()
         if predictor:
             if previous is None:
                 previous = saved.duplicate()

@@ -27,7 +27,6 @@ import logging
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
@@ -37,69 +36,18 @@ from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
 
-from fenics_nl.convergence import observed_orders
+from fenics_nl import output
 from fenics_nl.errors import SolveError
 from fenics_nl.linear_solver import create_ksp, rigid_body_modes
+from fenics_nl.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
 METHODS = ("full", "modified", "periodic", "bfgs")
-PHASES = ("residual", "tangent", "factorization", "solve")
 
 
 class ConvergenceError(SolveError):
     """A non-linear solve failed; `result` holds what was done up to the failure."""
-
-    def __init__(self, message: str, result: NewtonResult):
-        super().__init__(message)
-        self.result = result
-
-
-@dataclass
-class WorkCounts:
-    """What a solve spent: assemblies, factorizations, linear solves and time per phase."""
-
-    residual_assemblies: int = 0
-    tangent_assemblies: int = 0
-    factorizations: int = 0
-    linear_solves: int = 0
-    krylov_iterations: int = 0  # CG iterations (GAMG, or a reused factorization), else 0
-    time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
-
-    def add(self, other: WorkCounts) -> None:
-        """Accumulate `other` into self."""
-        self.residual_assemblies += other.residual_assemblies
-        self.tangent_assemblies += other.tangent_assemblies
-        self.factorizations += other.factorizations
-        self.linear_solves += other.linear_solves
-        self.krylov_iterations += other.krylov_iterations
-        for k, v in other.time.items():
-            self.time[k] = self.time.get(k, 0.0) + v
-
-
-@dataclass
-class NewtonResult:
-    """Outcome of one non-linear solve."""
-
-    converged: bool
-    reason: str
-    iterations: int
-    residual_norms: list[float]
-    work: WorkCounts
-    wall_time: float = 0.0
-    elapsed: list[float] = field(default_factory=list)  # seconds from the start, per norm
-
-    @property
-    def orders(self) -> list[float]:
-        """Observed orders from the residual norms (round-off tail excluded)."""
-        r = self.residual_norms
-        return observed_orders(r, floor=1e-11 * max(r)) if r else []
-
-    @property
-    def order(self) -> float:
-        """Last observed order, NaN when fewer than three meaningful residuals exist."""
-        q = self.orders
-        return q[-1] if q else math.nan
 
 
 def forcing_term(relative_residual: float) -> float:
@@ -138,6 +86,116 @@ class _Timer:
         self.work.time[self.phase] += time.perf_counter() - self.t0
 
 
+class TangentPolicy:
+    """When the tangent is rebuilt and refactorized, and when a factorization is reused.
+
+    * ``full``: every iteration; ``periodic``: every `period` iterations; ``modified`` and
+      ``bfgs``: once per solve, or once for the solver's life with the elastic tangent;
+    * a tangent with no coefficient (linear material) once per solve: it is exact;
+    * with `reuse` (a direct solver as CG preconditioner), a new tangent keeps the last
+      factorization while CG on it needs at most REUSE_ITERATIONS iterations, or while the
+      Dirichlet rows changed only a little (`bcs_changed(small=True)`).
+    """
+
+    REUSE_ITERATIONS = 10
+
+    def __init__(self, method: str, period: int, *, fixed: bool, for_life: bool, reuse: bool):
+        self.method, self.period = method, period
+        self.fixed, self.for_life, self.reuse = fixed, for_life, reuse
+        self.ready = False  # a tangent valid for this solve is assembled and factorized
+        self.factorization_current = False  # the factorization is of the current tangent
+
+    def start_solve(self) -> None:
+        """A new solve: the state moved, so every tangent but a life-long one is stale."""
+        if not self.for_life:
+            self.ready = False
+
+    def bcs_changed(self, small: bool) -> None:
+        """New Dirichlet rows: rebuild the tangent; refactorize unless only a few changed."""
+        self.ready = False
+        if not small:
+            self.factorization_current = False
+
+    def needs_tangent(self, k: int) -> bool:
+        """At iteration k."""
+        if self.fixed and self.ready:
+            return False  # a linear material: the tangent built for this solve is exact
+        if self.method == "full":
+            return True
+        if self.method == "periodic":
+            return k % self.period == 0
+        return not self.ready
+
+    def needs_factorization(self) -> bool:
+        """After a tangent assembly."""
+        return not (self.reuse and self.factorization_current)
+
+    def factorized(self) -> None:
+        """A factorization of the current tangent was made."""
+        self.factorization_current = True
+
+    def assembled(self) -> None:
+        """The tangent for this solve is in place."""
+        self.ready = True
+
+    def krylov_iterations(self, its: int) -> None:
+        """CG on a reused factorization took `its`: beyond a few, refactorize next time."""
+        self.factorization_current = its <= self.REUSE_ITERATIONS
+
+
+class InverseBFGS:
+    """L-BFGS corrections of a constant tangent's inverse (Matthies–Strang), two-loop form.
+
+    du = H R with H built on H0 = K0⁻¹ from the last `memory` pairs s_i = u_{i+1} − u_i,
+    y_i = R_{i+1} − R_i, ρ_i = 1/(y_i·s_i); one solve with K0 per iteration.
+    """
+
+    def __init__(self, memory: int):
+        self.memory = memory
+        self.pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []
+
+    def direction(self, b: PETSc.Vec, du: PETSc.Vec, solve) -> None:
+        """du = H b; `solve(q)` puts K0⁻¹ q into du."""
+        q = b.copy()
+        alphas = []
+        for s, y, rho in reversed(self.pairs):
+            a = rho * s.dot(q)
+            q.axpy(-a, y)
+            alphas.append(a)
+        solve(q)
+        for (s, y, rho), a in zip(self.pairs, reversed(alphas), strict=True):
+            du.axpy(a - rho * y.dot(du), s)
+        q.destroy()
+
+    def store(self, du: PETSc.Vec, alpha: float, b_old: PETSc.Vec, b_new: PETSc.Vec) -> None:
+        """Keep s = −α du and y = b_new − b_old if y·s > 0 (H stays positive definite)."""
+        s = du.copy()
+        s.scale(-alpha)
+        y = b_old.copy()
+        y.aypx(-1.0, b_new)
+        ys = y.dot(s)
+        if not ys > 1e-12 * y.norm() * s.norm():
+            s.destroy()
+            y.destroy()
+            return  # curvature condition fails: skip the update
+        self.pairs.append((s, y, 1.0 / ys))
+        if len(self.pairs) > self.memory:
+            for v in self.pairs.pop(0)[:2]:
+                v.destroy()
+
+    def clear(self) -> None:
+        """Forget every pair (a new solve), destroying their vectors."""
+        for s, y, _ in self.pairs:
+            s.destroy()
+            y.destroy()
+        self.pairs.clear()
+
+
+class _LinearSolveFailed(Exception):
+    def __init__(self, reason: int):
+        super().__init__(f"linear solver failed (KSP reason {reason})")
+
+
 class NewtonSolver:
     """Hand-written Newton loop for R(u; v) = 0; `solve()` updates `u` in place.
 
@@ -153,9 +211,33 @@ class NewtonSolver:
     refactorized; CG on it is preconditioned by the last factorization, which is renewed
     only when CG needed more than REUSE_ITERATIONS iterations. Where the tangent changes by
     a low-rank term (a few constrained rows), CG converges in a handful of iterations.
-    """
 
-    REUSE_ITERATIONS = 10
+    Args:
+        residual: the residual form R(u; v), linear in the test function v.
+        u: the unknown; its current value is the starting point and holds the solution.
+        bcs: Dirichlet conditions, imposed on u before the first residual.
+        method: ``full``, ``modified``, ``periodic`` or ``bfgs`` (see the module).
+        tangent: the tangent form; by default ∂R/∂u by UFL.
+        constant_tangent: for ``modified`` and ``bfgs``: ``initial`` (the tangent at the
+            start of each solve) or ``elastic`` (K(0), factorized once for the solver's life).
+        period: iterations between tangent rebuilds of ``periodic``.
+        linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
+        prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...).
+        rtol: convergence when ‖R‖ ≤ rtol ‖R₀‖ ...
+        atol: ... or ‖R‖ ≤ atol F, F = `force_scale` (relative too).
+        force_scale: a force of the problem (the load); default the largest ‖R₀‖ seen.
+        max_it: iterations before ConvergenceError.
+        divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ stops with ConvergenceError.
+        line_search: backtracking on ‖R‖ (halving, at most 10 times).
+        bfgs_memory: pairs kept by ``bfgs``.
+        reuse_factorization: keep the last factorization as a CG preconditioner (see above).
+
+    Example::
+
+        solver = NewtonSolver(material.internal_work(u, v) * dx - f * v[2] * ds, u, bcs,
+                              method="bfgs", force_scale=load)
+        result = solver.solve()  # SolveResult: iterations, residual_norms, work
+    """
 
     def __init__(
         self,
@@ -200,44 +282,40 @@ class NewtonSolver:
         # A tangent with no coefficients (linear material) is assembled once; new Dirichlet
         # rows are then applied to a copy instead of reassembling.
         J_expanded = expand_derivatives(J)
-        self._tangent_fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
+        fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
         self._K_fixed = None  # K without Dirichlet rows, kept after its first assembly
-        if constant_tangent == "elastic" and method in ("modified", "bfgs"):
-            # K(0): the same tangent form evaluated at a zero displacement.
-            self._K_const = fem.form(ufl.replace(J, {u: fem.Function(V)}))
-            self._constant_for_life = True
-        else:
-            self._K_const = self._K
-            self._constant_for_life = False
+        for_life = constant_tangent == "elastic" and method in ("modified", "bfgs")
+        # the tangent that is assembled: K(u), or K(0) (the same form at a zero displacement)
+        self._K_used = fem.form(ufl.replace(J, {u: fem.Function(V)})) if for_life else self._K
+        self._constant = method in ("modified", "bfgs")
         self.A = petsc.create_matrix(self._K)
         # reuse: the factorized matrix P lags behind A and preconditions CG on A
-        self.reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
+        reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
-        self._P_current = False
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
         nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
         self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
-                              P=self.A if self.reuse else None, rtol=1e-12)
+                              P=self.A if reuse else None, rtol=1e-12)
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
         own_rtol = linear_solver == "gamg" and not PETSc.Options().hasName(f"{prefix}ksp_rtol")
-        self.forcing = own_rtol and not self._tangent_fixed
-        if own_rtol and self._tangent_fixed:
+        self.forcing = own_rtol and not fixed
+        if own_rtol and fixed:
             self.ksp.setTolerances(rtol=1e-11)
-        if self.reuse and self.ksp.getType() == "preonly":
+        if reuse and self.ksp.getType() == "preonly":
             # options turned CG off: a lagging factorization would then give wrong solves
             log.warning("%sksp_type preonly: factorization reuse disabled", prefix)
-            self.reuse = False
-        self._tangent_ready = False
+            reuse = False
+        self.policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse)
+        self.bfgs = InverseBFGS(bfgs_memory) if method == "bfgs" else None
         self.total = WorkCounts()
 
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
-        im = self.u.function_space.dofmap.index_map
-        return im.size_global * self.u.function_space.dofmap.index_map_bs
+        return output.dofs(self.u.function_space)
 
     def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False) -> None:
         """Replace the Dirichlet conditions (their rows change, so the tangent is stale).
@@ -246,33 +324,27 @@ class NewtonSolver:
         `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
         """
         self.bcs = list(bcs)
-        self._tangent_ready = False
-        if not small_change:
-            self._P_current = False
-
-    def invalidate_tangent(self) -> None:
-        """Force the next iteration to rebuild the tangent."""
-        self._tangent_ready = False
+        self.policy.bcs_changed(small_change)
 
     # -- the loop --------------------------------------------------------------------
 
-    def solve(self) -> NewtonResult:
+    def solve(self) -> SolveResult:
         """Run the loop from the current `u`; raise ConvergenceError on failure."""
         t_start = time.perf_counter()
         work = WorkCounts()
         x = self.u.x.petsc_vec
         petsc.set_bc(x, self.bcs)  # U[bc] = g, so every correction is zero there
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        if not self._constant_for_life:
-            self._tangent_ready = False
-        pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []  # BFGS (s, y, 1/y·s)
+        self.policy.start_solve()
+        if self.bfgs:
+            self.bfgs.clear()
         norms = [self._residual(work)]
         elapsed = [time.perf_counter() - t_start]
         k = 0
 
-        def result(converged: bool, reason: str) -> NewtonResult:
+        def result(converged: bool, reason: str) -> SolveResult:
             self.total.add(work)
-            return NewtonResult(converged, reason, k, norms, work, time.perf_counter() - t_start,
+            return SolveResult(converged, reason, k, norms, work, time.perf_counter() - t_start,
                                 elapsed)
 
         while True:
@@ -291,20 +363,24 @@ class NewtonSolver:
                 raise ConvergenceError(f"residual blew up at iteration {k} "
                                        f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
                                        result(False, "diverged"))
-            if self._needs_tangent(k):
-                self._assemble_tangent(work)
-            if self.forcing:
-                self.ksp.setTolerances(rtol=forcing_term(rnorm / norms[0]))
-            if self.method == "bfgs":
-                b_old = self.b.copy()
-                self._bfgs_direction(pairs, work)
-            else:
-                self._linear_solve(self.b, work)
-            alpha = self._step(rnorm, work)
-            norms.append(self._last_norm)
+            try:
+                if self.policy.needs_tangent(k):
+                    self._assemble_tangent(work)
+                if self.forcing:
+                    self.ksp.setTolerances(rtol=forcing_term(rnorm / norms[0]))
+                if self.bfgs:
+                    b_old = self.b.copy()
+                    self.bfgs.direction(self.b, self.du, lambda q: self._linear_solve(q, work))
+                else:
+                    self._linear_solve(self.b, work)
+            except _LinearSolveFailed as err:
+                raise ConvergenceError(f"{err} at iteration {k}", result(False, "ksp")) from None
+            alpha, rnorm_new = self._step(rnorm, work)
+            norms.append(rnorm_new)
             elapsed.append(time.perf_counter() - t_start)
-            if self.method == "bfgs":
-                self._bfgs_store(pairs, alpha, b_old)
+            if self.bfgs:
+                self.bfgs.store(self.du, alpha, b_old, self.b)
+                b_old.destroy()
             k += 1
 
     # -- pieces ----------------------------------------------------------------------
@@ -313,15 +389,6 @@ class NewtonSolver:
         """max(rtol ‖R₀‖, atol F): both relative to forces of the problem itself."""
         self._largest_r0 = max(self._largest_r0, r0)
         return max(self.rtol * r0, self.atol * (self.force_scale or self._largest_r0))
-
-    def _needs_tangent(self, k: int) -> bool:
-        if self._tangent_fixed and self._tangent_ready:
-            return False  # a linear material: the tangent built for this solve is exact
-        if self.method == "full":
-            return True
-        if self.method == "periodic":
-            return k % self.period == 0
-        return not self._tangent_ready
 
     def _residual(self, work: WorkCounts) -> float:
         """b = R(u) with b[bc] = u − g (zero once imposed); returns ‖b‖."""
@@ -336,17 +403,16 @@ class NewtonSolver:
 
     def _assemble_tangent(self, work: WorkCounts) -> None:
         with _Timer(work, "tangent"):
-            if self._tangent_fixed and not self._uses_constant:
+            if self.policy.fixed and not self._constant:
                 self._apply_bcs_to_fixed_tangent(work)
             else:
                 self.A.zeroEntries()
-                petsc.assemble_matrix(self.A, self._K_const if self._uses_constant else self._K,
-                                      bcs=self.bcs, diag=1.0)
+                petsc.assemble_matrix(self.A, self._K_used, bcs=self.bcs, diag=1.0)
                 self.A.assemble()
                 work.tangent_assemblies += 1
-        if not (self.reuse and self._P_current):
+        if self.policy.needs_factorization():
             self._factorize(work)
-        self._tangent_ready = True
+        self.policy.assembled()
 
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
         """A = K with the Dirichlet rows and columns replaced by the identity (no assembly)."""
@@ -364,20 +430,16 @@ class NewtonSolver:
     def _factorize(self, work: WorkCounts) -> None:
         """Numeric factorization of the current tangent (the symbolic one is reused)."""
         with _Timer(work, "factorization"):
-            if self.reuse and self.P is None:
+            if self.policy.reuse and self.P is None:
                 self.P = self.A.copy()
                 self.ksp.setOperators(self.A, self.P)
-            elif self.reuse:
+            elif self.policy.reuse:
                 self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self.ksp.getPC().setUp()
             work.factorizations += 1
-        self._P_current = True
+        self.policy.factorized()
 
-    @property
-    def _uses_constant(self) -> bool:
-        return self.method in ("modified", "bfgs")
-
-    def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts) -> None:
+    def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
         """du = K⁻¹ rhs (the Newton correction is −du)."""
         with _Timer(work, "solve"):
             self.ksp.solve(rhs, self.du)
@@ -386,60 +448,31 @@ class NewtonSolver:
         its = self.ksp.getIterationNumber()
         if self.ksp.getType() != "preonly":
             work.krylov_iterations += its
-        if self.reuse:
-            if reason < 0:  # the old factorization no longer helps: refactorize, solve again
-                self._factorize(work)
-                return self._linear_solve(rhs, work)
-            # cheaper to refactorize next time than to keep paying many iterations
-            self._P_current = its <= self.REUSE_ITERATIONS
+        if self.policy.reuse and reason < 0 and retry:
+            # the old factorization no longer helps: refactorize, solve once more
+            self._factorize(work)
+            return self._linear_solve(rhs, work, retry=False)
         if reason < 0:
-            raise ConvergenceError(f"linear solver failed (KSP reason {reason})",
-                                   NewtonResult(False, "ksp", 0, [], work))
+            raise _LinearSolveFailed(reason)
+        if self.policy.reuse:  # many iterations: cheaper to refactorize next time
+            self.policy.krylov_iterations(its)
 
-    def _step(self, rnorm: float, work: WorkCounts) -> float:
-        """u ← u − α du with α = 1, or backtracking on ‖R‖ if line search is on."""
+    def _step(self, rnorm: float, work: WorkCounts) -> tuple[float, float]:
+        """u ← u − α du with α = 1, or backtracking on ‖R‖ if line search is on.
+
+        Returns α and the new ‖R‖.
+        """
         x = self.u.x.petsc_vec
         alpha = 1.0
         x.axpy(-alpha, self.du)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        self._last_norm = self._residual(work)
+        norm = self._residual(work)
         if self.line_search:
             for _ in range(10):
-                if math.isfinite(self._last_norm) and self._last_norm <= (1 - 1e-4 * alpha) * rnorm:
+                if math.isfinite(norm) and norm <= (1 - 1e-4 * alpha) * rnorm:
                     break
                 x.axpy(alpha / 2, self.du)  # from u − α du back to u − (α/2) du
                 alpha /= 2
                 x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-                self._last_norm = self._residual(work)
-        return alpha
-
-    def _bfgs_direction(self, pairs, work: WorkCounts) -> None:
-        """du = H R with H the L-BFGS inverse built on H0 = K0⁻¹ (two-loop recursion).
-
-        One solve with the factorized constant tangent per iteration, the rest is vector
-        algebra: s_i = u_{i+1} − u_i, y_i = R_{i+1} − R_i, ρ_i = 1/(y_i·s_i).
-        """
-        q = self.b.copy()
-        alphas = []
-        for s, y, rho in reversed(pairs):
-            a = rho * s.dot(q)
-            q.axpy(-a, y)
-            alphas.append(a)
-        self._linear_solve(q, work)
-        for (s, y, rho), a in zip(pairs, reversed(alphas), strict=True):
-            beta = rho * y.dot(self.du)
-            self.du.axpy(a - beta, s)
-        q.destroy()
-
-    def _bfgs_store(self, pairs, alpha: float, b_old: PETSc.Vec) -> None:
-        """Keep s = u_{k+1} − u_k = −α du and y = R_{k+1} − R_k if y·s > 0."""
-        s = self.du.copy()
-        s.scale(-alpha)
-        y = b_old
-        y.aypx(-1.0, self.b)
-        ys = y.dot(s)
-        if not ys > 1e-12 * y.norm() * s.norm():
-            return  # curvature condition fails: skip the update, keep H positive definite
-        pairs.append((s, y, 1.0 / ys))
-        if len(pairs) > self.bfgs_memory:
-            pairs.pop(0)
+                norm = self._residual(work)
+        return alpha, norm

@@ -16,6 +16,11 @@ from dolfinx import fem
 from mpi4py import MPI
 
 
+def dofs(V: fem.FunctionSpace) -> int:
+    """Global number of scalar unknowns of V (what the scenes report as `dofs`)."""
+    return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+
+
 def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path]:
     """`folder`/<name>.bp for each function (collective); returns the paths."""
     from dolfinx.io import VTXWriter

@@ -26,10 +26,11 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl import boundary, hertz, kinematics
+from fenics_nl import boundary, hertz, kinematics, output
 from fenics_nl.contact import ActiveSetContact
 from fenics_nl.errors import SolveError
 from fenics_nl.meshes import graded_block
+from fenics_nl.result import SolveResult, WorkCounts
 
 MODELS = ("axisymmetric", "3d", "plane-strain")
 
@@ -104,17 +105,17 @@ class Punch:
                 "force_scale": force / self.symmetry_factor}
         opts.update(newton_options or {})
         self.contact = ActiveSetContact(
-            residual, self.u, bcs, facets("contact"), self._gap(0.0), normal_axis=self.vertical,
+            residual, self.u, bcs, facets("contact"), self.gap(0.0), normal_axis=self.vertical,
             normal_sign=1, formulation=formulation, initial="penetrating", newton_options=opts,
             prefix=f"punch_{model.replace('-', '')}_")
 
     @property
     def dofs(self) -> int:
         """Global number of displacement unknowns."""
-        V = self.u.function_space
-        return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        return output.dofs(self.u.function_space)
 
-    def _radius(self, x):
+    def radius_of(self, x):
+        """Distance from the punch axis (the x coordinate in plane strain)."""
         return np.sqrt(x[0] ** 2 + x[1] ** 2) if self.model == "3d" else np.abs(x[0])
 
     def gap_at(self, r, delta: float):
@@ -125,26 +126,27 @@ class Punch:
             return r**2 / (2 * R) - delta
         return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
 
-    def _gap(self, delta: float):
-        return lambda x: self.gap_at(self._radius(x), delta)
+    def gap(self, delta: float):
+        """γ(x) of the punch pressed by δ, for the contact surface."""
+        return lambda x: self.gap_at(self.radius_of(x), delta)
 
     def indent(self, delta: float) -> Indentation:
         """Press the punch down by δ (from the last state's active set)."""
         c = self.contact
-        c.set_gap(self._gap(delta))
-        c.active = c._sync(c.active | (c.normal_gap() > 0))  # warm start + new penetration
+        c.set_gap(self.gap(delta))
+        c.add_penetrating()  # warm start: the last set and what penetrates now
         res = c.solve()
         comm = self.mesh.comm
         radius = self._contact_radius()
         p = c.pressure(self.weight)
         p_max = comm.allreduce(float(np.max(p[c.active], initial=0.0)), op=MPI.MAX)
-        return Indentation(delta, self.symmetry_factor * res.force, radius, p_max,
-                           res.iterations, res.newton_iterations, res.factorizations)
+        return Indentation(delta, self.symmetry_factor * c.force, radius, p_max,
+                           res.active_set_iterations, res.iterations, res.work.factorizations)
 
     def _contact_radius(self) -> float:
         """Distance of the outermost active node from the axis (within h of the true edge)."""
         c = self.contact
-        r = self._radius(c.x[c.active].T) if c.active.any() else np.zeros(0)
+        r = self.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
         return self.mesh.comm.allreduce(float(np.max(r, initial=0.0)), op=MPI.MAX)
 
     def push(self, force: float, delta0: float, rtol: float = 1e-10, max_it: int = 30
@@ -174,7 +176,7 @@ class Punch:
         """
         c = self.contact
         owned = c.owned
-        local = (self._radius(c.x[owned].T), c.pressure(self.weight)[owned], c.active[owned])
+        local = (self.radius_of(c.x[owned].T), c.pressure(self.weight)[owned], c.active[owned])
         parts = self.mesh.comm.gather(local, root=0)
         if self.mesh.comm.rank != 0:
             return None
@@ -210,3 +212,39 @@ class Punch:
         if self.model == "plane-strain":  # a cylinder: no force-indentation law to check
             return hertz.cylinder_from_force(E, nu, self.R, state.force)
         return hertz.sphere_from_indentation(E, nu, self.R, state.indentation)
+
+
+class PunchLoad:
+    """The punch's load path as a solver for `loading.solve_incrementally`.
+
+    The load factor t scales the indentation δ (displacement control) or the force P
+    (force control: δ found by `Punch.push`, started from δ ∝ t^(2/3) as in Hertz).
+    Each converged state is kept in `states`.
+    """
+
+    def __init__(self, punch: Punch, *, indentation: float | None = None,
+                 force: float | None = None, first_guess: float | None = None):
+        if (indentation is None) == (force is None):
+            raise ValueError("give either an indentation or a force")
+        self.punch, self.u = punch, punch.u
+        self.indentation, self.force, self.first_guess = indentation, force, first_guess
+        self.states: list[Indentation] = []
+        self.t, self._t_last = 0.0, 0.0
+
+    def set_load(self, t: float) -> None:
+        """The load factor of the next solve."""
+        self.t = t
+
+    def solve(self) -> SolveResult:
+        """The state at the current load factor, from the last one."""
+        if self.force is None:
+            s = self.punch.indent(self.t * self.indentation)
+        else:
+            guess = (self.states[-1].indentation * (self.t / self._t_last) ** (2 / 3)
+                     if self.states else self.first_guess * self.t ** (2 / 3))
+            s, _ = self.punch.push(self.t * self.force, guess)
+        self.states.append(s)
+        self._t_last = self.t
+        work = WorkCounts(factorizations=s.factorizations)
+        return SolveResult(True, "punch state", s.newton_iterations, [], work,
+                           active_set_iterations=s.active_set_iterations)

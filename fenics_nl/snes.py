@@ -1,6 +1,6 @@
 """The same problems through PETSc SNES (`dolfinx.fem.petsc.NonlinearProblem`), for cross-checks.
 
-`SnesSolver` has the surface of `NewtonSolver` (`solve()` → `NewtonResult`), so scenes and
+`SnesSolver` has the surface of `NewtonSolver` (`solve()` → `SolveResult`), so scenes and
 benchmarks swap one for the other. Work is counted with PETSc's own logging events, so the
 counts do not depend on our code being right. Modified and periodic Newton are SNES's
 Jacobian lagging (`-snes_lag_jacobian`).
@@ -16,7 +16,8 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.newton import ConvergenceError, NewtonResult, WorkCounts
+from fenics_nl.newton import ConvergenceError
+from fenics_nl.result import SolveResult, WorkCounts
 
 # PETSc event names behind each count; MUMPS factorizations log as Mat*FactorNum.
 EVENTS = {
@@ -64,7 +65,8 @@ def petsc_work(counter: EventCounter) -> WorkCounts:
     return work
 
 
-def _all_event_names():
+def all_event_names() -> list[str]:
+    """Every PETSc event name that `petsc_work` reads."""
     out = []
     for names in EVENTS.values():
         out += [names] if isinstance(names, str) else list(names)
@@ -141,15 +143,15 @@ class SnesSolver:
         self.snes = self.problem.solver
         self.snes.setConvergenceHistory(reset=True)
         scale_absolute_tolerance(self.snes, atol, force_scale)
-        # time of each residual norm, as NewtonResult.elapsed. The monitor holds the list,
+        # time of each residual norm, as SolveResult.elapsed. The monitor holds the list,
         # not self: a cycle self → snes → monitor → self would leave the PETSc objects to the
         # garbage collector, which destroys them in a different order on each rank (hang).
         self._stamps: list[float] = []
         stamps = self._stamps
         self.snes.setMonitor(lambda snes, it, norm: stamps.append(time.perf_counter()))
-        self.counter = EventCounter(_all_event_names())
+        self.counter = EventCounter(all_event_names())
 
-    def solve(self) -> NewtonResult:
+    def solve(self) -> SolveResult:
         """Solve from the current `u` (boundary values imposed first, as NewtonSolver does)."""
         t0 = time.perf_counter()
         x = self.u.x.petsc_vec
@@ -161,7 +163,7 @@ class SnesSolver:
         work = petsc_work(self.counter)
         norms = [float(r) for r in self.snes.getConvergenceHistory()[0]]
         reason = self.snes.getConvergedReason()
-        result = NewtonResult(reason > 0, f"SNES reason {reason}",
+        result = SolveResult(reason > 0, f"SNES reason {reason}",
                               self.snes.getIterationNumber(), norms, work,
                               time.perf_counter() - t0, [t - t0 for t in self._stamps])
         if reason <= 0:

@@ -1,71 +1,18 @@
-"""An L-shaped bracket in gmsh (OpenCASCADE), dimensions in mm.
+"""Write the bracket of `fenics_nl.bracket_geometry` (dimensions in mm) to a .msh file.
 
-Base plate 100 x 60 x 10 on z = 0 with two bolt holes (Ø12) at x = 70; a vertical arm
-10 x 60 x 80 at x = 0 with a loaded hole (Ø16) through it at z = 60; an 8 mm fillet
-between them, where the stress concentrates. Physical groups:
-
-    bolts (the two hole surfaces), load (the arm's hole surface), base (the bottom face
-    z = 0), solid (the volume).
-
-Run it to write a mesh you can open in gmsh:  python meshes/bracket.py --size 4 -o bracket.msh
+python meshes/bracket.py --size 4 -o bracket.msh
 """
-
-from __future__ import annotations
 
 import argparse
 
 import gmsh
 
-LENGTH, WIDTH, THICK, HEIGHT = 100.0, 60.0, 10.0, 80.0
-FILLET, BOLT_R, BOLT_X, LOAD_R, LOAD_Z = 8.0, 6.0, 70.0, 8.0, 60.0
-GROUPS = ("bolts", "load", "base")
-
-
-def build(size: float) -> None:
-    """Create the model `bracket` in the current gmsh session and mesh it (tetrahedra)."""
-    occ = gmsh.model.occ
-    gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.model.add("bracket")
-    base = occ.addBox(0, 0, 0, LENGTH, WIDTH, THICK)
-    arm = occ.addBox(0, 0, 0, THICK, WIDTH, HEIGHT)
-    solid = occ.fuse([(3, base)], [(3, arm)])[0][0][1]
-    occ.synchronize()
-    # the inner edge between the base's top face and the arm's inner face: x = t, z = t
-    inner = [tag for _, tag in gmsh.model.getEntities(1)
-             if _is_line_at(occ.getCenterOfMass(1, tag), x=THICK, z=THICK)]
-    solid = occ.fillet([solid], inner, [FILLET])[0][1]
-    holes = [occ.addCylinder(BOLT_X, y, -1, 0, 0, THICK + 2, BOLT_R)
-             for y in (WIDTH / 4, 3 * WIDTH / 4)]
-    holes.append(occ.addCylinder(-1, WIDTH / 2, LOAD_Z, THICK + 2, 0, 0, LOAD_R))
-    occ.cut([(3, solid)], [(3, h) for h in holes])
-    occ.synchronize()
-    groups = {name: [] for name in GROUPS}
-    for _, tag in gmsh.model.getEntities(2):
-        x, _, z = occ.getCenterOfMass(2, tag)
-        if abs(z) < 1e-6 and occ.getMass(2, tag) > 100:
-            groups["base"].append(tag)
-        elif abs(x - BOLT_X) < 1e-6 and z < THICK:
-            groups["bolts"].append(tag)
-        elif abs(z - LOAD_Z) < 1e-6 and x < THICK + 1e-6:
-            groups["load"].append(tag)
-    for i, name in enumerate(GROUPS, start=1):
-        gmsh.model.addPhysicalGroup(2, groups[name], i, name=name)
-    gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)], 1, name="solid")
-    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-    gmsh.option.setNumber("Mesh.MeshSizeMin", size / 4)
-    # elements per 2π on holes and fillet: at least 12, and proportional to 1/size below
-    # size 6 so that a smaller size refines the whole part (a true mesh-convergence study)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", max(12, round(72 / size)))
-    gmsh.model.mesh.generate(3)
-
-
-def _is_line_at(c, x, z):
-    return abs(c[0] - x) < 1e-6 and abs(c[2] - z) < 1e-6
+from fenics_nl.bracket_geometry import build
 
 
 def main():
     """Write the bracket mesh to a .msh file."""
-    ap = argparse.ArgumentParser(description=__doc__,
+    ap = argparse.ArgumentParser(description=__doc__ + build.__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--size", type=float, default=5.0, help="largest element size [mm]")
     ap.add_argument("-o", "--output", default="bracket.msh", help="mesh file to write")

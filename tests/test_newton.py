@@ -170,3 +170,29 @@ def test_parallel_solve_matches_serial(method):
     ps, rs = solve(NewtonSolver, comm=MPI.COMM_SELF, method=method)
     assert abs(tip(p) - tip(ps)) < 1e-8 * abs(tip(ps))
     assert r.iterations == rs.iterations
+
+
+def test_linear_solver_failure_keeps_the_residual_history():
+    # CG without preconditioner, 2 iterations: the first correction fails; the error says
+    # so and its result holds the first residual, as every other failure does
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    opts = PETSc.Options()
+    for k, v in {"kspfail_ksp_type": "cg", "kspfail_pc_type": "none",
+                 "kspfail_ksp_max_it": "2"}.items():
+        opts[k] = v
+    try:
+        s = NewtonSolver(p.residual, p.u, p.bcs, prefix="kspfail_")
+        with pytest.raises(ConvergenceError, match=r"linear solver failed .* at iteration 0") as e:
+            s.solve()
+    finally:
+        for k in ("kspfail_ksp_type", "kspfail_pc_type", "kspfail_ksp_max_it"):
+            opts.delValue(k)
+    assert e.value.result.reason == "ksp" and len(e.value.result.residual_norms) == 1
+
+
+def test_bfgs_keeps_at_most_its_memory():
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    s = NewtonSolver(p.residual, p.u, p.bcs, prefix="bfgsmem_", method="bfgs", bfgs_memory=3,
+                     max_it=200)
+    r = s.solve()
+    assert r.iterations > 3 and len(s.bfgs.pairs) == 3

@@ -1,0 +1,170 @@
+"""The candidate contact surface S_C: its nodes, normal, gap, nodal areas and status meshtags.
+
+S_C is a set of boundary facets, flat, with outward normal n = ±e_axis, facing a rigid
+obstacle at gap γ(x) along n. Its *nodes* are the dofs of the displacement's normal
+component on those facets (vertices for P1, vertices and edge midpoints for P2). A node's
+status (active or not; later stick or slip) is a boolean array over these nodes, kept equal
+on the ranks that share a node (`sync`). Everything a contact formulation or a scene needs
+to know about S_C is here, in public names.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import ufl
+from dolfinx import fem, la, mesh
+from dolfinx.fem import petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+
+class ContactSurface:
+    """Nodes of S_C for the displacement space V, and the obstacle's gap at them."""
+
+    def __init__(self, V: fem.FunctionSpace, facets: np.ndarray,
+                 gap: Callable[[np.ndarray], np.ndarray], *, normal_axis: int,
+                 normal_sign: int = 1):
+        self.V, self.mesh = V, V.mesh
+        self.comm = self.mesh.comm
+        self.axis, self.sign = normal_axis, int(np.sign(normal_sign))
+        self.facets = np.asarray(facets, dtype=np.int32)
+        if self.comm.allreduce(len(self.facets)) == 0:
+            raise ValueError("the contact surface has no facets (missing or wrong tag?)")
+        fdim = self.mesh.topology.dim - 1
+        if V.dofmap.index_map_bs == 1:  # one component (a bar): no sub-space to extract
+            self.Vn, self.component = V, V
+            self.dofs_V = self.dofs_n = fem.locate_dofs_topological(V, fdim, self.facets)
+        else:
+            self.component = V.sub(self.axis)
+            self.Vn, _ = self.component.collapse()
+            dofs = fem.locate_dofs_topological((self.component, self.Vn), fdim, self.facets)
+            self.dofs_V, self.dofs_n = dofs[0], dofs[1]
+        self.x = self.Vn.tabulate_dof_coordinates()[self.dofs_n]
+        self.g = fem.Function(self.Vn)  # u_axis = sign·γ, prescribed on active nodes
+        self.set_gap(gap)
+        self.vertices = vertex_of_dof(self.Vn)[self.dofs_n]  # −1: not at a vertex
+        self._flags = la.vector(self.Vn.dofmap.index_map)
+        self._areas: dict = {}
+
+    # -- nodes --------------------------------------------------------------------------
+
+    @property
+    def owned(self) -> np.ndarray:
+        """Mask of the nodes this rank owns (counts and sums use only these)."""
+        return self.dofs_n < self.Vn.dofmap.index_map.size_local
+
+    def sync(self, local: np.ndarray) -> np.ndarray:
+        """A nodal flag array with the owners' values pushed to the ghosts."""
+        self._flags.array[:] = 0.0
+        self._flags.array[self.dofs_n] = local
+        self._flags.scatter_forward()
+        return self._flags.array[self.dofs_n] > 0.5
+
+    def count(self, mask: np.ndarray) -> int:
+        """Global number of nodes in `mask`."""
+        return self.comm.allreduce(int(np.sum(mask & self.owned)))
+
+    def total(self, values: np.ndarray) -> float:
+        """Σ values over the nodes, every rank's owned ones."""
+        return self.comm.allreduce(float(np.sum(values[self.owned])))
+
+    def fingerprint(self, mask: np.ndarray) -> tuple[int, int]:
+        """Global signature of a node set: its size and the sum of its global indices."""
+        im = self.Vn.dofmap.index_map
+        gidx = im.local_to_global(self.dofs_n[mask & self.owned].astype(np.int32))
+        return (self.comm.allreduce(len(gidx)),
+                self.comm.allreduce(int(np.sum(gidx, dtype=np.int64))))
+
+    # -- gap and geometry ---------------------------------------------------------------
+
+    def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
+        """New obstacle position: γ at the nodes, and the prescribed normal displacement."""
+        self.gamma = np.asarray(gap(self.x.T), dtype=float)
+        self.g.x.array[self.dofs_n] = self.sign * self.gamma
+
+    def normal_displacement(self, u: fem.Function) -> np.ndarray:
+        """u_n = n·u at the nodes."""
+        return self.sign * u.x.array[self.dofs_V]
+
+    def normal_gap(self, u: fem.Function) -> np.ndarray:
+        """u_n − γ at the nodes (positive = penetration)."""
+        return self.normal_displacement(u) - self.gamma
+
+    def nodal_areas(self, weight=1.0) -> np.ndarray:
+        """Lumped areas m_j = ∫_{S_C} φ_j w ds (w = 2πr in the axisymmetric model)."""
+        key = id(weight) if not isinstance(weight, float | int) else float(weight)
+        if key not in self._areas:
+            fdim = self.mesh.topology.dim - 1
+            tags = mesh.meshtags(self.mesh, fdim, np.sort(self.facets),
+                                 np.ones(len(self.facets), dtype=np.int32))
+            ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
+            v = ufl.TestFunction(self.V)
+            v_n = v[self.axis] if ufl.shape(v) else v
+            b = petsc.assemble_vector(fem.form(v_n * weight * ds))
+            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+            with b.localForm() as loc:
+                self._areas[key] = loc.array_r[self.dofs_V].copy()
+            b.destroy()
+        return self._areas[key]
+
+    def dirichlet(self, mask: np.ndarray) -> fem.DirichletBC:
+        """u_n = γ on the nodes of `mask`."""
+        if self.component is self.Vn:
+            return fem.dirichletbc(self.g, self.dofs_V[mask])
+        return fem.dirichletbc(self.g, [self.dofs_V[mask], self.dofs_n[mask]], self.component)
+
+    # -- output -------------------------------------------------------------------------
+
+    def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
+        """A function on the normal component's space: `values` at the nodes, 0 elsewhere."""
+        f = fem.Function(self.Vn, name=name)
+        f.x.array[self.dofs_n] = values
+        f.x.scatter_forward()
+        return f
+
+    def vertex_tags(self, mask: np.ndarray) -> mesh.MeshTags:
+        """Vertex meshtags (value 1) of the nodes of `mask` that are mesh vertices."""
+        verts = self.vertices[mask]
+        verts = np.sort(verts[verts >= 0]).astype(np.int32)
+        return mesh.meshtags(self.mesh, 0, verts, np.ones(len(verts), dtype=np.int32))
+
+    def facet_tags(self, mask: np.ndarray) -> mesh.MeshTags:
+        """Facet meshtags of S_C: 1 where every vertex of the facet is in `mask`, else 0."""
+        fdim = self.mesh.topology.dim - 1
+        self.mesh.topology.create_connectivity(fdim, 0)
+        f2v = self.mesh.topology.connectivity(fdim, 0)
+        imap = self.mesh.topology.index_map(0)
+        in_mask = np.zeros(imap.size_local + imap.num_ghosts, dtype=bool)
+        verts = self.vertices[mask]
+        in_mask[verts[verts >= 0]] = True
+        values = np.array([in_mask[f2v.links(f)].all() for f in self.facets], dtype=np.int32)
+        order = np.argsort(self.facets)
+        return mesh.meshtags(self.mesh, fdim, self.facets[order], values[order])
+
+
+def vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
+    """Mesh vertex of each dof of a scalar Lagrange space, −1 for dofs not at a vertex.
+
+    A Lagrange cell on simplices numbers its vertex dofs first, in the order of the cell's
+    vertices (checked: other cells are refused).
+    """
+    topo = V.mesh.topology
+    if topo.cell_type not in (mesh.CellType.interval, mesh.CellType.triangle,
+                              mesh.CellType.tetrahedron):
+        raise ValueError(f"contact surfaces are written for simplex meshes, got {topo.cell_type}")
+    tdim = topo.dim
+    topo.create_connectivity(tdim, 0)
+    c2v = topo.connectivity(tdim, 0).array.reshape(-1, tdim + 1)
+    dofs = V.dofmap.list[:, : tdim + 1]
+    out = np.full(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, -1,
+                  dtype=np.int32)
+    out[dofs.ravel()] = c2v[: dofs.shape[0]].ravel()
+    return out
+
+
+def global_max(comm: MPI.Comm, values: np.ndarray) -> float:
+    """max |values| over every rank (0 for none)."""
+    return comm.allreduce(float(np.max(np.abs(values), initial=0.0)), op=MPI.MAX)

@@ -1,0 +1,64 @@
+"""What every solver returns: one result type, and the work it counts."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from fenics_nl.convergence import observed_orders
+
+PHASES = ("residual", "tangent", "factorization", "solve")
+
+
+@dataclass
+class WorkCounts:
+    """What a solve spent: assemblies, factorizations, linear solves and time per phase."""
+
+    residual_assemblies: int = 0
+    tangent_assemblies: int = 0
+    factorizations: int = 0
+    linear_solves: int = 0
+    krylov_iterations: int = 0  # CG iterations (GAMG, or a reused factorization), else 0
+    time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
+
+    def add(self, other: WorkCounts) -> None:
+        """Accumulate `other` into self."""
+        self.residual_assemblies += other.residual_assemblies
+        self.tangent_assemblies += other.tangent_assemblies
+        self.factorizations += other.factorizations
+        self.linear_solves += other.linear_solves
+        self.krylov_iterations += other.krylov_iterations
+        for k, v in other.time.items():
+            self.time[k] = self.time.get(k, 0.0) + v
+
+
+@dataclass
+class SolveResult:
+    """Outcome of one solve of the current load state, whatever the solver.
+
+    `iterations` are non-linear (Newton) iterations, summed over the inner solves of an
+    active-set loop, whose own count is `active_set_iterations` (0 without contact).
+    """
+
+    converged: bool
+    reason: str
+    iterations: int
+    residual_norms: list[float]
+    work: WorkCounts
+    wall_time: float = 0.0
+    elapsed: list[float] = field(default_factory=list)  # seconds from the start, per norm
+    active_set_iterations: int = 0
+    active_sizes: list[int] = field(default_factory=list)  # active nodes after each
+    history: list[dict] = field(default_factory=list)  # per active-set iteration
+
+    @property
+    def orders(self) -> list[float]:
+        """Observed orders from the residual norms (round-off tail excluded)."""
+        r = self.residual_norms
+        return observed_orders(r, floor=1e-11 * max(r)) if r else []
+
+    @property
+    def order(self) -> float:
+        """Last observed order, NaN when fewer than three meaningful residuals exist."""
+        q = self.orders
+        return q[-1] if q else math.nan
