@@ -24,9 +24,9 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 from common import elapsed, machine, pyplot, save_figure, update_readme
 from mpi4py import MPI
 
-from fenics_nl import elastica
-from fenics_nl.beam import Beam
-from fenics_nl.loading import LoadStepError
+from fenics_nl.scenes.beam import Beam
+from fenics_nl.solvers.loading import LoadStepError
+from fenics_nl.theory import elastica
 
 HERE = Path(__file__).resolve().parent
 comm = MPI.COMM_WORLD

@@ -90,7 +90,7 @@ def timed_linear_solve(a, L, bcs, kind: str, prefix: str, x=None) -> float:
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    from fenics_nl.linear_solver import create_ksp
+    from fenics_nl.solvers.linear_solver import create_ksp
 
     comm = MPI.COMM_WORLD
     comm.Barrier()

@@ -24,10 +24,10 @@ from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, up
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl import hertz
-from fenics_nl.contact_peers import solve_penalty, solve_snes_vi
-from fenics_nl.materials import LinearElastic
-from fenics_nl.punch import Punch
+from fenics_nl.contact.peers import solve_penalty, solve_snes_vi
+from fenics_nl.materials.laws import LinearElastic
+from fenics_nl.scenes.punch import Punch
+from fenics_nl.theory import hertz
 
 HERE = Path(__file__).resolve().parent
 E, NU, R, DELTA = 1.0, 0.3, 1.0, 0.01

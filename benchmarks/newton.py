@@ -29,10 +29,10 @@ from common import (
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.newton import NewtonSolver
-from fenics_nl.problems import cantilever_3d
-from fenics_nl.snes import SnesSolver
+from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.scenes.problems import cantilever_3d
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.snes import SnesSolver
 
 HERE = Path(__file__).resolve().parent
 VARIANTS = [  # (label, solver class, options)

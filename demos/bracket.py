@@ -37,12 +37,12 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 from mpi4py import MPI
 
-from fenics_nl import cli, output
-from fenics_nl.bracket import THICKNESS_MM, Bracket
-from fenics_nl.cli import say
-from fenics_nl.loading import LoadStepError, solve_incrementally
-from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.newton import stalled_at_round_off
+from fenics_nl.io import cli, output
+from fenics_nl.io.cli import say
+from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.newton import stalled_at_round_off
 
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
@@ -284,7 +284,7 @@ def plot(steps, args):
 
 def picture(b, vm, args):
     """Two views of the deformed bracket (σ_eq), the load arrow, the bolts, the floor."""
-    from fenics_nl.pictures import bracket_picture
+    from fenics_nl.io.pictures import bracket_picture
 
     bracket_picture(b, vm, args.png, units=args.units, force=args.force)
     say(f"wrote {args.png}")

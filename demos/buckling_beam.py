@@ -37,9 +37,10 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl import cli, elastica, output
-from fenics_nl.beam import Beam
-from fenics_nl.cli import say
+from fenics_nl.io import cli, output
+from fenics_nl.io.cli import say
+from fenics_nl.scenes.beam import Beam
+from fenics_nl.theory import elastica
 
 comm = MPI.COMM_WORLD
 # -

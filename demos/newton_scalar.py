@@ -28,7 +28,8 @@ import time
 import mpmath
 import numpy as np
 
-from fenics_nl import cli, scalar
+from fenics_nl.io import cli
+from fenics_nl.solvers import scalar
 
 # Each function: r(u), a starting point, and what it models.
 FUNCTIONS = {

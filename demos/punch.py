@@ -41,11 +41,12 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl import cli, hertz, output
-from fenics_nl.cli import say
-from fenics_nl.loading import solve_incrementally
-from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.punch import Punch, PunchLoad
+from fenics_nl.io import cli, output
+from fenics_nl.io.cli import say
+from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.scenes.punch import Punch, PunchLoad
+from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.theory import hertz
 
 comm = MPI.COMM_WORLD
 MAX_REFINE = 6  # a/1280 under the punch in 2D: ~1e6 unknowns

@@ -9,7 +9,7 @@ Bad parameters are `ValueError`. Anything else is a bug and keeps its traceback.
 class SolveError(RuntimeError):
     """A solve failed: the problem as posed could not be solved by the chosen method.
 
-    `result` (a `fenics_nl.result.SolveResult`, or None) holds what was done up to the
+    `result` (a `fenics_nl.solvers.result.SolveResult`, or None) holds what was done up to the
     failure: iterations, work counts, residual history.
     """
 

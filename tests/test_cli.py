@@ -2,7 +2,7 @@ import argparse
 
 import pytest
 
-from fenics_nl.cli import parse_with_petsc_options
+from fenics_nl.io.cli import parse_with_petsc_options
 
 
 def parser():

@@ -4,10 +4,12 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import boundary, hertz, kinematics
-from fenics_nl.contact import ActiveSetContact
-from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.meshes import graded_block
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import graded_block
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.theory import hertz
 
 
 def spring_over_support(m, k=100.0, g=9.81, gap=0.05, formulation="elimination"):

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from fenics_nl import elastica
+from fenics_nl.theory import elastica
 
 # formulas.md table: P/P_cr, α (deg), δ/L, x/L
 TABLE = [(1.01, 16.15, 0.1779, 0.9802), (1.05, 35.61, 0.3800, 0.9053),
@@ -27,7 +27,7 @@ def test_small_rotation_asymptote_and_straight_branch():
 
 
 def test_shape_ends_at_the_tip_position():
-    from fenics_nl import elastica
+    from fenics_nl.theory import elastica
 
     for ratio in (1.05, 1.5, 3.0):
         x, y = elastica.shape(ratio)

@@ -6,8 +6,8 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
-from fenics_nl.loading import LoadStepError, solve_incrementally
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 
 class ScalarLoad:

@@ -5,8 +5,8 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from mpi4py import MPI
 
-from fenics_nl import kinematics
-from fenics_nl.materials import LinearElastic, NeoHookean, PowerLaw, StVenantKirchhoff
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import LinearElastic, NeoHookean, PowerLaw, StVenantKirchhoff
 
 E, NU = 1000.0, 0.3
 

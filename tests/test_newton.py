@@ -6,11 +6,11 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenics_nl.loading import LoadStepError, solve_incrementally
-from fenics_nl.materials import PowerLaw
-from fenics_nl.newton import ConvergenceError, NewtonSolver
-from fenics_nl.problems import cantilever_3d
-from fenics_nl.snes import EventCounter, SnesSolver
+from fenics_nl.materials.laws import PowerLaw
+from fenics_nl.scenes.problems import cantilever_3d
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
+from fenics_nl.solvers.snes import EventCounter, SnesSolver
 
 # Power law far into its non-linear range: at this load ε_eq reaches ~20 ε0 at the clamp.
 MATERIAL = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=0.3)

@@ -3,7 +3,7 @@ import math
 import mpmath
 import pytest
 
-from fenics_nl import scalar
+from fenics_nl.solvers import scalar
 
 GOLDEN = (1 + 5**0.5) / 2
 EQUATIONS = [  # r, u0: each root is simple and each start within Newton's basin

@@ -9,13 +9,14 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import boundary, hertz
-from fenics_nl.contact import ActiveSetContact
-from fenics_nl.loading import LoadStepError, solve_incrementally
-from fenics_nl.materials import LinearElastic, PowerLaw
-from fenics_nl.mesh_check import bad_cells
-from fenics_nl.newton import ConvergenceError, NewtonSolver
-from fenics_nl.problems import cantilever_3d
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.mesh_check import bad_cells
+from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.scenes.problems import cantilever_3d
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
+from fenics_nl.theory import hertz
 
 pytestmark = pytest.mark.stress
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from fenics_nl.convergence import observed_orders
+from fenics_nl.solvers.convergence import observed_orders
 
 PHASES = ("residual", "tangent", "factorization", "solve")
 

@@ -16,13 +16,16 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import boundary, elastica, kinematics, output
-from fenics_nl.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
-from fenics_nl.elastica import euler_load
+from fenics_nl.domain import boundary
 from fenics_nl.errors import SolveError
-from fenics_nl.loading import LoadPath, solve_incrementally
-from fenics_nl.materials import LinearElastic, NeoHookean, StVenantKirchhoff
-from fenics_nl.newton import ConvergenceError, NewtonSolver
+from fenics_nl.io import output
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import LinearElastic, NeoHookean, StVenantKirchhoff
+from fenics_nl.solvers.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
+from fenics_nl.solvers.loading import LoadPath, solve_incrementally
+from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
+from fenics_nl.theory import elastica
+from fenics_nl.theory.elastica import euler_load
 
 MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
 # A load path that ends unstable is redone with 4x the steps, up to this many: small steps
@@ -104,7 +107,7 @@ class Beam:
         t = fem.Constant(self.mesh, np.array([-1.0 / self.h, 0.0]))
         from dolfinx.fem.petsc import LinearProblem
 
-        from fenics_nl.snes import unless_set
+        from fenics_nl.solvers.snes import unless_set
 
         LinearProblem(a, ufl.dot(t, v) * self.ds_end, u=u0, bcs=self.bcs,
                       petsc_options_prefix="beam_prestress_",

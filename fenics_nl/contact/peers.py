@@ -17,8 +17,13 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenics_nl.newton import NewtonSolver
-from fenics_nl.snes import EventCounter, all_event_names, petsc_work, scale_absolute_tolerance
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.snes import (
+    EventCounter,
+    all_event_names,
+    petsc_work,
+    scale_absolute_tolerance,
+)
 
 
 def _surface_measure(punch):

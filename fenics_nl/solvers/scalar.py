@@ -15,7 +15,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from fenics_nl.convergence import observed_orders
+from fenics_nl.solvers.convergence import observed_orders
 
 METHODS = ("newton", "modified", "secant")
 DIVERGED = 1e8  # |r(u_k)| / |r(u_0)| beyond which the iteration is declared divergent

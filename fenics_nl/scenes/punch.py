@@ -26,11 +26,14 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl import boundary, hertz, kinematics, output
-from fenics_nl.contact import ActiveSetContact
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import graded_block
 from fenics_nl.errors import SolveError
-from fenics_nl.meshes import graded_block
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.io import output
+from fenics_nl.materials import kinematics
+from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.theory import hertz
 
 MODELS = ("axisymmetric", "3d", "plane-strain")
 

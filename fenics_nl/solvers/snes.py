@@ -16,8 +16,8 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.newton import ConvergenceError
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.solvers.newton import ConvergenceError
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 # PETSc event names behind each count; MUMPS factorizations log as Mat*FactorNum.
 EVENTS = {

@@ -36,10 +36,10 @@ from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
 
-from fenics_nl import output
 from fenics_nl.errors import SolveError
-from fenics_nl.linear_solver import create_ksp, rigid_body_modes
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.io import output
+from fenics_nl.solvers.linear_solver import create_ksp, rigid_body_modes
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 

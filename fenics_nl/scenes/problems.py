@@ -9,7 +9,7 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl import kinematics
+from fenics_nl.materials import kinematics
 
 
 @dataclass

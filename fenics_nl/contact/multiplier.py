@@ -25,10 +25,10 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.contact_surface import vertex_of_dof
-from fenics_nl.newton import ConvergenceError
-from fenics_nl.result import SolveResult
-from fenics_nl.snes import (
+from fenics_nl.contact.surface import vertex_of_dof
+from fenics_nl.solvers.newton import ConvergenceError
+from fenics_nl.solvers.result import SolveResult
+from fenics_nl.solvers.snes import (
     EventCounter,
     all_event_names,
     petsc_work,

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fenics_nl.errors import SolveError
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 

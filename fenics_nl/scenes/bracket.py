@@ -1,6 +1,6 @@
 """The bracket scene: a 3D gmsh part, a power-law material, bolts and a rigid floor.
 
-The mesh comes from `fenics_nl.bracket_geometry` (built on rank 0, distributed) or from a user's
+The mesh comes from `bracket_geometry` (built on rank 0, distributed) or from a user's
 .msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
 a uniform traction of total force F along +x; the bolt holes are clamped, and with
 ``support="contact"`` the base also rests on a rigid floor (frictionless, may lift off).
@@ -17,11 +17,14 @@ from dolfinx import fem
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-from fenics_nl import boundary, bracket_geometry, kinematics, output
-from fenics_nl.contact import ActiveSetContact
-from fenics_nl.mesh_check import check_cells
-from fenics_nl.newton import NewtonSolver
-from fenics_nl.snes import SnesSolver
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.mesh_check import check_cells
+from fenics_nl.io import output
+from fenics_nl.materials import kinematics
+from fenics_nl.scenes import bracket_geometry
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.snes import SnesSolver
 
 GROUPS = ("bolts", "load", "base")
 THICKNESS_MM = bracket_geometry.THICK  # the base plate's thickness

@@ -7,7 +7,7 @@ import os
 import numpy as np
 from dolfinx import fem
 
-from fenics_nl.output import gather_grid, owned_cell_values
+from fenics_nl.io.output import gather_grid, owned_cell_values
 
 
 def off_screen():

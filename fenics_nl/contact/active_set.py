@@ -39,10 +39,10 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.contact_surface import ContactSurface, global_max
+from fenics_nl.contact.surface import ContactSurface, global_max
 from fenics_nl.errors import SolveError
-from fenics_nl.newton import NewtonSolver
-from fenics_nl.result import SolveResult, WorkCounts
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
@@ -136,7 +136,7 @@ class ActiveSetContact:
         if formulation == "elimination":
             self.system = EliminationSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         else:
-            from fenics_nl.contact_multiplier import MultiplierSystem
+            from fenics_nl.contact.multiplier import MultiplierSystem
 
             self.system = MultiplierSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         self.system.set_active(self.active, None)

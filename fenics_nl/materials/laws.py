@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import ufl
 
-from fenics_nl import kinematics
+from fenics_nl.materials import kinematics
 
 
 def check_range(name: str, value: float, low: float, high: float) -> None:

@@ -1,0 +1,1 @@
+"""Meshes, their checks, and boundary conditions and reactions."""

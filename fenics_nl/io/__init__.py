@@ -1,0 +1,1 @@
+"""What a run hands its user: command line, VTX fields, pictures."""

@@ -1,0 +1,1 @@
+"""Materials as free energies, and the strain measures they are written in."""

@@ -1,0 +1,1 @@
+"""The scenes, composed from the pieces above: punch, buckling beam, bracket."""

@@ -1,0 +1,1 @@
+"""Closed forms to validate against: Hertz, Euler and the elastica."""
