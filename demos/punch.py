@@ -267,6 +267,11 @@ def title(state, ref, args):
     if args.model == "plane-strain":
         return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
                 f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
+    if args.force is not None:  # P prescribed: the check is on the indentation it needs
+        d_ref = hertz.sphere_from_force(args.E, args.nu, args.radius, state.force)["indentation"]
+        return (f"{args.model} punch, P = {state.force:.4g} (prescribed): δ = "
+                f"{state.indentation:.3g} ({100 * (state.indentation / d_ref - 1):+.2f} % from "
+                f"Hertz), a {a_err:+.1f} %, p0 {p_err:+.1f} %")
     return (f"{args.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
             f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
             f"p0 {p_err:+.1f} %")

@@ -308,6 +308,12 @@ def test_bracket_contact_support_lifts_off(tmp_path):
     k = bracket(tmp_path)
     base_area = 100 * 60 - 2 * math.pi * 6**2
     assert 0 < c["lifted_off_area"] < base_area
+    # equilibrium: the bolts take the pull, the frictionless floor pushes only upwards, and
+    # bolts and floor balance vertically (a node on both counts with the bolts)
+    (bx, by, bz), (fx, fy, fz) = c["reactions"]["bolts"], c["reactions"]["base"]
+    assert bx == pytest.approx(-8e3, rel=1e-8) and fz > 0
+    assert max(abs(by), abs(fx), abs(fy), abs(bz + fz)) < 1e-8 * 8e3
+    assert 0 < c["max_floor_pressure"] < 1e4  # finite at the P2 vertices too (HRZ areas)
     # the floor only adds support: the arm moves less than with the bolts alone
     assert c["load_point_displacement"] < k["load_point_displacement"]
 
@@ -380,7 +386,8 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
                           (["--mesh", "box.msh", "--size", "3"], "contradict"),
                           (["--compare", "--png", "x.png"], "--compare"),
                           (["--force", "nan"], "--force: must be a finite number"),
-                          (["--material", "linear", "--sigma0", "100"], "set the power law")]:
+                          (["--material", "linear", "--sigma0", "100"], "set the power law"),
+                          (["--compare", "--newton", "modified"], "drop --newton")]:
         proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)

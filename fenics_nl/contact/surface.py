@@ -93,7 +93,12 @@ class ContactSurface:
         return self.normal_displacement(u) - self.gamma
 
     def nodal_areas(self, weight=1.0) -> np.ndarray:
-        """Lumped areas m_j = ∫_{S_C} φ_j w ds (w = 2πr in the axisymmetric model)."""
+        """Lumped areas m_j at the nodes (w = 2πr in the axisymmetric model).
+
+        Row sums m_j = ∫_{S_C} φ_j w ds; where they vanish (the vertices of P2 triangles,
+        whose basis functions integrate to zero) the diagonal (HRZ) lumping instead:
+        m_j ∝ ∫ φ_j² w ds, scaled to the same total area. Every m_j is then positive.
+        """
         key = id(weight) if not isinstance(weight, float | int) else float(weight)
         if key not in self._areas:
             fdim = self.mesh.topology.dim - 1
@@ -102,13 +107,29 @@ class ContactSurface:
             ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
             v = ufl.TestFunction(self.V)
             v_n = v[self.axis] if ufl.shape(v) else v
-            b = petsc.assemble_vector(fem.form(v_n * weight * ds))
-            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-            with b.localForm() as loc:
-                self._areas[key] = loc.array_r[self.dofs_V].copy()
-            b.destroy()
+            m = self._at_nodes(petsc.assemble_vector(fem.form(v_n * weight * ds)))
+            if self.comm.allreduce(bool(np.any(m[self.owned] <= 1e-12 * np.abs(m).max(initial=0))),
+                                   op=MPI.LOR):
+                w = ufl.TrialFunction(self.V)
+                w_n = w[self.axis] if ufl.shape(w) else w
+                M = petsc.assemble_matrix(fem.form(w_n * v_n * weight * ds))
+                M.assemble()
+                diagonal = petsc.create_vector(self.V)  # ghosted, like the row sums
+                M.getDiagonal(diagonal)
+                d = self._at_nodes(diagonal)
+                M.destroy()
+                m = d * self.total(m) / self.total(d)
+            self._areas[key] = m
         return self._areas[key]
+
+    def _at_nodes(self, b: PETSc.Vec) -> np.ndarray:
+        """An assembled vector's values at the nodes (owned and ghosts); destroys b."""
+        b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        with b.localForm() as loc:
+            values = loc.array_r[self.dofs_V].copy()
+        b.destroy()
+        return values
 
     def dirichlet(self, mask: np.ndarray) -> fem.DirichletBC:
         """u_n = γ on the nodes of `mask`."""

@@ -35,7 +35,9 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
 
     R = f_int − f_ext assembled without any Dirichlet row, at the current u: on a supported
     group it is the force the support exerts on the body (an axisymmetric residual carries
-    2πr, so this is the force on the whole revolution). Collective.
+    2πr, so this is the force on the whole revolution). A node shared by several groups (the
+    edge of a clamped bolt hole on a floor) counts in the first of them only: list the
+    groups that hold a node fully (clamped) first. Collective.
     """
     from dolfinx.fem import petsc
     from mpi4py import MPI
@@ -47,12 +49,16 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
     b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
     bs = V.dofmap.index_map_bs
     n_owned = V.dofmap.index_map.size_local
-    R = b.array_r[: n_owned * bs].reshape(-1, bs)
+    R = b.array_r[: n_owned * bs].reshape(-1, bs).copy()
     b.destroy()
     fdim = V.mesh.topology.dim - 1
+    counted = np.zeros(n_owned, dtype=bool)
     out = {}
     for name, facets in groups.items():
         nodes = fem.locate_dofs_topological(V, fdim, facets)
-        total = R[nodes[nodes < n_owned]].sum(axis=0)
+        nodes = nodes[nodes < n_owned]
+        nodes = nodes[~counted[nodes]]
+        counted[nodes] = True
+        total = R[nodes].sum(axis=0)
         out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]
     return out

@@ -88,10 +88,11 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
                             "width": 0.7, "height": 0.08, "title_font_size": 14,
                             "label_font_size": 12, "fmt": "%.0f"})
             centre = load[0].mean(axis=0) + scale * load_motion  # on the deformed hole
-            pl.add_arrows(centre[None, :] - [0.25 * size, 0, 0], np.array([[1.0, 0, 0]]),
-                          mag=0.25 * size, color="red")
-            pl.add_point_labels([centre - [0.25 * size, 0, -0.04 * size]],
-                                [f"F = {force / 1e3:.3g} kN"], font_size=14, text_color="red",
+            # the pull on the hole, drawn from the hole along +x (seen past the arm)
+            pl.add_arrows(centre[None, :], np.array([[1.0, 0, 0]]), mag=0.3 * size,
+                          color="red")
+            pl.add_point_labels([centre + np.array([0.15, 0.0, 0.05]) * size],
+                                [f"F = {force / 1e3:.3g} kN"], font_size=16, text_color="red",
                                 shape=None, show_points=False)
             pl.add_points(bolts[0], color="black", point_size=6, render_points_as_spheres=True)
             if status is not None:
@@ -100,13 +101,15 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
                                      i_size=1.3 * (hi[0] - lo[0]), j_size=1.3 * (hi[1] - lo[1])),
                             color="tan", opacity=0.5)
         pl.view_vector(direction)
-        pl.add_text(label, font_size=10, position="upper_left")
+        if i == 0:
+            label = (f"bracket, {b.support} support, F = {force / 1e3:.3g} kN: load-point "
+                     f"displacement {np.linalg.norm(load_motion):.3g} {units}\n{label}")
+        pl.add_text(label, font_size=12 if i == 0 else 10, position="upper_left")
     pl.subplot(0, 0)
     legend = (f"deformed x{scale:.3g} (grey: undeformed); black: clamped bolt holes"
               + ("; floor: base nodes in contact blue, lifted off orange"
                  if status is not None else ""))
-    pl.add_text(f"bracket, {b.support} support, F = {force / 1e3:.3g} kN\n{legend}",
-                font_size=10, position="lower_left")
+    pl.add_text(legend, font_size=10, position="lower_left")
     pl.screenshot(path)
     pl.close()
 

@@ -140,6 +140,7 @@ class Beam:
                               prefix=f"beam_{method}_")
         tangent = ufl.derivative(self.residual, self.u)
         while True:
+            self.path_steps = steps  # the number of steps of the last path run
             self.u.x.array[:] = 0.0
             path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
                                        max_step=1.0 if grow else 1.0 / steps,
