@@ -48,7 +48,8 @@ def parse_args(argv=None):
     p = cli.parser("Newton (order 2), modified Newton (order 1) and secant (order 1.618) on a "
                    "scalar equation r(u) = 0, in many-digit arithmetic so that the orders show.")
     p.add_argument("--function", choices=FUNCTIONS, default="spring",
-                   help="equation r(u) = 0 to solve (dimensionless)")
+                   help="equation r(u) = 0 to solve (dimensionless): "
+                        + "; ".join(f"{k}: {v[2]}" for k, v in FUNCTIONS.items()))
     p.add_argument("--u0", type=cli.finite, default=None,
                    help="starting point (default: the function's own)")
     p.add_argument("--slope", type=cli.finite, default=None,
