@@ -40,6 +40,7 @@ from mpi4py import MPI
 from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.parallel import global_max
 from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import stalled_at_round_off
@@ -185,7 +186,7 @@ def run_variant(args, newton):
 
 def summary(b, steps, wall, args):
     vm = b.von_mises()
-    vm_max = output.global_max(comm, vm.x.array)
+    vm_max = global_max(comm, vm.x.array)
     mat = b.material
     out = {
         "support": args.support, "force": args.force, "length_unit": args.units,
@@ -211,7 +212,7 @@ def summary(b, steps, wall, args):
         out["lifted_off_area"] = b.lifted_off_area()
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
         c = b.solver
-        out["max_floor_pressure"] = output.global_max(comm, c.pressure()[c.active])
+        out["max_floor_pressure"] = global_max(comm, c.pressure()[c.active])
     return out, vm
 
 

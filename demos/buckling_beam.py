@@ -39,6 +39,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
+from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import Beam
 from fenics_nl.theory import elastica
 
@@ -188,12 +189,10 @@ def centreline(beam):
     X = beam.V.tabulate_dof_coordinates()
     on = np.isclose(X[:, 1], 0.0)
     u = beam.u.x.array.reshape(-1, 2)[on]
-    pts = X[on, :2] + u
-    parts = comm.gather((X[on, 0], pts), root=0)
-    if comm.rank != 0:
+    rows = gather_rows(comm, X[on, 0], X[on, :2] + u)
+    if rows is None:
         return None
-    x0 = np.concatenate([p[0] for p in parts])
-    pts = np.concatenate([p[1] for p in parts])
+    x0, pts = rows
     return pts[np.argsort(x0)]
 
 

@@ -176,12 +176,13 @@ def run(args):
         theory = " (Hertz: 1.5)" if args.model != "plane-strain" else ""
         say(f"P ∝ δ^{out['fitted_exponent']:.4f} over the steps{theory}")
     writers = []
+    vm = punch.von_mises() if args.output or args.png else None  # once for both
     if args.output:
-        writers.append(lambda: write_fields(punch, args.output))
+        writers.append(lambda: write_fields(punch, vm, args.output))
     if args.plot:
         writers.append(lambda: plot(punch, states, ref, args))
     if args.png:
-        writers.append(lambda: picture(punch, last, ref, args))
+        writers.append(lambda: picture(punch, vm, last, ref, args))
     return out, writers
 
 
@@ -223,8 +224,8 @@ def check_against_hertz(punch, last, args, out):
     return ref
 
 
-def write_fields(punch, folder):
-    paths = output.write_fields(folder, [punch.u, *punch.contact_fields(), punch.von_mises()])
+def write_fields(punch, vm, folder):
+    paths = output.write_fields(folder, [punch.u, *punch.contact_fields(), vm])
     say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
 
 
@@ -295,12 +296,12 @@ def pressure_panel(ax, profile, state, ref):
     ax.grid(alpha=0.3)
 
 
-def picture(punch, state, ref, args):
+def picture(punch, vm, state, ref, args):
     """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
     import matplotlib
 
     matplotlib.use("Agg")
-    section = output.section(punch.u, punch.von_mises(), normal_axis=1 if punch.vertical == 2
+    section = output.section(punch.u, vm, normal_axis=1 if punch.vertical == 2
                              else None)
     profile = punch.surface_profile()
     if comm.rank != 0:

@@ -39,8 +39,9 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.contact.surface import ContactSurface, global_max
+from fenics_nl.contact.surface import ContactSurface
 from fenics_nl.errors import SolveError
+from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
@@ -177,6 +178,11 @@ class ActiveSetContact:
         """Warm start for a new load: the current set, plus every node now penetrating."""
         self.active = self.surface.sync(self.active | (self.normal_gap() > 0))
 
+    def fields(self, weight=1.0) -> list[fem.Function]:
+        """Nodal contact pressure and active set (1/0) on S_C, to write out."""
+        return [self.nodal_field(self.pressure(weight), "contact_pressure"),
+                self.nodal_field(self.active.astype(float), "active_set")]
+
     def active_vertices(self) -> mesh.MeshTags:
         """Vertex meshtags of the active nodes (value 1)."""
         return self.surface.vertex_tags(self.active)
@@ -220,8 +226,9 @@ class ActiveSetContact:
             T_n, d = self.normal_forces(), self.normal_gap()
             # thresholds from the problem's own scales: the largest contact force, and the
             # obstacle's gap or the motion itself
-            scale_T = global_max(self.comm, T_n)
-            scale_u = max(global_max(self.comm, S.gamma), global_max(self.comm, self.u.x.array))
+            scale_T = global_max(self.comm, np.abs(T_n))
+            scale_u = max(global_max(self.comm, np.abs(S.gamma)),
+                          global_max(self.comm, np.abs(self.u.x.array)))
             leave = self.active & (T_n > 1e-10 * scale_T)
             join = ~self.active & (d > 1e-10 * scale_u)
             new = S.sync((self.active & ~leave) | join)

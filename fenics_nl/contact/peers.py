@@ -14,15 +14,16 @@ import numpy as np
 import ufl
 from dolfinx import fem, mesh
 from dolfinx.fem import petsc
-from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import (
     EventCounter,
     all_event_names,
     petsc_work,
     scale_absolute_tolerance,
+    unless_set,
 )
 
 
@@ -44,7 +45,8 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
             "snes_max_it": 100, "ksp_type": "preonly", "pc_type": "lu",
             "pc_factor_mat_solver_type": "mumps"}
     problem = petsc.NonlinearProblem(punch.residual, u, bcs=punch.bcs,
-                                     petsc_options_prefix=prefix, petsc_options=opts)
+                                     petsc_options_prefix=prefix,
+                                     petsc_options=unless_set(prefix, opts))
     lower, upper = problem.x.duplicate(), problem.x.duplicate()
     lower.set(PETSc.NINFINITY)
     upper.set(PETSc.INFINITY)
@@ -93,5 +95,4 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
 
 
 def _max_penetration(punch) -> float:
-    c = punch.contact
-    return punch.mesh.comm.allreduce(float(np.max(c.normal_gap(), initial=0.0)), op=MPI.MAX)
+    return global_max(punch.mesh.comm, punch.contact.normal_gap())

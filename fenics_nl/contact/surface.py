@@ -185,7 +185,3 @@ def vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
     out[dofs.ravel()] = c2v[: dofs.shape[0]].ravel()
     return out
 
-
-def global_max(comm: MPI.Comm, values: np.ndarray) -> float:
-    """max |values| over every rank (0 for none)."""
-    return comm.allreduce(float(np.max(np.abs(values), initial=0.0)), op=MPI.MAX)

@@ -241,8 +241,10 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
 
 
 def _one_line(err: BaseException) -> str:
+    from petsc4py import PETSc
+
     text = " ".join(str(err).split())
-    if type(err).__name__ == "Error" and "petsc4py" in type(err).__module__:
+    if isinstance(err, PETSc.Error):
         # PETSc's stack: keep its messages, drop the "function() at file:line" frames
         parts = [p.strip() for p in re.split(r"\[\d+\]", text)]
         text = "; ".join(p for p in parts if p and " at /" not in p)

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 from dolfinx import fem
-from mpi4py import MPI
 
 
 def dofs(V: fem.FunctionSpace) -> int:
@@ -107,9 +106,14 @@ def owned_cell_values(f: fem.Function) -> np.ndarray:
     return f.x.array[f.function_space.dofmap.list[:n, 0]]
 
 
-def global_max(comm: MPI.Comm, values: np.ndarray) -> float:
-    """max over every rank (0 for empty arrays)."""
-    return comm.allreduce(float(np.max(values, initial=0.0)), op=MPI.MAX)
+def vertex_interpolant(u: fem.Function) -> fem.Function:
+    """u itself if it is P1, else its interpolant in the vector P1 space (for pictures)."""
+    if u.function_space.element.basix_element.degree == 1:
+        return u
+    msh = u.function_space.mesh
+    u1 = fem.Function(fem.functionspace(msh, ("Lagrange", 1, (msh.geometry.dim,))))
+    u1.interpolate(u)
+    return u1
 
 
 def section(u: fem.Function, cell_field: fem.Function, normal_axis: int | None = None):
@@ -120,13 +124,9 @@ def section(u: fem.Function, cell_field: fem.Function, normal_axis: int | None =
     displacement of the nodes, triangles, and `cell_field` (DG0) on each triangle. `u`
     is drawn through its vertex values (P1).
     """
+    u = vertex_interpolant(u)
     V = u.function_space
     msh = V.mesh
-    if V.element.basix_element.degree != 1:
-        V1 = fem.functionspace(msh, ("Lagrange", 1, (msh.geometry.dim,)))
-        u1 = fem.Function(V1)
-        u1.interpolate(u)
-        u, V = u1, V1
     grid = gather_grid(V, {"u": u}, {"f": owned_cell_values(cell_field)})
     if grid is None:
         return None

@@ -7,7 +7,8 @@ import os
 import numpy as np
 from dolfinx import fem
 
-from fenics_nl.io.output import gather_grid, owned_cell_values
+from fenics_nl.io.output import gather_grid, owned_cell_values, vertex_interpolant
+from fenics_nl.parallel import gather_rows
 
 
 def off_screen():
@@ -19,14 +20,6 @@ def off_screen():
     vtk.vtkObject.GlobalWarningDisplayOff()  # "bad X server connection" is not an error
     pyvista.OFF_SCREEN = True
     return pyvista
-
-
-def gather_points(x: np.ndarray, values: np.ndarray, comm):
-    """Rows of `x` and `values` from every rank, on rank 0 (None elsewhere)."""
-    parts = comm.gather((x, values), root=0)
-    if comm.rank != 0:
-        return None
-    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
 
 def facet_points(msh, facets: np.ndarray) -> np.ndarray:
@@ -47,17 +40,15 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
     writes `path`.
     """
     comm = b.mesh.comm
-    V1 = fem.functionspace(b.mesh, ("Lagrange", 1, (3,)))
-    u1 = fem.Function(V1)
-    u1.interpolate(b.u)
-    grid = gather_grid(V1, {"u": u1}, {"vm": owned_cell_values(vm)})
-    bolts = gather_points(facet_points(b.mesh, b.groups["bolts"]), np.zeros(0), comm)
-    load = gather_points(facet_points(b.mesh, b.load_facets), np.zeros(0), comm)
+    u1 = vertex_interpolant(b.u)
+    grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(vm)})
+    bolts = gather_rows(comm, facet_points(b.mesh, b.groups["bolts"]))
+    load = gather_rows(comm, facet_points(b.mesh, b.load_facets))
     load_motion = b.load_point_motion()
     status = None
     if b.support == "contact":
         c = b.solver
-        status = gather_points(c.x[c.owned], c.active[c.owned], comm)
+        status = gather_rows(comm, c.x[c.owned], c.active[c.owned])
     if comm.rank != 0:
         return
     pv = off_screen()

@@ -22,6 +22,7 @@ from fenics_nl.domain import boundary
 from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.parallel import global_max
 from fenics_nl.scenes import bracket_geometry
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
@@ -91,8 +92,7 @@ class Bracket:
 
         tdim = self.mesh.topology.dim
         cells = np.arange(self.mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-        self.largest_cell = comm.allreduce(float(np.max(self.mesh.h(tdim, cells), initial=0.0)),
-                                           op=MPI.MAX)
+        self.largest_cell = global_max(comm, self.mesh.h(tdim, cells))
         self.groups = {"bolts": facets("bolts")}
         self.load_facets = facets("load")
         if support == "contact":
@@ -157,9 +157,7 @@ class Bracket:
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal floor pressure and active set (1/0) on the base (contact support only)."""
-        c = self.solver
-        return [c.nodal_field(c.pressure(), "contact_pressure"),
-                c.nodal_field(c.active.astype(float), "active_set")]
+        return self.solver.fields()
 
     def von_mises(self) -> fem.Function:
         """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""

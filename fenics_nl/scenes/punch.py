@@ -32,6 +32,7 @@ from fenics_nl.domain.meshes import graded_block
 from fenics_nl.errors import SolveError
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.parallel import gather_rows, global_max
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
 
@@ -139,10 +140,8 @@ class Punch:
         c.set_gap(self.gap(delta))
         c.add_penetrating()  # warm start: the last set and what penetrates now
         res = c.solve()
-        comm = self.mesh.comm
         radius = self._contact_radius()
-        p = c.pressure(self.weight)
-        p_max = comm.allreduce(float(np.max(p[c.active], initial=0.0)), op=MPI.MAX)
+        p_max = global_max(self.mesh.comm, c.pressure(self.weight)[c.active])
         return Indentation(delta, self.symmetry_factor * c.force, radius, p_max,
                            res.active_set_iterations, res.iterations, res.work.factorizations)
 
@@ -150,7 +149,7 @@ class Punch:
         """Distance of the outermost active node from the axis (within h of the true edge)."""
         c = self.contact
         r = self.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
-        return self.mesh.comm.allreduce(float(np.max(r, initial=0.0)), op=MPI.MAX)
+        return global_max(self.mesh.comm, r)
 
     def push(self, force: float, delta0: float, rtol: float = 1e-10, max_it: int = 30
              ) -> tuple[Indentation, int]:
@@ -179,18 +178,17 @@ class Punch:
         """
         c = self.contact
         owned = c.owned
-        local = (self.radius_of(c.x[owned].T), c.pressure(self.weight)[owned], c.active[owned])
-        parts = self.mesh.comm.gather(local, root=0)
-        if self.mesh.comm.rank != 0:
+        rows = gather_rows(self.mesh.comm, self.radius_of(c.x[owned].T),
+                           c.pressure(self.weight)[owned], c.active[owned])
+        if rows is None:
             return None
-        r, p, active = (np.concatenate([x[i] for x in parts]) for i in range(3))
+        r, p, active = rows
         order = np.argsort(r)
         return r[order], p[order], active[order]
 
     def nodes_in_contact(self) -> int:
         """Global number of active S_C nodes."""
-        c = self.contact
-        return self.mesh.comm.allreduce(int(np.sum(c.active & c.owned)))
+        return self.contact.surface.count(self.contact.active)
 
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (DG0), with the hoop strain in the axisymmetric model."""
@@ -198,14 +196,12 @@ class Punch:
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal contact pressure and active set (1/0) on S_C, to write out."""
-        c = self.contact
-        return [c.nodal_field(c.pressure(self.weight), "contact_pressure"),
-                c.nodal_field(c.active.astype(float), "active_set")]
+        return self.contact.fields(self.weight)
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on each constrained group of the modelled part (`boundary`).
 
-        A node shared by two groups (a corner) counts in both.
+        A node shared by two groups (a corner) counts in the first: contact, bottom, symmetry.
         """
         return boundary.reactions(self.residual, self.u, self.groups)
 

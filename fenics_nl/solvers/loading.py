@@ -115,9 +115,11 @@ def solve_incrementally(
         path.factors.append(t)
         path.results.append(result)
         path.work.add(result.work)
-        if progress:
-            progress(f"step {len(path.factors)}: t = {t:.4g}, {result.iterations} iterations, "
-                     f"|R| = {result.residual_norms[-1]:.2e}")
+        if progress:  # a solver may keep no residual history (a composite load, say)
+            norm = (f", |R| = {result.residual_norms[-1]:.2e}" if result.residual_norms
+                    else "")
+            progress(f"step {len(path.factors)}: t = {t:.4g}, {result.iterations} "
+                     f"iterations{norm}")
         if on_step:
             on_step(t, result)
         if adaptive and result.iterations <= easy_iterations:
