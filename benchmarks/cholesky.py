@@ -24,7 +24,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_nl.materials.laws import PowerLaw
-from fenics_nl.scenes.bracket import Bracket
+from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.loading import solve_incrementally
 
 p = argparse.ArgumentParser()
@@ -32,7 +32,7 @@ p.add_argument("--size", type=float, default=6.0)
 p.add_argument("--json")
 args = p.parse_args()
 
-b = Bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
+b = build_bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
             force_scale=8e3)
 for k in range(1, 5):  # the 8 kN state, so that the tangent is the non-linear one
     b.set_load(8e3 * k / 4)
@@ -85,7 +85,7 @@ for kind, flag, ordering in CASES:
 # the same comparison inside Newton: full Newton, 4 load steps to 8 kN, same mesh
 newton = []
 for kind in ("lu", "cholesky"):
-    c = Bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
+    c = build_bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
                 force_scale=8e3, linear_solver=kind)
     t0 = time.perf_counter()
     path = solve_incrementally(c.solver, lambda t, c=c: c.set_load(8e3 * t), 4, adaptive=False,

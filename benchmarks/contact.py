@@ -26,7 +26,7 @@ from mpi4py import MPI
 
 from fenics_nl.contact.peers import solve_penalty, solve_snes_vi
 from fenics_nl.materials.laws import LinearElastic
-from fenics_nl.scenes.punch import Punch
+from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz
 
 HERE = Path(__file__).resolve().parent
@@ -37,8 +37,8 @@ comm = MPI.COMM_WORLD
 
 
 def punch(model, refine, **kw):
-    return Punch(model, LinearElastic(E, NU), R, A, refine=refine,
-                 block=100.0 if model == "3d" else 1000.0, **kw)
+    return build_punch(model, LinearElastic(E, NU), R, A, refine=refine,
+                       block=100.0 if model == "3d" else 1000.0, **kw)
 
 
 def timed_indent(p):
@@ -54,7 +54,7 @@ def linear_solve_time(p):
     du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     a = fem.form(ufl.derivative(p.residual, p.u, du))
     ds = ufl.Measure("ds", domain=p.mesh)
-    L = fem.form(-1.0 * v[p.vertical] * p.weight * ds)
+    L = fem.form(-1.0 * v[p.block.vertical] * p.block.weight * ds)
     return timed_linear_solve(a, L, p.bcs, "lu", "lin_")
 
 
@@ -70,8 +70,8 @@ def refinement(model, refines):
         p = punch(model, r)
         s, t = timed_indent(p)
         e = errors(s)
-        e["contact_radius_error_over_h"] = (s.contact_radius - REF["contact_radius"]) / p.h
-        rows.append({"model": model, "refine": r, "h": p.h, "dofs": p.dofs, "wall_time_s": t,
+        e["contact_radius_error_over_h"] = (s.contact_radius - REF["contact_radius"]) / p.block.h
+        rows.append({"model": model, "refine": r, "h": p.block.h, "dofs": p.dofs, "wall_time_s": t,
                      "force": s.force, "active_set_iterations": s.active_set_iterations,
                      "factorizations": s.factorizations, **e,
                      "linear_solve_time_s": linear_solve_time(p)})
@@ -97,7 +97,7 @@ def peers(refine, penalties):
     r = solve_snes_vi(p, DELTA)
     out["SNES VI (vinewtonrsls)"] = {**r, "force_rel_error": r["force"] / REF["force"] - 1}
     for k in penalties:
-        r = solve_penalty(p, DELTA, k * E / p.h, prefix=f"pen{int(k)}_")
+        r = solve_penalty(p, DELTA, k * E / p.block.h, prefix=f"pen{int(k)}_")
         out[f"penalty k = {k:g} E/h"] = {**r, "force_rel_error": r["force"] / REF["force"] - 1}
     for label, r in out.items():
         say(f"{label:36s} {r['wall_time_s']:.3f} s  "

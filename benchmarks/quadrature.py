@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
 from fenics_nl.materials.laws import PowerLaw
-from fenics_nl.scenes.bracket import Bracket
+from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.loading import solve_incrementally
 
 p = argparse.ArgumentParser()
@@ -29,7 +29,7 @@ args = p.parse_args()
 rows = []
 for size in args.sizes:
     for q in args.degrees:
-        b = Bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=size, degree=2,
+        b = build_bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=size, degree=2,
                     force_scale=8e3, quadrature_degree=q)
         t0 = time.perf_counter()
         try:

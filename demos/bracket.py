@@ -35,13 +35,15 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
+import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output
+from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.parallel import global_max
-from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket
+from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket, BracketPart
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import stalled_at_round_off
 
@@ -50,74 +52,6 @@ VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
 MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit
 DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README table)
 # -
-
-
-def parse_args(argv=None):
-    p = cli.parser(
-        "3D L-bracket in a power-law material, Newton variants side by side. Lengths in "
-        "--units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa).",
-        epilog="PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
-               "(--newton snes) or -bracket_elim_ (--support contact), e.g. "
-               "-bracket_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
-                   help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
-    p.add_argument("--newton", choices=VARIANTS, default=None,
-                   help="non-linear solver (default full)")
-    p.add_argument("--compare", action="store_true",
-                   help="run every variant on the same mesh and print one table")
-    p.add_argument("--force", type=cli.positive, default=8e3,
-                   help="total load on the arm's hole [N]")
-    p.add_argument("--steps", type=cli.at_least(1), default=4, help="equal load steps")
-    p.add_argument("--tolerance", type=cli.finite, default=1e-9,
-                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
-    p.add_argument("--units", choices=list(MM), default="mm",
-                   help="length unit of the geometry, --size and the results")
-    p.add_argument("--size", type=cli.positive, default=None,
-                   help=f"largest element size (default {DEFAULT_SIZE_MM:g} mm), at most "
-                        f"twice the {THICKNESS_MM:g} mm plate thickness")
-    p.add_argument("--degree", type=int, choices=[1, 2], default=2,
-                   help="Lagrange degree (P1 is far too stiff here: see the README)")
-    p.add_argument("--mesh", metavar="MSH",
-                   help="a .msh file with groups bolts, load, base (in --units; not with --size)")
-    p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
-                   help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
-    p.add_argument("--material", choices=["power-law", "linear"], default="power-law",
-                   help="the power law below, or linear elasticity (E, nu): one Newton "
-                        "iteration per load step")
-    p.add_argument("--E", type=cli.positive, default=None,
-                   help="Young's modulus (default 200 GPa, in N/unit²)")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--sigma0", type=cli.positive, default=None,
-                   help="power law: reference stress (default 200 MPa, in N/unit²)")
-    p.add_argument("--n", type=cli.positive, default=None,
-                   help="power law exponent [-] (default 0.2)")
-    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
-                              "floor pressure and active set",
-                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
-                    plot="load against load-point displacement")
-    args, petsc_args = cli.parse_with_petsc_options(p, argv)
-    if args.compare and args.newton:
-        p.error("--compare runs every Newton variant: drop --newton")
-    args.newton = args.newton or "full"
-    if args.compare and (args.png or args.plot or args.output):
-        p.error("--compare prints a table of the variants: --png, --plot and --output "
-                "go with one --newton")
-    if args.mesh and args.size is not None:
-        p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
-    mm = MM[args.units]
-    args.E = args.E if args.E is not None else 200e3 / mm**2
-    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
-    if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
-        p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
-                f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
-    return args, petsc_args
-
-
-def main(argv=None) -> int:
-    args, petsc_args = parse_args(argv)
-    prefixes = {"bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"}
-    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
-                         prefixes=prefixes)
 
 
 def run(args):
@@ -139,14 +73,42 @@ def run(args):
 
 def run_variant(args, newton):
     """Load steps with one Newton variant; returns the bracket and a record per step."""
-    material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
-                if args.material == "power-law" else LinearElastic(args.E, args.nu))
+    # ### The part
+    #
+    # The gmsh geometry (or the user's .msh) with its physical groups: the bolt holes are
+    # clamped, the loaded hole carries a uniform traction of total force F along +x.
     mm = MM[args.units]
     size_mm = args.size / mm if args.size is not None else DEFAULT_SIZE_MM
     say("reading " + args.mesh if args.mesh else f"meshing the bracket (size {size_mm:g} mm) ...")
-    b = Bracket(material, size=size_mm, mesh_file=args.mesh, support=args.support,
-                degree=args.degree, newton=newton, force_scale=args.force,
-                tolerance=args.tolerance, length_scale=1.0 if args.mesh else mm,
+    part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
+                       degree=args.degree, length_scale=1.0 if args.mesh else mm)
+
+    # ### The material
+    #
+    # The power law's energy $\varphi(\varepsilon)$ (or Hooke's); $\sigma$ and the
+    # tangent are its derivatives, taken by UFL.
+    material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
+                if args.material == "power-law" else LinearElastic(args.E, args.nu))
+
+    # ### The residual
+    #
+    # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,dx -
+    # \int_{S_{load}} t \cdot v\,ds$, the traction $t$ scaled by the load factor.
+    # +
+    u, v = part.u, ufl.TestFunction(part.V)
+    eps = kinematics.small_strain
+    residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
+                - ufl.dot(part.traction, v) * part.ds_load)
+    # -
+
+    # ### The solver
+    #
+    # `Bracket` builds the chosen Newton variant (`fenics_nl.solvers.NewtonSolver`: full,
+    # modified, periodic, quasi-Newton; or PETSc SNES) on this residual, inside the
+    # active-set loop when the base rests on the floor. Its absolute tolerance is
+    # `--tolerance` times the load.
+    b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
+                tolerance=args.tolerance,
                 linear_solver="lu" if args.solver == "direct" else "gamg")
     say(f"{b.dofs} unknowns (P{args.degree}), {newton} Newton, {args.steps} load steps")
     steps = []
@@ -166,7 +128,9 @@ def run_variant(args, newton):
             f"{r.iterations} Newton iterations{sets}, |u_load| = "
             f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
 
-    # equal steps, each from the last converged state (no predictor, no step control)
+    # ### Load steps
+    #
+    # Equal steps, each from the last converged state (no predictor, no step control).
     # +
     t0 = time.perf_counter()
     try:
@@ -278,10 +242,7 @@ def writers(b, vm, steps, args):
 def plot(steps, args):
     if comm.rank != 0:
         return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pictures.pyplot()
 
     fig, ax = plt.subplots(figsize=(5, 4))
     ax.plot([0] + [s["load_point_displacement"] for s in steps],
@@ -291,17 +252,83 @@ def plot(steps, args):
     ax.grid(alpha=0.3)
     ax.set_title(f"bracket, {args.support} support, {args.material}"
                  + (f" n = {args.n}" if args.material == "power-law" else ""))
-    fig.tight_layout()
-    fig.savefig(args.plot, dpi=120)
-    print(f"wrote {args.plot}")
+    pictures.save_figure(fig, args.plot)
 
 
 def picture(b, vm, args):
     """Two views of the deformed bracket (σ_eq), the load arrow, the bolts, the floor."""
-    from fenics_nl.io.pictures import bracket_picture
-
-    bracket_picture(b, vm, args.png, units=args.units, force=args.force)
+    pictures.bracket_picture(b, vm, args.png, units=args.units, force=args.force)
     say(f"wrote {args.png}")
+
+
+# ## The command line
+
+def parse_args(argv=None):
+    p = cli.parser(
+        "3D L-bracket in a power-law material, Newton variants side by side. Lengths in "
+        "--units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa).",
+        epilog="PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
+               "(--newton snes) or -bracket_elim_ (--support contact), e.g. "
+               "-bracket_ksp_view. An option no solver reads is an error.")
+    p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
+                   help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
+    p.add_argument("--newton", choices=VARIANTS, default=None,
+                   help="non-linear solver (default full)")
+    p.add_argument("--compare", action="store_true",
+                   help="run every variant on the same mesh and print one table")
+    p.add_argument("--force", type=cli.positive, default=8e3,
+                   help="total load on the arm's hole [N]")
+    p.add_argument("--steps", type=cli.at_least(1), default=4, help="equal load steps")
+    p.add_argument("--tolerance", type=cli.finite, default=1e-9,
+                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
+    p.add_argument("--units", choices=list(MM), default="mm",
+                   help="length unit of the geometry, --size and the results")
+    p.add_argument("--size", type=cli.positive, default=None,
+                   help=f"largest element size (default {DEFAULT_SIZE_MM:g} mm), at most "
+                        f"twice the {THICKNESS_MM:g} mm plate thickness")
+    p.add_argument("--degree", type=int, choices=[1, 2], default=2,
+                   help="Lagrange degree (P1 is far too stiff here: see the README)")
+    p.add_argument("--mesh", metavar="MSH",
+                   help="a .msh file with groups bolts, load, base (in --units; not with --size)")
+    p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
+                   help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
+    p.add_argument("--material", choices=["power-law", "linear"], default="power-law",
+                   help="the power law below, or linear elasticity (E, nu): one Newton "
+                        "iteration per load step")
+    p.add_argument("--E", type=cli.positive, default=None,
+                   help="Young's modulus (default 200 GPa, in N/unit²)")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--sigma0", type=cli.positive, default=None,
+                   help="power law: reference stress (default 200 MPa, in N/unit²)")
+    p.add_argument("--n", type=cli.positive, default=None,
+                   help="power law exponent [-] (default 0.2)")
+    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
+                              "floor pressure and active set",
+                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
+                    plot="load against load-point displacement")
+    args, petsc_args = cli.parse_with_petsc_options(p, argv)
+    if args.compare and args.newton:
+        p.error("--compare runs every Newton variant: drop --newton")
+    args.newton = args.newton or "full"
+    if args.compare and (args.png or args.plot or args.output):
+        p.error("--compare prints a table of the variants: --png, --plot and --output "
+                "go with one --newton")
+    if args.mesh and args.size is not None:
+        p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
+    mm = MM[args.units]
+    args.E = args.E if args.E is not None else 200e3 / mm**2
+    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
+    if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
+        p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
+                f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
+    return args, petsc_args
+
+
+def main(argv=None) -> int:
+    args, petsc_args = parse_args(argv)
+    prefixes = {"bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"}
+    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
+                         prefixes=prefixes)
 
 
 if __name__ == "__main__":

@@ -35,17 +35,231 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output
+from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.materials import kinematics
 from fenics_nl.parallel import gather_rows
-from fenics_nl.scenes.beam import Beam
+from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
 
 comm = MPI.COMM_WORLD
 # -
 
+
+def progress(steps):
+    """Show about ten of the path's step lines, and every cut or branch switch."""
+    every = max(1, steps // 10)
+
+    def show(message):
+        if message.startswith("step "):
+            k = int(message.split()[1].rstrip(":"))
+            if k % every:
+                return
+        say("  " + message)
+
+    return show
+
+
+def run(args):
+    # ### The cantilever
+    #
+    # Q2 quadrilaterals (square, 2·2^refine through the height), clamped at $x = 0$, a dead
+    # traction $(-P, \varepsilon P)/h$ on the end face.
+    cantilever = Cantilever(args.length, args.thickness, plane=args.plane,
+                            refine=args.refine, imperfection=args.imperfection)
+
+    # ### The material
+    #
+    # A free energy of the Green–Lagrange strain $e = (F^TF - I)/2$; the second
+    # Piola–Kirchhoff stress $S = \partial\varphi/\partial e$ is derived by UFL.
+    material = MATERIALS[args.material](args.E, args.nu)
+
+    # ### The residual
+    #
+    # Total Lagrangian: $R(u; v) = \int_{\Omega_0} P(u) : \nabla v\,d\Omega_0 -
+    # \int_{end} t \cdot v\,dS_0$ with $P = F S$ the first Piola–Kirchhoff stress and $t$
+    # the dead traction.
+    # +
+    u, v = cantilever.u, ufl.TestFunction(cantilever.V)
+    grad_v = kinematics.displacement_gradient(v, cantilever.model)
+    residual = (ufl.inner(material.first_piola(u, cantilever.model), grad_v) * cantilever.dx
+                - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
+    # -
+    beam = Beam(cantilever, material, residual)
+    say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
+        f"{args.material}, plane {args.plane}")
+
+    # ### Linear buckling (SLEPc) against Euler
+    #
+    # $(K + \lambda K_G)\varphi = 0$ around the straight state pre-stressed by a unit load.
+    # +
+    loads, _ = beam.critical_loads(3)
+    P_cr = loads[0]
+    say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
+        f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
+    # -
+
+    # ### The post-buckling path
+    #
+    # Post-buckling path: load steps to r·P_Euler (never larger than 1/n, cut on failure),
+    # then the stability check of the end state and, if needed, branch switching.
+    # +
+    history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
+
+    def record(t, result):
+        r = t * args.load_ratio
+        # a redone path, or the branch-switched end state, replaces what it passes again
+        while len(history) > 1 and history[-1][0] >= r:
+            history.pop()
+        while shapes and shapes[-1][0] >= r:
+            shapes.pop()
+        tip = beam.tip()
+        history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
+                        tip["axial"]))
+        if args.png:
+            shapes.append((r, centreline(beam)))
+
+    say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
+    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
+                                     on_step=record, progress=progress(args.steps))
+    redone = [] if beam.path_steps == args.steps else [
+        f"the {args.steps}-step path ended on the straight (unstable) branch; it was redone "
+        f"with {beam.path_steps} steps"]
+    # -
+
+    # ### Against the elastica
+    #
+    # Tip rotation, lateral deflection and axial displacement at the last load.
+    # +
+    tip = beam.tip()
+    alpha = math.degrees(abs(tip["rotation"]))
+    alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
+    d_el, x_el = elastica.tip_position(args.load_ratio)
+    say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
+        f"{alpha_el:.3f}), lateral deflection {abs(tip['lateral']):.5g} (elastica "
+        f"{d_el * args.length:.5g}), axial displacement {tip['axial']:.5g} (elastica "
+        f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
+        f"{path.iterations} Newton iterations, {path.failures} step cuts")
+    out = {
+        "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
+        "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
+        "tip_rotation_deg": alpha, "tip_deflection": abs(tip["lateral"]),
+        "tip_axial_displacement": tip["axial"], "elastica_tip_rotation_deg": alpha_el,
+        "elastica_tip_deflection": d_el * args.length,
+        "elastica_tip_axial_displacement": (x_el - 1) * args.length,
+        "load_steps": len(path.factors), "step_cuts": path.failures,
+        "newton_iterations": sum(r.iterations for r in path.results),
+        "factorizations": path.work.factorizations, "branch_switched": switched,
+        "newton": args.newton, "reactions": beam.reactions(),
+        "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
+        "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
+                 for h in history],
+        "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
+                     "by O((h/L)²)", *redone],
+    }
+    # -
+    writers = []
+    if args.output:
+        def fields():
+            paths = output.write_fields(args.output, [beam.u])
+            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
+        writers.append(fields)
+    if args.plot:
+        writers.append(lambda: plot(history, args))
+    if args.png:
+        writers.append(lambda: picture(shapes, args))
+    return out, writers
+
+
+def centreline(beam):
+    """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
+    X = beam.V.tabulate_dof_coordinates()
+    on = np.isclose(X[:, 1], 0.0)
+    u = beam.u.x.array.reshape(-1, 2)[on]
+    rows = gather_rows(comm, X[on, 0], X[on, :2] + u)
+    if rows is None:
+        return None
+    x0, pts = rows
+    return pts[np.argsort(x0)]
+
+
+def plot(history, args):
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+
+    h = np.array(history)
+    top = max(h[:, 0].max(), 1.1) * 1.05
+    alpha_top = math.radians(min(179, 1.15 * max(h[:, 1].max(), 10)))
+    alpha = np.linspace(1e-3, alpha_top, 300)
+    ratio = np.array([elastica.load_ratio(a) for a in alpha])
+    keep = ratio <= top
+    k = np.sin(alpha / 2)
+    from scipy.special import ellipk
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    a1.plot(np.degrees(alpha[keep]), ratio[keep], "-", label="elastica")
+    a1.plot(h[:, 1], h[:, 0], "o", ms=3, label="finite strain FE")
+    a1.set_xlabel("tip rotation α [deg]")
+    a2.plot((2 * k / ellipk(k * k) * args.length)[keep], ratio[keep], "-", label="elastica")
+    a2.plot(h[:, 2], h[:, 0], "o", ms=3, label="finite strain FE")
+    a2.set_xlabel("lateral tip deflection [length]")
+    for a in (a1, a2):
+        a.axhline(1.0, color="gray", lw=0.5)
+        a.set_ylim(0, top)
+        a.set_xlim(left=0)
+        a.set_ylabel("P / P_cr (Euler)")
+        a.grid(alpha=0.3)
+        a.legend()
+    fig.suptitle(f"cantilever, L/h = {args.length / args.thickness:g}, imperfection "
+                 f"{args.imperfection:g} P: P/P_cr = {args.load_ratio:g}, α = {h[-1, 1]:.2f}° "
+                 f"(elastica {math.degrees(elastica.tip_rotation(args.load_ratio)):.2f}°)")
+    pictures.save_figure(fig, args.plot)
+
+
+def picture(shapes, args):
+    """Computed centrelines past P_cr (solid) on the elastica's (dashed), same colours."""
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+
+    fig, ax = plt.subplots(figsize=(7, 6))
+    L = args.length
+    ax.plot([0, L], [0, 0], "k:", lw=0.8, label="undeformed")
+    # below P_cr the beam stays straight: one shape stands for them all
+    # past 1.05 P_cr: closer to P_cr the imperfect beam still lags behind the perfect
+    # elastica (the imperfection's amplification), which would read as a disagreement
+    buckled = [s for s in shapes if s[0] >= 1.05]
+    picks = buckled[:: max(1, len(buckled) // 6)] + shapes[-1:]
+    picks = list({round(r, 6): (r, pts) for r, pts in picks}.values())
+    cmap = plt.get_cmap("viridis")
+    top = max(s[0] for s in picks)
+    for r, pts in picks:
+        colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
+        sign = 1 if pts[-1, 1] >= 0 else -1
+        ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
+        xe, ye = elastica.shape(r)
+        ax.plot(xe * L, sign * ye * L, "--", color="k", lw=0.8)
+    ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
+    ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
+                arrowprops={"arrowstyle": "->"})
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [length]")
+    ax.set_ylabel("y [length]")
+    alpha = math.degrees(math.atan2(*np.diff(picks[-1][1][-2:], axis=0)[0][::-1]))
+    ax.set_title(f"buckled cantilever, dead end load up to P/P_cr = {args.load_ratio:g} "
+                 f"(imperfection {args.imperfection:g} P)\nend slope at the last load "
+                 f"{abs(alpha):.1f}°, elastica "
+                 f"{math.degrees(elastica.tip_rotation(args.load_ratio)):.1f}°", fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    ax.grid(alpha=0.3)
+    pictures.save_figure(fig, args.png)
+
+
+# ## The command line
 
 def parse_args(argv=None):
     p = cli.parser(
@@ -82,6 +296,8 @@ def parse_args(argv=None):
         p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")
     if not 0 <= args.imperfection < 0.1:
         p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
+    if args.material == "neo-hookean" and args.plane == "stress":
+        p.error("neo-hookean is implemented in plane strain only (--plane strain)")
     return args, petsc_args
 
 
@@ -89,194 +305,6 @@ def main(argv=None) -> int:
     args, petsc_args = parse_args(argv)
     return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
                          prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
-
-
-def progress(steps):
-    """Show about ten of the path's step lines, and every cut or branch switch."""
-    every = max(1, steps // 10)
-
-    def show(message):
-        if message.startswith("step "):
-            k = int(message.split()[1].rstrip(":"))
-            if k % every:
-                return
-        say("  " + message)
-
-    return show
-
-
-def run(args):
-    beam = Beam(args.length, args.thickness, args.E, args.nu, material=args.material,
-                plane=args.plane, refine=args.refine, imperfection=args.imperfection)
-    say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
-        f"{args.material}, plane {args.plane}")
-
-    # Linear buckling (SLEPc) against Euler.
-    # +
-    loads, _ = beam.critical_loads(3)
-    P_cr = loads[0]
-    say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
-        f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
-    # -
-
-    # Post-buckling path: load steps to r·P_Euler (never larger than 1/n, cut on failure),
-    # then the stability check of the end state and, if needed, branch switching.
-    # +
-    history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
-
-    def record(t, result):
-        r = t * args.load_ratio
-        # a redone path, or the branch-switched end state, replaces what it passes again
-        while len(history) > 1 and history[-1][0] >= r:
-            history.pop()
-        while shapes and shapes[-1][0] >= r:
-            shapes.pop()
-        tip = beam.tip()
-        history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
-                        tip["axial"]))
-        if args.png:
-            shapes.append((r, centreline(beam)))
-
-    say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
-    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                     on_step=record, progress=progress(args.steps))
-    redone = [] if beam.path_steps == args.steps else [
-        f"the {args.steps}-step path ended on the straight (unstable) branch; it was redone "
-        f"with {beam.path_steps} steps"]
-    # -
-
-    tip = beam.tip()
-    alpha = math.degrees(abs(tip["rotation"]))
-    alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
-    d_el, x_el = elastica.tip_position(args.load_ratio)
-    say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
-        f"{alpha_el:.3f}), lateral deflection {abs(tip['lateral']):.5g} (elastica "
-        f"{d_el * args.length:.5g}), axial displacement {tip['axial']:.5g} (elastica "
-        f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
-        f"{path.iterations} Newton iterations, {path.failures} step cuts")
-    out = {
-        "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
-        "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
-        "tip_rotation_deg": alpha, "tip_deflection": abs(tip["lateral"]),
-        "tip_axial_displacement": tip["axial"], "elastica_tip_rotation_deg": alpha_el,
-        "elastica_tip_deflection": d_el * args.length,
-        "elastica_tip_axial_displacement": (x_el - 1) * args.length,
-        "load_steps": len(path.factors), "step_cuts": path.failures,
-        "newton_iterations": sum(r.iterations for r in path.results),
-        "factorizations": path.work.factorizations, "branch_switched": switched,
-        "newton": args.newton, "reactions": beam.reactions(),
-        "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
-        "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
-                 for h in history],
-        "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
-                     "by O((h/L)²)", *redone],
-    }
-    writers = []
-    if args.output:
-        def fields():
-            paths = output.write_fields(args.output, [beam.u])
-            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-        writers.append(fields)
-    if args.plot:
-        writers.append(lambda: plot(history, args))
-    if args.png:
-        writers.append(lambda: picture(shapes, args))
-    return out, writers
-
-
-def centreline(beam):
-    """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
-    X = beam.V.tabulate_dof_coordinates()
-    on = np.isclose(X[:, 1], 0.0)
-    u = beam.u.x.array.reshape(-1, 2)[on]
-    rows = gather_rows(comm, X[on, 0], X[on, :2] + u)
-    if rows is None:
-        return None
-    x0, pts = rows
-    return pts[np.argsort(x0)]
-
-
-def plot(history, args):
-    if comm.rank != 0:
-        return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    h = np.array(history)
-    top = max(h[:, 0].max(), 1.1) * 1.05
-    alpha_top = math.radians(min(179, 1.15 * max(h[:, 1].max(), 10)))
-    alpha = np.linspace(1e-3, alpha_top, 300)
-    ratio = np.array([elastica.load_ratio(a) for a in alpha])
-    keep = ratio <= top
-    k = np.sin(alpha / 2)
-    from scipy.special import ellipk
-
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    a1.plot(np.degrees(alpha[keep]), ratio[keep], "-", label="elastica")
-    a1.plot(h[:, 1], h[:, 0], "o", ms=3, label="finite strain FE")
-    a1.set_xlabel("tip rotation α [deg]")
-    a2.plot((2 * k / ellipk(k * k) * args.length)[keep], ratio[keep], "-", label="elastica")
-    a2.plot(h[:, 2], h[:, 0], "o", ms=3, label="finite strain FE")
-    a2.set_xlabel("lateral tip deflection [length]")
-    for a in (a1, a2):
-        a.axhline(1.0, color="gray", lw=0.5)
-        a.set_ylim(0, top)
-        a.set_xlim(left=0)
-        a.set_ylabel("P / P_cr (Euler)")
-        a.grid(alpha=0.3)
-        a.legend()
-    fig.suptitle(f"cantilever, L/h = {args.length / args.thickness:g}, imperfection "
-                 f"{args.imperfection:g} P: P/P_cr = {args.load_ratio:g}, α = {h[-1, 1]:.2f}° "
-                 f"(elastica {math.degrees(elastica.tip_rotation(args.load_ratio)):.2f}°)")
-    fig.tight_layout()
-    fig.savefig(args.plot, dpi=120)
-    print(f"wrote {args.plot}")
-
-
-def picture(shapes, args):
-    """Computed centrelines past P_cr (solid) on the elastica's (dashed), same colours."""
-    if comm.rank != 0:
-        return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 6))
-    L = args.length
-    ax.plot([0, L], [0, 0], "k:", lw=0.8, label="undeformed")
-    # below P_cr the beam stays straight: one shape stands for them all
-    # past 1.05 P_cr: closer to P_cr the imperfect beam still lags behind the perfect
-    # elastica (the imperfection's amplification), which would read as a disagreement
-    buckled = [s for s in shapes if s[0] >= 1.05]
-    picks = buckled[:: max(1, len(buckled) // 6)] + shapes[-1:]
-    picks = list({round(r, 6): (r, pts) for r, pts in picks}.values())
-    cmap = plt.get_cmap("viridis")
-    top = max(s[0] for s in picks)
-    for r, pts in picks:
-        colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
-        sign = 1 if pts[-1, 1] >= 0 else -1
-        ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
-        xe, ye = elastica.shape(r)
-        ax.plot(xe * L, sign * ye * L, "--", color="k", lw=0.8)
-    ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
-    ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
-                arrowprops={"arrowstyle": "->"})
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [length]")
-    ax.set_ylabel("y [length]")
-    alpha = math.degrees(math.atan2(*np.diff(picks[-1][1][-2:], axis=0)[0][::-1]))
-    ax.set_title(f"buckled cantilever, dead end load up to P/P_cr = {args.load_ratio:g} "
-                 f"(imperfection {args.imperfection:g} P)\nend slope at the last load "
-                 f"{abs(alpha):.1f}°, elastica "
-                 f"{math.degrees(elastica.tip_rotation(args.load_ratio)):.1f}°", fontsize=10)
-    ax.legend(fontsize=8, loc="best")
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(args.png, dpi=120)
-    print(f"wrote {args.png}")
 
 
 if __name__ == "__main__":

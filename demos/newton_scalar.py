@@ -138,10 +138,9 @@ def table(method, res, orders, failure):
 
 def plot(results, path, title):
     """e_{k+1} against e_k, log-log: near the root the points lie on lines of slope q."""
-    import matplotlib
+    from fenics_nl.io import pictures  # imports dolfinx: only when a plot is asked for
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pictures.pyplot()
 
     fig, ax = plt.subplots(figsize=(6, 5))
     lo, hi = math.inf, 0.0
@@ -168,9 +167,7 @@ def plot(results, path, title):
     ax.set_title(f"e_k+1 against e_k (grey: slopes 1, 1.62, 2)\n{title}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    print(f"wrote {path}")
+    pictures.save_figure(fig, path)
 
 
 if __name__ == "__main__":

@@ -26,7 +26,7 @@
 # The block must behave like a half-space: it is 1000 contact radii wide and deep (100 in
 # 3D), with elements of a/40 under the punch growing by 5 % of the distance away from it;
 # on the axisymmetric model this keeps the block-size and far-field error near 0.15 %,
-# below the 0.5 % asked of the force (the sizes are measured in `fenics_nl/punch.py`).
+# below the 0.5 % asked of the force (the sizes are measured in `fenics_nl/scenes/punch.py`).
 #
 # ## Implementation
 
@@ -39,12 +39,14 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output
+from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes.punch import Punch, PunchLoad
+from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz
 
@@ -54,6 +56,275 @@ MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
 FEW_NODES = 10  # below this, a and p0 are coarse: say so
 # -
 
+
+def expected_radius(args):
+    """The contact radius the mesh is built for: Hertz's a for a sphere pushed by P (and
+    the cylinder's half-width), else √(Rδ) (a safe overestimate of a cylinder's)."""
+    E, nu, R = args.E, args.nu, args.radius
+    if args.force is not None:
+        if args.model == "plane-strain":
+            return hertz.cylinder_from_force(E, nu, R, args.force)["contact_radius"]
+        return hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
+    return math.sqrt(R * abs(args.indentation))
+
+
+def run(args):
+    if args.indentation is None and args.force is None:
+        args.indentation = 0.01 * args.radius
+    # ### The block
+    #
+    # A graded mesh, fine (h = a/40 by default) within 1.5 a of the axis and coarser away
+    # from it, in a block 1000 a wide (100 a in 3D) so that it behaves like Hertz's
+    # half-space. Its bottom slides on a rigid base; the symmetry planes carry their
+    # symmetry conditions; its top is the contact surface $S_C$.
+    a = expected_radius(args)
+    size = args.block or (100.0 if args.model == "3d" else 1000.0)
+    say(f"meshing the {args.model} block ({size:g} contact radii) ...")
+    block = PunchBlock(args.model, a, refine=args.refine, block=size)
+
+    # ### The material
+    #
+    # A free energy $\varphi(\varepsilon)$; the stress $\sigma = \partial\varphi/\partial
+    # \varepsilon$ and the tangent are derived from it by UFL. Hertz's theory is linear
+    # elastic; the power law puts a Newton loop inside every active-set iteration.
+    material = (LinearElastic(args.E, args.nu) if args.material == "linear"
+                else PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n))
+
+    # ### The residual
+    #
+    # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega$, and no
+    # external load: the punch acts only through the contact conditions. In the
+    # axisymmetric model $\varepsilon$ has the hoop strain $u_r/r$ and the weight is
+    # $2\pi r$, so that $R$ is the whole body's.
+    # +
+    u, v = block.u, ufl.TestFunction(block.V)
+    eps = kinematics.small_strain
+    residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
+                * block.weight * block.dx)
+    # -
+
+    # ### The active-set loop, in load steps
+    #
+    # `Punch` gives the residual, the supports and the gap $\gamma$ to
+    # `fenics_nl.contact.ActiveSetContact`, which runs the course's loop: solve with
+    # $u_n = \gamma$ on the active nodes (rows eliminated, or Lagrange multipliers), then
+    # update the set (leave where $T_n > 0$, join where $u_n > \gamma$) until it stops
+    # changing. The load (δ, or the force P by a secant iteration on δ) grows in equal
+    # steps, each started from the last active set.
+    # +
+    punch = Punch(block, material, residual, args.radius, formulation=args.formulation,
+                  gap=args.gap)
+    say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
+    load = PunchLoad(punch, indentation=args.indentation, force=args.force,
+                     first_guess=a * a / args.radius)
+    states = load.states
+
+    def report(t, result):
+        s = states[-1]
+        say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
+            f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
+            f"{s.active_set_iterations} active-set iterations")
+
+    solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
+                        on_step=report)
+    # -
+
+    # ### Against Hertz
+    #
+    # The force, the radius of the outermost active node and the largest nodal pressure,
+    # with their relative errors (`check_against_hertz` below also refuses a contact zone
+    # the mesh cannot resolve); with several steps, the exponent of P ∝ δ^m (Hertz: 1.5).
+    # +
+    last = states[-1]
+    out = {"model": args.model, "formulation": args.formulation, "material": args.material,
+           "force": last.force, "indentation": last.indentation,
+           "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
+           "element_size": block.h, "nodes_in_contact": punch.nodes_in_contact(),
+           "active_set_iterations": sum(s.active_set_iterations for s in states),
+           "newton_iterations": sum(s.newton_iterations for s in states),
+           "factorizations": sum(s.factorizations for s in states),
+           "steps": [{"indentation": s.indentation, "force": s.force,
+                      "contact_radius": s.contact_radius,
+                      "active_set_iterations": s.active_set_iterations} for s in states],
+           "reactions": punch.reactions(),
+           "reactions_of": {"axisymmetric": "the whole body (2πr in the residual)",
+                            "3d": "the modelled quarter",
+                            "plane-strain": "the modelled half, per unit length"}[args.model],
+           "dofs": punch.dofs, "ranks": comm.size, "warnings": []}
+    ref = check_against_hertz(punch, last, args, out)
+    if len(states) >= 2 and all(s.force > 0 for s in states):
+        d = np.log([s.indentation for s in states])
+        f = np.log([s.force for s in states])
+        out["fitted_exponent"] = float(np.polyfit(d, f, 1)[0])
+        theory = " (Hertz: 1.5)" if args.model != "plane-strain" else ""
+        say(f"P ∝ δ^{out['fitted_exponent']:.4f} over the steps{theory}")
+    # -
+    writers = []
+    vm = punch.von_mises() if args.output or args.png else None  # once for both
+    if args.output:
+        writers.append(lambda: write_fields(punch, vm, args.output))
+    if args.plot:
+        writers.append(lambda: plot(punch, states, ref, args))
+    if args.png:
+        writers.append(lambda: picture(punch, vm, last, ref, args))
+    return out, writers
+
+
+def check_against_hertz(punch, last, args, out):
+    """Hertz's values where theory gives them, relative errors, and what is not checked."""
+    n, h = out["nodes_in_contact"], punch.block.h
+    if last.force > 0 and n < MIN_NODES:
+        raise ValueError(f"only {n} node(s) of the surface are in contact (h = {h:.3g}, "
+                         f"contact radius {last.contact_radius:.3g}): the mesh cannot resolve "
+                         f"the contact zone; lower --refine or check the load")
+    if last.force > 0 and n < FEW_NODES:
+        out["warnings"].append(f"only {n} nodes in contact: contact radius and p0 are "
+                               f"resolved to about h = {punch.block.h:.3g} only")
+    if args.material != "linear":
+        out["warnings"].append("power-law material: Hertz's values are the linear reference, "
+                               "not a check")
+    if last.force == 0.0:
+        say("the punch does not touch the block: zero contact force")
+        return None
+    ref = punch.hertz(last)
+    for key in ("force", "contact_radius", "max_pressure"):
+        if key in ref:
+            out[f"hertz_{key}"] = ref[key]
+            out[f"{key}_rel_error"] = getattr(last, key) / ref[key] - 1
+    if args.model == "plane-strain":
+        out["warnings"].append("plane strain: the force is not checked (a cylinder's "
+                               "indentation depends on the block, Hertz gives no P(δ)); "
+                               "half-width and p0 are checked against Hertz for the computed P")
+        say(f"P = {last.force:.6g} per unit length (not checked); half-width "
+            f"{last.contact_radius:.5g} (Hertz {ref['contact_radius']:.5g}, "
+            f"{100 * out['contact_radius_rel_error']:+.2f} %, h = {punch.block.h:.2g}); p0 "
+            f"{last.max_pressure:.5g} (Hertz {ref['max_pressure']:.5g}, "
+            f"{100 * out['max_pressure_rel_error']:+.2f} %)")
+    else:
+        say(f"force {last.force:.6g} (Hertz {ref['force']:.6g}, "
+            f"{100 * out['force_rel_error']:+.3f} %); radius {last.contact_radius:.5g} (Hertz "
+            f"{ref['contact_radius']:.5g}, h = {punch.block.h:.2g}); p0 {last.max_pressure:.5g} "
+            f"(Hertz {ref['max_pressure']:.5g}, {100 * out['max_pressure_rel_error']:+.2f} %)")
+    return ref
+
+
+def write_fields(punch, vm, folder):
+    paths = output.write_fields(folder, [punch.u, *punch.contact_fields(), vm])
+    say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
+
+
+def plot(punch, states, ref, args):
+    profile = punch.surface_profile()
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    d = np.array([0.0] + [s.indentation for s in states])
+    P = np.array([0.0] + [s.force for s in states])
+    ax1.plot(d, P, "o", label="active set (FE)")
+    if args.model != "plane-strain":
+        dd = np.linspace(0, d.max(), 100)
+        Es = hertz.effective_modulus(args.E, args.nu)
+        ax1.plot(dd, 4 / 3 * Es * np.sqrt(args.radius) * dd**1.5, "-", label="Hertz")
+    ax1.set_xlabel("indentation δ [length]")
+    ax1.set_ylabel("force P [force]" + (" per unit length" if args.model == "plane-strain"
+                                        else ""))
+    ax1.legend()
+    ax1.grid(alpha=0.3)
+    if ref is not None:
+        pressure_panel(ax2, profile, states[-1], ref)
+    fig.suptitle(title(states[-1], ref, args))
+    pictures.save_figure(fig, args.plot)
+
+
+def title(state, ref, args):
+    """The load and the key figure, with what is checked against Hertz."""
+    if ref is None:
+        return f"{args.model} punch: no contact (δ = {state.indentation:.3g})"
+    a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
+    p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
+    if args.model == "plane-strain":
+        return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
+                f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
+    if args.force is not None:  # P prescribed: the check is on the indentation it needs
+        d_ref = hertz.sphere_from_force(args.E, args.nu, args.radius, state.force)["indentation"]
+        return (f"{args.model} punch, P = {state.force:.4g} (prescribed): δ = "
+                f"{state.indentation:.3g} ({100 * (state.indentation / d_ref - 1):+.2f} % from "
+                f"Hertz), a {a_err:+.1f} %, p0 {p_err:+.1f} %")
+    return (f"{args.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
+            f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
+            f"p0 {p_err:+.1f} %")
+
+
+def pressure_panel(ax, profile, state, ref):
+    """p/p0 against r/a (Hertz's a and p0), FE nodes against Hertz's ellipse."""
+    r, p, _ = profile
+    a, p0 = ref["contact_radius"], ref["max_pressure"]
+    ax.plot(r / a, p / p0, "o", ms=3, label="FE nodal pressure")
+    rr = np.linspace(0, 1.5, 300)
+    ax.plot(rr, hertz.pressure_profile(1.0, 1.0, rr), "-", label="Hertz")
+    ax.axvline(state.contact_radius / a, color="C3", ls="--", lw=1,
+               label=f"last active node: a = {state.contact_radius:.3g}")
+    ax.axvline(1.0, color="gray", ls=":", lw=1, label=f"Hertz a = {a:.3g}")
+    ax.set_xlim(0, 1.5)
+    ax.set_ylim(-0.05, 1.25)
+    ax.set_xlabel("r / a (Hertz)")
+    ax.set_ylabel(f"contact pressure p / p0 (Hertz p0 = {p0:.3g})")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+
+
+def picture(punch, vm, state, ref, args):
+    """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
+    section = output.section(punch.u, vm, normal_axis=1 if punch.block.vertical == 2
+                             else None)
+    profile = punch.surface_profile()
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    x, z, u_x, u_z, triangles, vm = section
+    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * punch.block.h)
+    window = 2.5 * a
+    # the rigid drop of the block is removed (the surface at the window's edge stays put),
+    # and the dent is drawn about a/4 deep
+    at_edge = np.argmin(np.hypot(x - window, z))
+    drop = u_z[at_edge]
+    dent = max(abs(state.indentation + drop), 1e-300)
+    scale = max(1.0, 0.25 * a / dent)
+    xd, zd = x + scale * u_x, z + scale * (u_z - drop)
+    p0 = ref["max_pressure"] if ref else max(state.max_pressure, 1e-300)
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 4.8),
+                                  gridspec_kw={"width_ratios": [1.25, 1]})
+    tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
+                       edgecolors="face", vmin=0)
+    ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
+    rr = np.linspace(0, window, 300)
+    gap = punch.gap_at(rr, state.indentation)
+    ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
+    ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
+    ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
+    if ref:
+        ax.plot([ref["contact_radius"]] * 2, [-0.3 * a, -0.15 * a], color="k", lw=1)
+        ax.annotate("a (Hertz)", (ref["contact_radius"], -0.38 * a), ha="center", fontsize=8)
+    ax.set_xlim(0, window)
+    ax.set_ylim(-2 * a, 0.5 * a)
+    ax.set_aspect("equal")
+    ax.set_xlabel("r [length]" if args.model == "axisymmetric" else "x [length]")
+    ax.set_ylabel("z [length]" + (" (section y = 0)" if args.model == "3d" else ""))
+    ax.set_title(f"displacement x{scale:.3g}" + (f", rigid drop {-drop:.3g} removed"
+                                                 if abs(drop) > 0.05 * dent else ""),
+                 fontsize=9)
+    cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
+    cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
+    ax.legend(loc="lower right", fontsize=8)
+    if ref is not None:
+        pressure_panel(ax2, profile, state, ref)
+    fig.suptitle(title(state, ref, args), fontsize=10)
+    pictures.save_figure(fig, args.png)
+
+
+# ## The command line
 
 def parse_args(argv=None):
     p = cli.parser(
@@ -110,245 +381,6 @@ def main(argv=None) -> int:
     what = "KSP" if args.formulation == "elimination" else "SNES and KSP"
     return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
                          prefixes={prefix: f"{what} of each active-set iteration"})
-
-
-# The scene: the contact radius expected from the load sets the mesh (Hertz's a for a
-# sphere; for the cylinder √(Rδ) is a safe overestimate of the half-width).
-
-def expected_radius(args):
-    E, nu, R = args.E, args.nu, args.radius
-    if args.force is not None:
-        if args.model == "plane-strain":
-            return hertz.cylinder_from_force(E, nu, R, args.force)["contact_radius"]
-        return hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
-    return math.sqrt(R * abs(args.indentation))
-
-
-def run(args):
-    material = (LinearElastic(args.E, args.nu) if args.material == "linear"
-                else PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n))
-    if args.indentation is None and args.force is None:
-        args.indentation = 0.01 * args.radius
-    a = expected_radius(args)
-    block = args.block or (100.0 if args.model == "3d" else 1000.0)
-    say(f"meshing the {args.model} block ({block:g} contact radii) ...")
-    punch = Punch(args.model, material, args.radius, a, refine=args.refine, block=block,
-                  formulation=args.formulation, gap=args.gap)
-    say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {punch.h:.3g}")
-
-    # Load steps: δ (or P) grows linearly; each step starts from the last active set.
-    # +
-    load = PunchLoad(punch, indentation=args.indentation, force=args.force,
-                     first_guess=a * a / args.radius)
-    states = load.states
-
-    def report(t, result):
-        s = states[-1]
-        say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
-            f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
-            f"{s.active_set_iterations} active-set iterations")
-
-    solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
-                        on_step=report)
-    # -
-
-    last = states[-1]
-    out = {"model": args.model, "formulation": args.formulation, "material": args.material,
-           "force": last.force, "indentation": last.indentation,
-           "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
-           "element_size": punch.h, "nodes_in_contact": punch.nodes_in_contact(),
-           "active_set_iterations": sum(s.active_set_iterations for s in states),
-           "newton_iterations": sum(s.newton_iterations for s in states),
-           "factorizations": sum(s.factorizations for s in states),
-           "steps": [{"indentation": s.indentation, "force": s.force,
-                      "contact_radius": s.contact_radius,
-                      "active_set_iterations": s.active_set_iterations} for s in states],
-           "reactions": punch.reactions(),
-           "reactions_of": {"axisymmetric": "the whole body (2πr in the residual)",
-                            "3d": "the modelled quarter",
-                            "plane-strain": "the modelled half, per unit length"}[args.model],
-           "dofs": punch.dofs, "ranks": comm.size, "warnings": []}
-    ref = check_against_hertz(punch, last, args, out)
-    if len(states) >= 2 and all(s.force > 0 for s in states):
-        d = np.log([s.indentation for s in states])
-        f = np.log([s.force for s in states])
-        out["fitted_exponent"] = float(np.polyfit(d, f, 1)[0])
-        theory = " (Hertz: 1.5)" if args.model != "plane-strain" else ""
-        say(f"P ∝ δ^{out['fitted_exponent']:.4f} over the steps{theory}")
-    writers = []
-    vm = punch.von_mises() if args.output or args.png else None  # once for both
-    if args.output:
-        writers.append(lambda: write_fields(punch, vm, args.output))
-    if args.plot:
-        writers.append(lambda: plot(punch, states, ref, args))
-    if args.png:
-        writers.append(lambda: picture(punch, vm, last, ref, args))
-    return out, writers
-
-
-def check_against_hertz(punch, last, args, out):
-    """Hertz's values where theory gives them, relative errors, and what is not checked."""
-    n = out["nodes_in_contact"]
-    if last.force > 0 and n < MIN_NODES:
-        raise ValueError(f"only {n} node(s) of the surface are in contact (h = {punch.h:.3g}, "
-                         f"contact radius {last.contact_radius:.3g}): the mesh cannot resolve "
-                         f"the contact zone; lower --refine or check the load")
-    if last.force > 0 and n < FEW_NODES:
-        out["warnings"].append(f"only {n} nodes in contact: contact radius and p0 are "
-                               f"resolved to about h = {punch.h:.3g} only")
-    if args.material != "linear":
-        out["warnings"].append("power-law material: Hertz's values are the linear reference, "
-                               "not a check")
-    if last.force == 0.0:
-        say("the punch does not touch the block: zero contact force")
-        return None
-    ref = punch.hertz(last)
-    for key in ("force", "contact_radius", "max_pressure"):
-        if key in ref:
-            out[f"hertz_{key}"] = ref[key]
-            out[f"{key}_rel_error"] = getattr(last, key) / ref[key] - 1
-    if args.model == "plane-strain":
-        out["warnings"].append("plane strain: the force is not checked (a cylinder's "
-                               "indentation depends on the block, Hertz gives no P(δ)); "
-                               "half-width and p0 are checked against Hertz for the computed P")
-        say(f"P = {last.force:.6g} per unit length (not checked); half-width "
-            f"{last.contact_radius:.5g} (Hertz {ref['contact_radius']:.5g}, "
-            f"{100 * out['contact_radius_rel_error']:+.2f} %, h = {punch.h:.2g}); p0 "
-            f"{last.max_pressure:.5g} (Hertz {ref['max_pressure']:.5g}, "
-            f"{100 * out['max_pressure_rel_error']:+.2f} %)")
-    else:
-        say(f"force {last.force:.6g} (Hertz {ref['force']:.6g}, "
-            f"{100 * out['force_rel_error']:+.3f} %); radius {last.contact_radius:.5g} (Hertz "
-            f"{ref['contact_radius']:.5g}, h = {punch.h:.2g}); p0 {last.max_pressure:.5g} "
-            f"(Hertz {ref['max_pressure']:.5g}, {100 * out['max_pressure_rel_error']:+.2f} %)")
-    return ref
-
-
-def write_fields(punch, vm, folder):
-    paths = output.write_fields(folder, [punch.u, *punch.contact_fields(), vm])
-    say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-
-
-def plot(punch, states, ref, args):
-    profile = punch.surface_profile()
-    if comm.rank != 0:
-        return
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    d = np.array([0.0] + [s.indentation for s in states])
-    P = np.array([0.0] + [s.force for s in states])
-    ax1.plot(d, P, "o", label="active set (FE)")
-    if args.model != "plane-strain":
-        dd = np.linspace(0, d.max(), 100)
-        Es = hertz.effective_modulus(args.E, args.nu)
-        ax1.plot(dd, 4 / 3 * Es * np.sqrt(args.radius) * dd**1.5, "-", label="Hertz")
-    ax1.set_xlabel("indentation δ [length]")
-    ax1.set_ylabel("force P [force]" + (" per unit length" if args.model == "plane-strain"
-                                        else ""))
-    ax1.legend()
-    ax1.grid(alpha=0.3)
-    if ref is not None:
-        pressure_panel(ax2, profile, states[-1], ref)
-    fig.suptitle(title(states[-1], ref, args))
-    fig.tight_layout()
-    fig.savefig(args.plot, dpi=120)
-    print(f"wrote {args.plot}")
-
-
-def title(state, ref, args):
-    """The load and the key figure, with what is checked against Hertz."""
-    if ref is None:
-        return f"{args.model} punch: no contact (δ = {state.indentation:.3g})"
-    a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
-    p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
-    if args.model == "plane-strain":
-        return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
-                f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
-    if args.force is not None:  # P prescribed: the check is on the indentation it needs
-        d_ref = hertz.sphere_from_force(args.E, args.nu, args.radius, state.force)["indentation"]
-        return (f"{args.model} punch, P = {state.force:.4g} (prescribed): δ = "
-                f"{state.indentation:.3g} ({100 * (state.indentation / d_ref - 1):+.2f} % from "
-                f"Hertz), a {a_err:+.1f} %, p0 {p_err:+.1f} %")
-    return (f"{args.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
-            f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
-            f"p0 {p_err:+.1f} %")
-
-
-def pressure_panel(ax, profile, state, ref):
-    """p/p0 against r/a (Hertz's a and p0), FE nodes against Hertz's ellipse."""
-    r, p, _ = profile
-    a, p0 = ref["contact_radius"], ref["max_pressure"]
-    ax.plot(r / a, p / p0, "o", ms=3, label="FE nodal pressure")
-    rr = np.linspace(0, 1.5, 300)
-    ax.plot(rr, hertz.pressure_profile(1.0, 1.0, rr), "-", label="Hertz")
-    ax.axvline(state.contact_radius / a, color="C3", ls="--", lw=1,
-               label=f"last active node: a = {state.contact_radius:.3g}")
-    ax.axvline(1.0, color="gray", ls=":", lw=1, label=f"Hertz a = {a:.3g}")
-    ax.set_xlim(0, 1.5)
-    ax.set_ylim(-0.05, 1.25)
-    ax.set_xlabel("r / a (Hertz)")
-    ax.set_ylabel(f"contact pressure p / p0 (Hertz p0 = {p0:.3g})")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-
-
-def picture(punch, vm, state, ref, args):
-    """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    section = output.section(punch.u, vm, normal_axis=1 if punch.vertical == 2
-                             else None)
-    profile = punch.surface_profile()
-    if comm.rank != 0:
-        return
-    import matplotlib.pyplot as plt
-
-    x, z, u_x, u_z, triangles, vm = section
-    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * punch.h)
-    window = 2.5 * a
-    # the rigid drop of the block is removed (the surface at the window's edge stays put),
-    # and the dent is drawn about a/4 deep
-    at_edge = np.argmin(np.hypot(x - window, z))
-    drop = u_z[at_edge]
-    dent = max(abs(state.indentation + drop), 1e-300)
-    scale = max(1.0, 0.25 * a / dent)
-    xd, zd = x + scale * u_x, z + scale * (u_z - drop)
-    p0 = ref["max_pressure"] if ref else max(state.max_pressure, 1e-300)
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 4.8),
-                                  gridspec_kw={"width_ratios": [1.25, 1]})
-    tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
-                       edgecolors="face", vmin=0)
-    ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
-    rr = np.linspace(0, window, 300)
-    gap = punch.gap_at(rr, state.indentation)
-    ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
-    ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
-    ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
-    if ref:
-        ax.plot([ref["contact_radius"]] * 2, [-0.3 * a, -0.15 * a], color="k", lw=1)
-        ax.annotate("a (Hertz)", (ref["contact_radius"], -0.38 * a), ha="center", fontsize=8)
-    ax.set_xlim(0, window)
-    ax.set_ylim(-2 * a, 0.5 * a)
-    ax.set_aspect("equal")
-    ax.set_xlabel("r [length]" if args.model == "axisymmetric" else "x [length]")
-    ax.set_ylabel("z [length]" + (" (section y = 0)" if args.model == "3d" else ""))
-    ax.set_title(f"displacement x{scale:.3g}" + (f", rigid drop {-drop:.3g} removed"
-                                                 if abs(drop) > 0.05 * dent else ""),
-                 fontsize=9)
-    cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
-    cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
-    ax.legend(loc="lower right", fontsize=8)
-    if ref is not None:
-        pressure_panel(ax2, profile, state, ref)
-    fig.suptitle(title(state, ref, args), fontsize=10)
-    fig.tight_layout()
-    fig.savefig(args.png, dpi=120)
-    print(f"wrote {args.png}")
 
 
 if __name__ == "__main__":

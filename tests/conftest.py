@@ -1,4 +1,5 @@
-"""Load the dolfinx wheel's MPI/PETSc first (fenics_nl imports dolfinx_solver).
+"""Shared test fixtures; loads the dolfinx wheel's MPI/PETSc first (fenics_nl imports
+dolfinx_solver).
 
 Under mpiexec, PETSc objects on the world communicator must be destroyed by every rank at
 the same point. Python's cyclic garbage collector runs whenever one rank's allocations
@@ -13,8 +14,20 @@ import fenics_nl  # noqa: F401
 
 # isort: split
 
+import importlib.util
+import itertools
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 from mpi4py import MPI
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMOS = ROOT / "demos"
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 if MPI.COMM_WORLD.size > 1:
     gc.disable()
@@ -23,3 +36,93 @@ if MPI.COMM_WORLD.size > 1:
     def _collect_on_every_rank_together():
         yield
         gc.collect()
+
+
+_modules = {}
+_runs = itertools.count()
+
+
+def demo_module(name: str):
+    """demos/`name` imported once (its `main(argv)` runs a scene in this process)."""
+    if name not in _modules:
+        spec = importlib.util.spec_from_file_location(f"demo_{Path(name).stem}", DEMOS / name)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        _modules[name] = module
+    return _modules[name]
+
+
+class Demos:
+    """Runs demos/<name> as a user does, in `tmp_path`.
+
+    Serially the demo's `main(argv)` runs in this process (scikit-fem's test_examples
+    style: no interpreter start, forms stay compiled); with ranks > 1 it runs under
+    `mpiexec -n ranks` in a subprocess. Either way the result is a CompletedProcess with
+    the exit status, stdout and stderr (captured at the file descriptors, so PETSc's own
+    output is in it).
+    """
+
+    module = staticmethod(demo_module)
+
+    def __init__(self, tmp_path, capfd, monkeypatch):
+        self.tmp_path, self.capfd, self.monkeypatch = tmp_path, capfd, monkeypatch
+
+    def run(self, args, check=True, ranks=1) -> subprocess.CompletedProcess:
+        """`python demos/args[0] args[1:]`; with `check`, a non-zero exit fails the test."""
+        name, argv = str(args[0]), [str(a) for a in args[1:]]
+        proc = self._in_process(name, argv) if ranks == 1 else self._mpiexec(name, argv, ranks)
+        if check:
+            assert proc.returncode == 0, proc.stderr
+        return proc
+
+    def _in_process(self, name, argv):
+        main = demo_module(name).main
+        self.capfd.readouterr()
+        with self.monkeypatch.context() as m:
+            m.chdir(self.tmp_path)
+            try:
+                code = main(argv)
+            except SystemExit as stop:  # argparse: --help, or a bad flag
+                code = stop.code if isinstance(stop.code, int) else int(stop.code is not None)
+        out, err = self.capfd.readouterr()
+        return subprocess.CompletedProcess([name, *argv], code, out, err)
+
+    def _mpiexec(self, name, argv, ranks):
+        cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, str(DEMOS / name), *argv]
+        return subprocess.run(cmd, cwd=self.tmp_path, capture_output=True, text=True,
+                              timeout=900)
+
+    def json(self, name, *args, ranks=1) -> dict:
+        """Run demos/`name` with `args` and return its JSON."""
+        out = self.tmp_path / f"{Path(name).stem}{next(_runs)}.json"
+        self.run([name, *args, "--json", out], ranks=ranks)
+        return json.loads(out.read_text())
+
+    def punch(self, *args, ranks=1) -> dict:
+        return self.json("punch.py", *args, ranks=ranks)
+
+    def beam(self, *args, ranks=1) -> dict:
+        return self.json("buckling_beam.py", *args, ranks=ranks)
+
+    def bracket(self, *args, ranks=1) -> dict:
+        return self.json("bracket.py", *args, ranks=ranks)
+
+
+@pytest.fixture
+def demo(tmp_path, capfd, monkeypatch) -> Demos:
+    """Run the demos in `tmp_path` (see `Demos`)."""
+    return Demos(tmp_path, capfd, monkeypatch)
+
+
+@pytest.fixture
+def on_elastica():
+    """The check of a beam JSON against Euler and the elastica, to the demo's tolerances."""
+
+    def check(d):
+        assert abs(d["critical_load_rel_error"]) < 0.005
+        da = abs(d["tip_rotation_deg"] - d["elastica_tip_rotation_deg"])
+        assert da < max(0.5, 0.01 * d["elastica_tip_rotation_deg"]), d
+        assert d["tip_deflection"] == pytest.approx(d["elastica_tip_deflection"], rel=0.01)
+        assert all(math.isfinite(p["tip_rotation_deg"]) for p in d["path"])
+
+    return check

@@ -128,3 +128,15 @@ def test_parallel_contact_matches_serial(formulation):
     cs, rs = axisymmetric_punch(formulation, comm=MPI.COMM_SELF)
     assert rp.active_sizes == rs.active_sizes
     assert abs(cp.force - cs.force) < 1e-9 * cs.force
+
+
+@pytest.mark.stress
+@pytest.mark.parametrize("nu", [0.45, 0.49, 0.499])
+def test_near_incompressibility_p2_keeps_hertz_p1_locks(nu):
+    # measured force errors against Hertz (axisymmetric, h = a/20): P1 +0.50 %, +1.37 %,
+    # +8.7 % for ν = 0.45, 0.49, 0.499 (volumetric locking); P2 +0.18 % throughout
+    ref = hertz.sphere_from_indentation(1.0, nu, 1.0, 0.01)["force"]
+    p2, _ = axisymmetric_punch("elimination", nu=nu, degree=2)
+    p1, _ = axisymmetric_punch("elimination", nu=nu, degree=1)
+    assert abs(p2.force / ref - 1) < 5e-3
+    assert abs(p2.force / ref - 1) < abs(p1.force / ref - 1)

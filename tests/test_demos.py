@@ -1,18 +1,15 @@
-"""Run each demo as a user would (a subprocess), serially and under mpiexec."""
+"""Each demo as a user runs it: serially (in-process) and under mpiexec, against theory."""
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
-from scenes import DEMOS, MPIEXEC, assert_on_elastica, beam, bracket, punch, run
 
 
-def test_newton_scalar_orders(tmp_path):
+def test_newton_scalar_orders(tmp_path, demo):
     out = tmp_path / "scalar.json"
-    run([DEMOS / "newton_scalar.py", "--json", out], tmp_path)
+    demo.run(["newton_scalar.py", "--json", out])
     data = json.loads(out.read_text())
     for method, order in [("newton", 2.0), ("modified", 1.0), ("secant", (1 + 5**0.5) / 2)]:
         assert abs(data[method]["order"] - order) < 0.15, (method, data[method])
@@ -20,10 +17,9 @@ def test_newton_scalar_orders(tmp_path):
     assert data["modified"]["iterations"] > 5 * data["newton"]["iterations"]
 
 
-def test_newton_scalar_plot_in_double_precision(tmp_path):
+def test_newton_scalar_plot_in_double_precision(tmp_path, demo):
     png = tmp_path / "orders.png"
-    run([DEMOS / "newton_scalar.py", "--function", "kepler", "--digits", "16", "--plot", png],
-        tmp_path)
+    demo.run(["newton_scalar.py", "--function", "kepler", "--digits", "16", "--plot", png])
     assert png.stat().st_size > 10_000
 
 
@@ -34,19 +30,19 @@ def test_newton_scalar_plot_in_double_precision(tmp_path):
     (["--maxit", "0"], "--maxit: must be >= 1"),
     (["--u0", "nan"], "--u0: must be a finite number"),
 ])
-def test_newton_scalar_bad_input(tmp_path, args, message):
-    proc = run([DEMOS / "newton_scalar.py", *args], tmp_path, check=False)
+def test_newton_scalar_bad_input(args, message, demo):
+    proc = demo.run(["newton_scalar.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1  # one line, no usage block
 
 
-def test_newton_scalar_divergence_is_a_result(tmp_path):
+def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
     # modified Newton with K = r'(u0) = 1.75 on u + u³ = 3 (r'(u*) = 5.4): the rate
     # 1 − r'(u*)/K = −2.1 diverges; the table shows it, the others converge as usual
     out = tmp_path / "h.json"
-    proc = run([DEMOS / "newton_scalar.py", "--function", "hardening", "--json", out,
-                "--plot", tmp_path / "h.png"], tmp_path)
+    proc = demo.run(["newton_scalar.py", "--function", "hardening", "--json", out,
+                     "--plot", tmp_path / "h.png"])
     d = json.loads(out.read_text())
     assert not d["modified"]["converged"] and "diverges" in d["modified"]["failure"]
     assert "diverges" in proc.stdout
@@ -54,19 +50,19 @@ def test_newton_scalar_divergence_is_a_result(tmp_path):
     assert abs(d["secant"]["order"] - (1 + 5**0.5) / 2) < 0.15
 
 
-@pytest.mark.parametrize("demo", ["newton_scalar.py", "punch.py", "buckling_beam.py",
+@pytest.mark.parametrize("name", ["newton_scalar.py", "punch.py", "buckling_beam.py",
                                   "bracket.py"])
-def test_help_describes_the_demo_and_states_defaults_once(tmp_path, demo):
-    text = run([DEMOS / demo, "--help"], tmp_path).stdout
+def test_help_describes_the_demo_and_states_defaults_once(demo, name):
+    text = demo.run([name, "--help"]).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
     prefix = {"punch.py": "-punch_axisymmetric_elim_ksp_view", "buckling_beam.py":
-              "-beam_buckling_", "bracket.py": "-bracket_elim_"}.get(demo)
+              "-beam_buckling_", "bracket.py": "-bracket_elim_"}.get(name)
     if prefix:  # the PETSc options prefixes are documented
         assert prefix in " ".join(text.split())
 
 
-def test_punch_axisymmetric_default_matches_hertz(tmp_path):
-    d = punch(tmp_path, "--steps", "4")
+def test_punch_axisymmetric_default_matches_hertz(demo):
+    d = demo.punch("--steps", "4")
     assert abs(d["force_rel_error"]) < 0.005
     assert abs(d["contact_radius"] - d["hertz_contact_radius"]) <= d["element_size"]
     assert abs(d["max_pressure_rel_error"]) < 0.03
@@ -78,16 +74,16 @@ def test_punch_axisymmetric_default_matches_hertz(tmp_path):
     (210e9, 0.25, 0.02, 2e-5),  # steel ball, 20 mm, 20 µm
     (3e6, 0.45, 5.0, 0.2),  # rubber-like block, large punch
 ])
-def test_punch_accuracy_holds_for_other_parameters(tmp_path, E, nu, R, delta):
-    d = punch(tmp_path, "--E", str(E), "--nu", str(nu), "--radius", str(R),
+def test_punch_accuracy_holds_for_other_parameters(E, nu, R, delta, demo):
+    d = demo.punch("--E", str(E), "--nu", str(nu), "--radius", str(R),
               "--indentation", str(delta))
     assert abs(d["force_rel_error"]) < 0.005
     assert abs(d["contact_radius"] - d["hertz_contact_radius"]) <= d["element_size"]
     assert abs(d["max_pressure_rel_error"]) < 0.03
 
 
-def test_punch_plane_strain_half_width_and_pressure(tmp_path):
-    d = punch(tmp_path, "--model", "plane-strain")
+def test_punch_plane_strain_half_width_and_pressure(demo):
+    d = demo.punch("--model", "plane-strain")
     assert abs(d["contact_radius_rel_error"]) < 0.02
     assert abs(d["max_pressure_rel_error"]) < 0.02
     # the force is not compared with itself: no Hertz force, and the JSON says why
@@ -95,105 +91,99 @@ def test_punch_plane_strain_half_width_and_pressure(tmp_path):
     assert any("force is not checked" in w for w in d["warnings"])
 
 
-def test_punch_force_control_at_a_realistic_modulus(tmp_path):
+def test_punch_force_control_at_a_realistic_modulus(demo):
     # steel-like E with a 100 N load: Newton's absolute floor scales with the load
-    d = punch(tmp_path, "--E", "210e9", "--radius", "0.01", "--force", "100")
+    d = demo.punch("--E", "210e9", "--radius", "0.01", "--force", "100")
     assert d["force"] == pytest.approx(100, rel=1e-9)
     assert abs(d["force_rel_error"]) < 0.005
 
 
-def test_punch_reactions_balance_the_contact_force(tmp_path):
-    d = punch(tmp_path, "--nu", "0.25")
+def test_punch_reactions_balance_the_contact_force(demo):
+    d = demo.punch("--nu", "0.25")
     # vertical equilibrium of the block: the base holds what the punch pushes
     assert d["reactions"]["bottom"][1] == pytest.approx(d["force"], rel=1e-8)
     assert d["warnings"] == []
 
 
-def test_punch_petsc_option_reaches_its_solver(tmp_path):
-    proc = run([DEMOS / "punch.py", "--refine", "0", "-punch_axisymmetric_elim_ksp_view"],
-               tmp_path)
+def test_punch_petsc_option_reaches_its_solver(demo):
+    proc = demo.run(["punch.py", "--refine", "0", "-punch_axisymmetric_elim_ksp_view"])
     assert "KSP Object: (punch_axisymmetric_elim_)" in proc.stdout
 
 
-def test_punch_every_output_is_written(tmp_path):
+def test_punch_every_output_is_written(tmp_path, demo):
     out = tmp_path / "o.json"
-    run([DEMOS / "punch.py", "--refine", "0", "--json", out, "--output", tmp_path / "f",
-         "--png", tmp_path / "p.png", "--plot", tmp_path / "c.png"], tmp_path)
+    demo.run(["punch.py", "--refine", "0", "--json", out, "--output", tmp_path / "f",
+              "--png", tmp_path / "p.png", "--plot", tmp_path / "c.png"])
     for name in ("displacement", "contact_pressure", "active_set", "von_mises"):
         assert (tmp_path / "f" / f"{name}.bp").is_dir()
     assert (tmp_path / "p.png").stat().st_size > 20_000 and out.exists()
 
 
-def test_a_failing_picture_keeps_the_json(tmp_path):
-    proc = run([DEMOS / "punch.py", "--refine", "0", "--json", "o.json", "--png",
-                "no/such/dir/p.png"], tmp_path, check=False)
+def test_a_failing_picture_keeps_the_json(tmp_path, demo):
+    proc = demo.run(["punch.py", "--refine", "0", "--json", "o.json", "--png",
+                     "no/such/dir/p.png"], check=False)
     assert proc.returncode == 1 and "writing an output failed" in proc.stderr
     assert "Traceback" not in proc.stderr
     assert json.loads((tmp_path / "o.json").read_text())["force"] > 0
 
 
-def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve():
+def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve(demo):
     # the check behind every punch report, called in-process on a state with 3 nodes in
     # contact (the CLI's --refine bound keeps a default run far from it)
-    import importlib.util
     from types import SimpleNamespace
 
-    spec = importlib.util.spec_from_file_location("punch_demo", DEMOS / "punch.py")
-    demo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(demo)
     state = SimpleNamespace(force=1.0, contact_radius=0.1)
+    punch = SimpleNamespace(block=SimpleNamespace(h=0.05))
     with pytest.raises(ValueError, match=r"only 3 node.* cannot resolve the contact zone"):
-        demo.check_against_hertz(SimpleNamespace(h=0.05), state, None,
-                                 {"nodes_in_contact": 3, "warnings": []})
+        demo.module("punch.py").check_against_hertz(punch, state, None,
+                                                    {"nodes_in_contact": 3, "warnings": []})
 
 
-def test_punch_outputs_and_options_on_two_ranks(tmp_path):
-    proc = run([DEMOS / "punch.py", "--refine", "0", "--output", "f", "--png", "p.png",
-                "--plot", "c.png", "--json", "o.json", "-punch_axisymmetric_elim_ksp_type",
-                "cg"], tmp_path, ranks=2)
+def test_punch_outputs_and_options_on_two_ranks(tmp_path, demo):
+    proc = demo.run(["punch.py", "--refine", "0", "--output", "f", "--png", "p.png",
+                     "--plot", "c.png", "--json", "o.json", "-punch_axisymmetric_elim_ksp_type",
+                     "cg"], ranks=2)
     assert proc.stdout.count("wall time") == 1  # rank 0 speaks
     for name in ("displacement", "contact_pressure", "active_set"):
         assert (tmp_path / "f" / f"{name}.bp").is_dir()
     assert json.loads((tmp_path / "o.json").read_text())["ranks"] == 2
-    bad = run([DEMOS / "punch.py", "-ksp_view"], tmp_path, check=False, ranks=2)
+    bad = demo.run(["punch.py", "-ksp_view"], check=False, ranks=2)
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
 
 
-def test_punch_picture_is_the_same_on_two_ranks(tmp_path):
+def test_punch_picture_is_the_same_on_two_ranks(tmp_path, demo):
     import matplotlib.image as mpimg
 
     for ranks in (1, 2):
-        cmd = [sys.executable, DEMOS / "punch.py", "--refine", "0", "--png",
-               tmp_path / f"p{ranks}.png"]
-        subprocess.run([MPIEXEC, "-n", str(ranks), *cmd], cwd=tmp_path, check=True,
-                       capture_output=True, timeout=600)
+        demo.run(["punch.py", "--refine", "0", "--png", tmp_path / f"p{ranks}.png"],
+                 ranks=ranks)
     one, two = (mpimg.imread(tmp_path / f"p{n}.png") for n in (1, 2))
     assert one.shape == two.shape
     # the whole mesh on both: only anti-aliasing at duplicated partition nodes may differ
     assert np.mean(np.abs(one - two)) < 2e-3
 
 
-def test_punch_3d_quarter_model(tmp_path):
-    d = punch(tmp_path, "--model", "3d")
+def test_punch_3d_quarter_model(demo):
+    d = demo.punch("--model", "3d")
     assert abs(d["force_rel_error"]) < 0.02
 
 
-def test_punch_force_control_reaches_the_force(tmp_path):
-    d = punch(tmp_path, "--force", "0.0015")
+def test_punch_force_control_reaches_the_force(demo):
+    d = demo.punch("--force", "0.0015")
     assert d["force"] == pytest.approx(0.0015, rel=1e-9)
     assert abs(d["force_rel_error"]) < 0.005  # P against Hertz at the δ found
 
 
-def test_punch_formulations_agree(tmp_path):
-    e = punch(tmp_path, "--formulation", "elimination")
-    m = punch(tmp_path, "--formulation", "multiplier")
+def test_punch_formulations_agree(demo):
+    e = demo.punch("--formulation", "elimination")
+    m = demo.punch("--formulation", "multiplier")
     assert m["force"] == pytest.approx(e["force"], rel=1e-9)
     assert m["contact_radius"] == e["contact_radius"]
 
 
-def test_punch_two_ranks_match_serial(tmp_path):
-    s = punch(tmp_path, "--steps", "2")
-    p = punch(tmp_path, "--steps", "2", ranks=2)
+def test_punch_two_ranks_match_serial(demo):
+    s = demo.punch("--steps", "2")
+    p = demo.punch("--steps", "2", ranks=2)
     assert p["ranks"] == 2
     assert p["force"] == pytest.approx(s["force"], rel=1e-8)
     assert p["contact_radius"] == pytest.approx(s["contact_radius"], rel=1e-12)
@@ -201,9 +191,8 @@ def test_punch_two_ranks_match_serial(tmp_path):
         assert np.allclose(p["reactions"][group], r, rtol=1e-8, atol=1e-10 * s["force"])
 
 
-def test_punch_that_never_touches_gives_zero_force(tmp_path):
-    proc = run([DEMOS / "punch.py", "--indentation", "-0.01", "--json", tmp_path / "z.json"],
-               tmp_path)
+def test_punch_that_never_touches_gives_zero_force(tmp_path, demo):
+    proc = demo.run(["punch.py", "--indentation", "-0.01", "--json", tmp_path / "z.json"])
     d = json.loads((tmp_path / "z.json").read_text())
     assert d["force"] == 0.0 and d["contact_radius"] == 0.0
     assert "does not touch" in proc.stdout
@@ -222,15 +211,15 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path):
     (["-punch_axisymmetric_elim_ksp_veiw"], "was read by no solver (misspelt?)"),
     (["-punch_axisymmetric_elim_pc_type", "nonsense"], "nonsense"),
 ])
-def test_punch_bad_input_one_clear_line(tmp_path, args, message):
-    proc = run([DEMOS / "punch.py", *args], tmp_path, check=False)
+def test_punch_bad_input_one_clear_line(args, message, demo):
+    proc = demo.run(["punch.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
 
 
 @pytest.mark.parametrize("ratio", ["1.05", "1.2", "2.0"])
-def test_beam_follows_the_elastica(tmp_path, ratio):
-    assert_on_elastica(beam(tmp_path, "--load-ratio", ratio))
+def test_beam_follows_the_elastica(ratio, demo, on_elastica):
+    on_elastica(demo.beam("--load-ratio", ratio))
 
 
 @pytest.mark.parametrize("args", [
@@ -240,14 +229,14 @@ def test_beam_follows_the_elastica(tmp_path, ratio):
     ["--plane", "strain", "--E", "5e6", "--nu", "0.45", "--refine", "1"],
     ["--plane", "strain", "--material", "neo-hookean"],
 ])
-def test_beam_accuracy_holds_for_other_parameters(tmp_path, args):
-    assert_on_elastica(beam(tmp_path, *args, "--load-ratio", "1.2"))
+def test_beam_accuracy_holds_for_other_parameters(args, demo, on_elastica):
+    on_elastica(demo.beam(*args, "--load-ratio", "1.2"))
 
 
-def test_beam_every_output_and_the_clamp_reaction(tmp_path):
+def test_beam_every_output_and_the_clamp_reaction(tmp_path, demo):
     # --output used to crash at the end (XDMF cannot hold P2 on quadrilaterals), losing
     # the other outputs of the run
-    d = beam(tmp_path, "--load-ratio", "1.2", "--output", "f", "--png", "b.png",
+    d = demo.beam("--load-ratio", "1.2", "--output", "f", "--png", "b.png",
              "--plot", "c.png")
     assert (tmp_path / "f" / "displacement.bp").is_dir()
     assert (tmp_path / "b.png").exists() and (tmp_path / "c.png").exists()
@@ -256,9 +245,9 @@ def test_beam_every_output_and_the_clamp_reaction(tmp_path):
     assert rx == pytest.approx(P, rel=1e-7) and ry == pytest.approx(-1e-4 * P, rel=1e-4)
 
 
-def test_beam_below_euler_stays_straight(tmp_path):
+def test_beam_below_euler_stays_straight(demo):
     # Only the imperfection bends it: linear theory gives α ≈ ε r π²/8 / (1 − r) rad.
-    d = beam(tmp_path, "--load-ratio", "0.9")
+    d = demo.beam("--load-ratio", "0.9")
     eps, r = 1e-4, 0.9
     amplified = math.degrees(eps * r * math.pi**2 / 8 / (1 - r))
     assert 0.5 * amplified < d["tip_rotation_deg"] < 1.5 * amplified
@@ -266,15 +255,15 @@ def test_beam_below_euler_stays_straight(tmp_path):
 
 
 @pytest.mark.parametrize("args", [["--steps", "1"], ["--load-ratio", "10"]])
-def test_beam_stress_cases_land_on_the_right_branch(tmp_path, args):
+def test_beam_stress_cases_land_on_the_right_branch(args, demo, on_elastica):
     # One huge step converges to the unstable straight beam; the stability check sees it
     # and switches branch. r = 10 is deep in the post-buckling range (α ≈ 177°).
-    assert_on_elastica(beam(tmp_path, *args))
+    on_elastica(demo.beam(*args))
 
 
-def test_beam_two_ranks_match_serial(tmp_path):
-    s = beam(tmp_path, "--load-ratio", "1.2", "--steps", "20")
-    p = beam(tmp_path, "--load-ratio", "1.2", "--steps", "20", ranks=2)
+def test_beam_two_ranks_match_serial(demo):
+    s = demo.beam("--load-ratio", "1.2", "--steps", "20")
+    p = demo.beam("--load-ratio", "1.2", "--steps", "20", ranks=2)
     assert p["ranks"] == 2
     assert p["critical_load"] == pytest.approx(s["critical_load"], rel=1e-8)
     assert p["tip_rotation_deg"] == pytest.approx(s["tip_rotation_deg"], rel=1e-6)
@@ -286,14 +275,14 @@ def test_beam_two_ranks_match_serial(tmp_path):
     (["--material", "neo-hookean"], "plane strain only"), (["--oops"], "unrecognized"),
     (["--E", "nan"], "--E: must be a finite number"), (["-ksp_view"], "-beam_"),
 ])
-def test_beam_bad_input_one_clear_line(tmp_path, args, message):
-    proc = run([DEMOS / "buckling_beam.py", *args], tmp_path, check=False)
+def test_beam_bad_input_one_clear_line(args, message, demo):
+    proc = demo.run(["buckling_beam.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
 
 
-def test_bracket_newton_variants_agree(tmp_path):
-    d = bracket(tmp_path, "--compare")
+def test_bracket_newton_variants_agree(demo):
+    d = demo.bracket("--compare")
     ref = d["variants"]["full"]["load_point_displacement"]
     for name, v in d["variants"].items():
         assert abs(v["load_point_displacement"] / ref - 1) < 1e-7, name
@@ -303,9 +292,9 @@ def test_bracket_newton_variants_agree(tmp_path):
     assert d["max_eps_eq_over_eps0"] > 10  # strongly non-linear, as the demo says
 
 
-def test_bracket_contact_support_lifts_off(tmp_path):
-    c = bracket(tmp_path, "--support", "contact")
-    k = bracket(tmp_path)
+def test_bracket_contact_support_lifts_off(tmp_path, demo):
+    c = demo.bracket("--support", "contact")
+    k = demo.bracket()
     base_area = 100 * 60 - 2 * math.pi * 6**2
     assert 0 < c["lifted_off_area"] < base_area
     # equilibrium: the bolts take the pull, the frictionless floor pushes only upwards, and
@@ -318,9 +307,9 @@ def test_bracket_contact_support_lifts_off(tmp_path):
     assert c["load_point_displacement"] < k["load_point_displacement"]
 
 
-def test_bracket_outputs_and_bolt_reaction(tmp_path):
-    proc = run([DEMOS / "bracket.py", "--size", "20", "--steps", "1", "--output", "f", "--png",
-                "b.png", "--plot", "c.png", "--json", "b.json"], tmp_path)
+def test_bracket_outputs_and_bolt_reaction(tmp_path, demo):
+    proc = demo.run(["bracket.py", "--size", "20", "--steps", "1", "--output", "f",
+                     "--png", "b.png", "--plot", "c.png", "--json", "b.json"])
     assert "X server" not in proc.stderr and proc.stderr == ""  # off-screen, no VTK noise
     d = json.loads((tmp_path / "b.json").read_text())
     assert (tmp_path / "f" / "displacement.bp").is_dir()
@@ -331,20 +320,20 @@ def test_bracket_outputs_and_bolt_reaction(tmp_path):
     assert any("coarser than the default" in w for w in d["warnings"])
 
 
-def test_bracket_iterative_solver_matches_direct(tmp_path):
+def test_bracket_iterative_solver_matches_direct(demo):
     # CG + GAMG (inexact Newton corrections) must land on MUMPS's answer: the Newton
     # loop stops on the same residual tolerance whatever the linear solver.
     args = ("--size", "10", "--steps", "1")
-    d = bracket(tmp_path, *args)
-    g = bracket(tmp_path, *args, "--solver", "iterative")
+    d = demo.bracket(*args)
+    g = demo.bracket(*args, "--solver", "iterative")
     assert d["krylov_iterations"] == 0 and g["krylov_iterations"] > g["newton_iterations"]
     assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-7)
 
 
 @pytest.mark.parametrize("support", ["clamped", "contact"])
-def test_bracket_two_ranks_match_serial(tmp_path, support):
-    s = bracket(tmp_path, "--support", support)
-    p = bracket(tmp_path, "--support", support, ranks=2)
+def test_bracket_two_ranks_match_serial(support, demo):
+    s = demo.bracket("--support", support)
+    p = demo.bracket("--support", support, ranks=2)
     assert p["ranks"] == 2 and p["dofs"] == s["dofs"]
     assert p["load_point_displacement"] == pytest.approx(s["load_point_displacement"], rel=1e-8)
     for group, r in s["reactions"].items():
@@ -371,7 +360,7 @@ def _box_without_groups(path, fold=False):
     gmsh.finalize()
 
 
-def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
+def test_bracket_bad_mesh_input_one_clear_line(tmp_path, demo):
     (tmp_path / "corrupt.msh").write_text("$MeshFormat\nthis is not a mesh\n")
     _box_without_groups(tmp_path / "box.msh")
     _box_without_groups(tmp_path / "folded.msh", fold=True)
@@ -388,6 +377,6 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path):
                           (["--force", "nan"], "--force: must be a finite number"),
                           (["--material", "linear", "--sigma0", "100"], "set the power law"),
                           (["--compare", "--newton", "modified"], "drop --newton")]:
-        proc = run([DEMOS / "bracket.py", *args], tmp_path, check=False)
+        proc = demo.run(["bracket.py", *args], check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)

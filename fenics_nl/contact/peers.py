@@ -29,7 +29,7 @@ from fenics_nl.solvers.snes import (
 
 def _surface_measure(punch):
     fdim = punch.mesh.topology.dim - 1
-    f = np.sort(punch.contact_facets)
+    f = np.sort(punch.block.contact_facets)
     tags = mesh.meshtags(punch.mesh, fdim, f, np.ones(len(f), dtype=np.int32))
     return ufl.Measure("ds", domain=punch.mesh, subdomain_data=tags,
                        metadata={"quadrature_degree": 4})(1)
@@ -60,7 +60,7 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     wall = time.perf_counter() - t0
     reason = problem.solver.getConvergedReason()
     work = petsc_work(counter)
-    force = c.total_force() * punch.symmetry_factor
+    force = c.total_force() * punch.block.symmetry_factor
     return {"force": force, "wall_time_s": wall, "iterations": problem.solver.getIterationNumber(),
             "factorizations": work.factorizations, "converged": reason > 0,
             "max_penetration": _max_penetration(punch)}
@@ -80,7 +80,7 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
     k = fem.Constant(punch.mesh, float(stiffness))
     pen = ufl.max_value(c.surface.sign * u[c.surface.axis] - gamma, 0.0)
     ds = _surface_measure(punch)
-    w = punch.weight
+    w = punch.block.weight
     R = punch.residual + k * pen * c.surface.sign * v[c.surface.axis] * w * ds
     solver = NewtonSolver(R, u, punch.bcs, method="full", line_search=True, prefix=prefix,
                           rtol=1e-10, atol=1e-12, max_it=100)
@@ -88,7 +88,7 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
     res = solver.solve()
     wall = time.perf_counter() - t0
     force = fem.assemble_scalar(fem.form(k * pen * w * ds))
-    force = punch.mesh.comm.allreduce(force) * punch.symmetry_factor
+    force = punch.mesh.comm.allreduce(force) * punch.block.symmetry_factor
     return {"force": force, "wall_time_s": wall, "iterations": res.iterations,
             "factorizations": res.work.factorizations, "converged": res.converged,
             "max_penetration": _max_penetration(punch)}

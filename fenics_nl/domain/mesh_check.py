@@ -63,7 +63,7 @@ def check_cells(domain: dmesh.Mesh, name: str = "mesh") -> None:
     """Raise ValueError naming the first bad cell (on any rank) of a folded/degenerate mesh."""
     bad = bad_cells(domain)
     x = domain.geometry.x
-    cnodes = domain.geometry.dofmap
+    cnodes = domain.geometry.dofmaps[0]
     for kind, cells in bad.items():
         count = domain.comm.allreduce(len(cells), op=MPI.SUM)
         if count:

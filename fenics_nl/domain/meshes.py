@@ -7,9 +7,15 @@ from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 
-def _start(name: str):
+def start_model(name: str) -> None:
+    """A new model `name` in gmsh, with gmsh's default options.
+
+    Mesh options are global in gmsh: a bracket's MeshSizeMin, left over, made a punch meshed
+    next in the same session 40 times too coarse under the punch. Every model starts here.
+    """
     if not gmsh.isInitialized():
         gmsh.initialize(interruptible=False)
+    gmsh.option.restoreDefaults()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add(name)
 
@@ -46,7 +52,7 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     unit = fine_radius
     width, depth, h_fine, fine_radius = width / unit, depth / unit, h_fine / unit, 1.0
     if comm.rank == 0:
-        _start(f"block{dim}d")
+        start_model(f"block{dim}d")
         occ = gmsh.model.occ
         if dim == 2:
             occ.addRectangle(0, -depth, 0, width, depth)

@@ -11,6 +11,24 @@ from fenics_nl.io.output import gather_grid, owned_cell_values, vertex_interpola
 from fenics_nl.parallel import gather_rows
 
 
+def pyplot():
+    """matplotlib.pyplot on the Agg backend: figures are files, no display is needed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig, path) -> None:
+    """Lay out, write and close a matplotlib figure (closed: runs in one process add up)."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    pyplot().close(fig)
+    print(f"wrote {path}")
+
+
 def off_screen():
     """pyvista, set for off-screen rendering without the VTK X-server noise."""
     os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
@@ -42,8 +60,8 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
     comm = b.mesh.comm
     u1 = vertex_interpolant(b.u)
     grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(vm)})
-    bolts = gather_rows(comm, facet_points(b.mesh, b.groups["bolts"]))
-    load = gather_rows(comm, facet_points(b.mesh, b.load_facets))
+    bolts = gather_rows(comm, facet_points(b.mesh, b.part.groups["bolts"]))
+    load = gather_rows(comm, facet_points(b.mesh, b.part.load_facets))
     load_motion = b.load_point_motion()
     status = None
     if b.support == "contact":

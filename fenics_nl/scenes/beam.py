@@ -33,14 +33,17 @@ MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
 MAX_PATH_STEPS = 256
 
 
-class Beam:
-    """Build once; `set_load(P)`, `tip()`, `critical_loads()`."""
+class Cantilever:
+    """The beam's mesh and conditions: clamped at x = 0, a dead traction on the end x = L.
 
-    def __init__(self, length: float, thickness: float, E: float, nu: float, *,
-                 material: str = "svk", plane: str = "stress", refine: int = 0,
-                 imperfection: float = 1e-4, degree: int = 2, comm: MPI.Comm = MPI.COMM_WORLD):
-        if material not in MATERIALS:
-            raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
+    Q`degree` quadrilaterals, 2·2^refine through the height, square-ish. Everything a
+    residual is written with is public: `u`, `V`, `model` (plane_stress | plane_strain),
+    `dx` (degree 4), `traction` (set by `set_load`) and `ds_end`.
+    """
+
+    def __init__(self, length: float, thickness: float, *, plane: str = "stress",
+                 refine: int = 0, imperfection: float = 1e-4, degree: int = 2,
+                 comm: MPI.Comm = MPI.COMM_WORLD):
         if plane not in ("stress", "strain"):
             raise ValueError(f"plane must be stress or strain, got {plane!r}")
         if not (length > 0 and thickness > 0):
@@ -48,34 +51,25 @@ class Beam:
         if thickness > length / 5:
             raise ValueError(f"the beam must be slender: thickness <= length/5, got L/h = "
                              f"{length / thickness:.3g}")
-        if material == "neo-hookean" and plane == "stress":
-            raise ValueError("neo-hookean is implemented in plane strain only (--plane strain)")
         if refine < 0:
             raise ValueError(f"refine must be >= 0, got {refine}")
         self.L, self.h, self.imperfection = length, thickness, imperfection
         self.model = "plane_stress" if plane == "stress" else "plane_strain"
-        self.material = MATERIALS[material](E, nu)
-        self.E_bending = E if plane == "stress" else E / (1 - nu**2)
-        self.P_euler = euler_load(self.E_bending, thickness**3 / 12, length)
         ny = 2 * 2**refine
         nx = max(4, round(length / thickness * ny / 2))  # square-ish Q2 elements
         self.mesh = mesh.create_rectangle(comm, [[0, -thickness / 2], [length, thickness / 2]],
                                           [nx, ny], mesh.CellType.quadrilateral)
-        V = fem.functionspace(self.mesh, ("Lagrange", degree, (2,)))
-        self.V = V
-        self.u = fem.Function(V, name="displacement")
+        self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (2,)))
+        self.u = fem.Function(self.V, name="displacement")
         fdim = 1
         clamped = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], 0))
         end = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], length))
         tags = mesh.meshtags(self.mesh, fdim, end, np.ones(len(end), dtype=np.int32))
-        self.bcs = [boundary.fixed(V, clamped)]
+        self.bcs = [boundary.fixed(self.V, clamped)]
         self.groups = {"clamp": clamped}
         self.ds_end = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
         self.traction = fem.Constant(self.mesh, np.zeros(2))
-        v = ufl.TestFunction(V)
         self.dx = kinematics.quadrature_measure("dx", self.mesh, 4)
-        self.residual = (self.material.internal_work(self.u, v, self.model) * self.dx
-                         - ufl.dot(self.traction, v) * self.ds_end)
         u = self.u
         F = kinematics.deformation_gradient(u, "plane_stress")  # 2x2 in-plane F
         self._tip_forms = [fem.form(f * self.ds_end) for f in
@@ -95,6 +89,49 @@ class Beam:
         comm = self.mesh.comm
         ux, uy, t0, t1 = (comm.allreduce(fem.assemble_scalar(f)) for f in self._tip_forms)
         return {"axial": ux, "lateral": uy, "rotation": math.atan2(-t0, t1)}
+
+
+def build_beam(length: float, thickness: float, E: float, nu: float, *,
+               material: str = "svk", **options) -> Beam:
+    """The beam scene in one call (as `demos/buckling_beam.py` composes it).
+
+    `options` go to `Cantilever` (plane, refine, imperfection, degree, comm).
+    """
+    if material not in MATERIALS:
+        raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
+    cantilever = Cantilever(length, thickness, **options)
+    law = MATERIALS[material](E, nu)
+    v = ufl.TestFunction(cantilever.V)
+    H_v = kinematics.displacement_gradient(v, cantilever.model)
+    residual = (ufl.inner(law.first_piola(cantilever.u, cantilever.model), H_v) * cantilever.dx
+                - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
+    return Beam(cantilever, law, residual)
+
+
+class Beam:
+    """The buckling analysis and the load path of a cantilever's residual.
+
+    Args:
+        cantilever: mesh, space and conditions (`Cantilever`).
+        material: a finite-strain law; its E, ν give Euler's load.
+        residual: R(u; v) of the cantilever under its end traction (UFL form).
+    """
+
+    def __init__(self, cantilever: Cantilever, material, residual):
+        self.cantilever, self.material, self.residual = cantilever, material, residual
+        self.L, self.h, self.model = cantilever.L, cantilever.h, cantilever.model
+        self.mesh, self.V, self.u, self.bcs = (cantilever.mesh, cantilever.V, cantilever.u,
+                                               cantilever.bcs)
+        self.dx, self.ds_end = cantilever.dx, cantilever.ds_end
+        self.set_load, self.tip = cantilever.set_load, cantilever.tip
+        E, nu = material.E, material.nu
+        self.E_bending = E if self.model == "plane_stress" else E / (1 - nu**2)
+        self.P_euler = euler_load(self.E_bending, self.h**3 / 12, self.L)
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        return output.dofs(self.V)
 
     def critical_loads(self, n: int = 3):
         """SLEPc: the first n critical loads and modes around the undeformed state."""
@@ -170,7 +207,7 @@ class Beam:
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""
-        return boundary.reactions(self.residual, self.u, self.groups)
+        return boundary.reactions(self.residual, self.u, self.cantilever.groups)
 
     def kick_along(self, mode: fem.Function, deflection: float) -> None:
         """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`."""

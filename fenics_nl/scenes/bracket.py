@@ -48,8 +48,6 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
         check_cells(data.mesh, name=path)  # a file may hold anything: inverted cells too
     else:
         if comm.rank == 0:
-            if not gmsh.isInitialized():
-                gmsh.initialize(interruptible=False)
             bracket_geometry.build(size)
         data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
         if comm.rank == 0:
@@ -68,21 +66,21 @@ def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None
 MAX_IT = {"full": 50, "periodic": 150, "modified": 800, "bfgs": 800}
 
 
-class Bracket:
-    """Build once; `set_load(F)`, `solve()`, `load_point_displacement()`, `von_mises()`."""
+class BracketPart:
+    """The bracket's mesh and conditions: bolt holes clamped, a traction on the loaded hole.
 
-    def __init__(self, material, *, size: float = 5.0, mesh_file: str | None = None,
-                 support: str = "clamped", degree: int = 1, newton: str = "full",
-                 linear_solver: str = "lu", comm: MPI.Comm = MPI.COMM_WORLD, period: int = 3,
-                 force_scale: float | None = None, tolerance: float = 1e-9,
-                 length_scale: float = 1.0, quadrature_degree: int | None = None):
-        if not 0 < tolerance < 1:
-            raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+    Lagrange P`degree` tetrahedra. Everything a residual is written with is public: `u`,
+    `V`, `dx` (degree 2 × degree by default: exact for the linear part of the power law,
+    README table), `traction` (set by `set_load`) and `ds_load`. With
+    ``support="contact"`` the base is the candidate contact surface on a rigid floor.
+    """
+
+    def __init__(self, *, size: float = 5.0, mesh_file: str | None = None,
+                 support: str = "clamped", degree: int = 1, length_scale: float = 1.0,
+                 quadrature_degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD):
         if support not in ("clamped", "contact"):
             raise ValueError(f"support must be clamped or contact, got {support!r}")
-        if newton == "snes" and support == "contact":
-            raise ValueError("--newton snes works with --support clamped only")
-        self.material, self.support = material, support
+        self.support = support
         data = load_mesh(comm, size, mesh_file, length_scale)
         self.mesh = data.mesh
         tags = data.facet_tags
@@ -94,46 +92,18 @@ class Bracket:
         cells = np.arange(self.mesh.topology.index_map(tdim).size_local, dtype=np.int32)
         self.largest_cell = global_max(comm, self.mesh.h(tdim, cells))
         self.groups = {"bolts": facets("bolts")}
-        self.load_facets = facets("load")
+        self.load_facets, self.base_facets = facets("load"), facets("base")
         if support == "contact":
-            self.groups["base"] = facets("base")
-        V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
-        self.V = V
-        self.u = fem.Function(V, name="displacement")
-        v = ufl.TestFunction(V)
+            self.groups["base"] = self.base_facets
+        self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
+        self.u = fem.Function(self.V, name="displacement")
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
         self.ds_load = ds(data.physical_groups["load"].tag)
         self.load_area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * self.ds_load)))
         self.traction = fem.Constant(self.mesh, np.zeros(3))
-        # 2 × degree by default: exact for the linear part of the power law (README table)
         q = quadrature_degree if quadrature_degree is not None else 2 * degree
-        dx = kinematics.quadrature_measure("dx", self.mesh, q)
-        self.residual = (material.internal_work(self.u, v) * dx
-                         - ufl.dot(self.traction, v) * self.ds_load)
-        bcs = [boundary.fixed(V, facets("bolts"))]
-        self.base_facets = facets("base")
-        # atol = tolerance × the load: ‖R‖ cannot go below the round-off of the internal
-        # forces, which reaches 1e-10 of the load at ε_eq ~ 800 ε0 (measured: 20 kN in 10
-        # steps on P2, 17k unknowns), hence 1e-9; and an active-set iteration restarts
-        # Newton close to equilibrium, where rtol ‖R₀‖ means little
-        method = {"quasi-newton": "bfgs"}.get(newton, newton)
-        opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
-                "max_it": MAX_IT.get(method, 50),
-                "linear_solver": linear_solver, "period": period}
-        if support == "contact":
-            # the floor z = 0 under the base: outward normal −e_z, gap 0
-            self.solver = ActiveSetContact(
-                self.residual, self.u, bcs, self.base_facets, lambda x: np.zeros(x.shape[1]),
-                normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
-                newton_options={k: v for k, v in opts.items() if k != "linear_solver"})
-        elif newton == "snes":
-            self.solver = SnesSolver(self.residual, self.u, bcs, prefix="bracket_snes_",
-                                     rtol=1e-10, atol=tolerance, force_scale=force_scale,
-                                     max_it=MAX_IT["full"],
-                                     linear_solver=linear_solver)
-        else:
-            self.solver = NewtonSolver(self.residual, self.u, bcs, prefix="bracket_", **opts)
-        self.bcs = bcs
+        self.dx = kinematics.quadrature_measure("dx", self.mesh, q)
+        self.bcs = [boundary.fixed(self.V, facets("bolts"))]
         self._mean_u = [fem.form(self.u[i] * self.ds_load) for i in range(3)]
 
     @property
@@ -155,6 +125,78 @@ class Bracket:
         """|mean displacement of the loaded hole| (in the mesh's length unit)."""
         return float(np.linalg.norm(self.load_point_motion()))
 
+
+def build_bracket(material, *, size: float = 5.0, mesh_file: str | None = None,
+                  support: str = "clamped", degree: int = 1, length_scale: float = 1.0,
+                  quadrature_degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD,
+                  **options) -> Bracket:
+    """The bracket scene in one call (as `demos/bracket.py` composes it).
+
+    `options` go to `Bracket` (newton, linear_solver, period, force_scale, tolerance).
+    """
+    part = BracketPart(size=size, mesh_file=mesh_file, support=support, degree=degree,
+                       length_scale=length_scale, quadrature_degree=quadrature_degree,
+                       comm=comm)
+    eps, v = kinematics.small_strain, ufl.TestFunction(part.V)
+    residual = (ufl.inner(material.stress(eps(part.u)), eps(v)) * part.dx
+                - ufl.dot(part.traction, v) * part.ds_load)
+    return Bracket(part, material, residual, **options)
+
+
+class Bracket:
+    """The non-linear solver of a bracket's residual.
+
+    A Newton variant, SNES, or the active-set loop when the base rests on the floor.
+
+    Args:
+        part: mesh, space and conditions (`BracketPart`).
+        material: the small-strain law of the residual (for σ_eq).
+        residual: R(u; v) of the part under its traction (UFL form).
+        newton: full | modified | periodic | quasi-newton | snes.
+        linear_solver: ``lu`` (MUMPS) or ``gamg`` (CG + GAMG).
+        period: tangent rebuilt every `period` iterations (``periodic``).
+        force_scale: the force of the absolute tolerance (default: the first residual).
+        tolerance: ‖R‖ ≤ tolerance × force_scale ends Newton.
+    """
+
+    def __init__(self, part: BracketPart, material, residual, *, newton: str = "full",
+                 linear_solver: str = "lu", period: int = 3, force_scale: float | None = None,
+                 tolerance: float = 1e-9):
+        if not 0 < tolerance < 1:
+            raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+        if newton == "snes" and part.support == "contact":
+            raise ValueError("--newton snes works with --support clamped only")
+        self.part, self.material, self.residual = part, material, residual
+        self.mesh, self.V, self.u, self.bcs = part.mesh, part.V, part.u, part.bcs
+        self.support, self.largest_cell = part.support, part.largest_cell
+        self.set_load, self.load_point_motion = part.set_load, part.load_point_motion
+        self.load_point_displacement = part.load_point_displacement
+        # atol = tolerance × the load: ‖R‖ cannot go below the round-off of the internal
+        # forces, which reaches 1e-10 of the load at ε_eq ~ 800 ε0 (measured: 20 kN in 10
+        # steps on P2, 17k unknowns), hence 1e-9; and an active-set iteration restarts
+        # Newton close to equilibrium, where rtol ‖R₀‖ means little
+        method = {"quasi-newton": "bfgs"}.get(newton, newton)
+        opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
+                "max_it": MAX_IT.get(method, 50),
+                "linear_solver": linear_solver, "period": period}
+        if part.support == "contact":
+            # the floor z = 0 under the base: outward normal −e_z, gap 0
+            self.solver = ActiveSetContact(
+                residual, self.u, self.bcs, part.base_facets, lambda x: np.zeros(x.shape[1]),
+                normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
+                newton_options={k: v for k, v in opts.items() if k != "linear_solver"})
+        elif newton == "snes":
+            self.solver = SnesSolver(residual, self.u, self.bcs, prefix="bracket_snes_",
+                                     rtol=1e-10, atol=tolerance, force_scale=force_scale,
+                                     max_it=MAX_IT["full"], linear_solver=linear_solver)
+        else:
+            self.solver = NewtonSolver(residual, self.u, self.bcs, prefix="bracket_", **opts)
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        return output.dofs(self.V)
+
     def contact_fields(self) -> list[fem.Function]:
         """Nodal floor pressure and active set (1/0) on the base (contact support only)."""
         return self.solver.fields()
@@ -165,7 +207,7 @@ class Bracket:
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on the bolts (and on the base from the floor), see `boundary`."""
-        return boundary.reactions(self.residual, self.u, self.groups)
+        return boundary.reactions(self.residual, self.u, self.part.groups)
 
     def lifted_off_area(self) -> float:
         """Area of the base not in contact with the floor [mm²] (contact support only)."""

@@ -15,16 +15,17 @@ from __future__ import annotations
 
 import gmsh
 
+from fenics_nl.domain.meshes import start_model
+
 LENGTH, WIDTH, THICK, HEIGHT = 100.0, 60.0, 10.0, 80.0
 FILLET, BOLT_R, BOLT_X, LOAD_R, LOAD_Z = 8.0, 6.0, 70.0, 8.0, 60.0
 GROUPS = ("bolts", "load", "base")
 
 
 def build(size: float) -> None:
-    """Create the model `bracket` in the current gmsh session and mesh it (tetrahedra)."""
+    """Create the model `bracket` in gmsh (default options) and mesh it (tetrahedra)."""
     occ = gmsh.model.occ
-    gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.model.add("bracket")
+    start_model("bracket")
     base = occ.addBox(0, 0, 0, LENGTH, WIDTH, THICK)
     arm = occ.addBox(0, 0, 0, THICK, WIDTH, HEIGHT)
     solid = occ.fuse([(3, base)], [(3, arm)])[0][0][1]

@@ -52,22 +52,22 @@ class Indentation:
     factorizations: int
 
 
-class Punch:
-    """The punch scene: build once, then `indent(δ)` or `push(P)` (warm-started)."""
+class PunchBlock:
+    """The block under the punch: graded mesh, displacement space, supports, S_C.
 
-    def __init__(self, model: str, material, radius: float, a: float, *, refine: int = 1,
-                 block: float = 1000.0, formulation: str = "elimination", gap: str = "parabola",
-                 comm: MPI.Comm = MPI.COMM_WORLD, newton_options: dict | None = None,
-                 growth: float | None = None):
+    Element size h = a/(20·2^refine) (plane strain a/40, 3D a/6) within 1.5a of the axis;
+    `a` is the expected contact radius. Everything a residual is written with is public:
+    `u`, `V`, `kinematics` (the strain model), `dx` (degree-2 quadrature, exact for P1) and
+    `weight` (2πr in the axisymmetric model, else 1).
+    """
+
+    def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
+                 growth: float | None = None, comm: MPI.Comm = MPI.COMM_WORLD):
         if model not in MODELS:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        if not radius > 0:
-            raise ValueError(f"radius must be > 0, got {radius}")
-        if gap not in ("parabola", "sphere"):
-            raise ValueError(f"gap must be parabola or sphere, got {gap!r}")
         if refine < 0 or block < 10:
             raise ValueError("refine must be >= 0 and block >= 10 (block size in contact radii)")
-        self.model, self.material, self.R, self.gap_shape = model, material, radius, gap
+        self.model, self.a = model, a
         dim = 3 if model == "3d" else 2
         self.vertical = dim - 1
         # plane strain: the half-width is about half of √(Rδ), so the mesh is twice as fine
@@ -76,14 +76,12 @@ class Punch:
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth)
         self.mesh = data.mesh
-        V = fem.functionspace(self.mesh, ("Lagrange", 1, (dim,)))
-        self.u = fem.Function(V, name="displacement")
-        v = ufl.TestFunction(V)
-        kin = "axisymmetric" if model == "axisymmetric" else "3d" if dim == 3 else "plane_strain"
-        self.weight = kinematics.measure_weight(self.mesh, kin)
-        dx = kinematics.quadrature_measure("dx", self.mesh, 2)
-        residual = material.internal_work(self.u, v, kin) * dx
-        self.residual, self.kinematics = residual, kin
+        self.V = fem.functionspace(self.mesh, ("Lagrange", 1, (dim,)))
+        self.u = fem.Function(self.V, name="displacement")
+        self.kinematics = ("axisymmetric" if model == "axisymmetric"
+                           else "3d" if dim == 3 else "plane_strain")
+        self.weight = kinematics.measure_weight(self.mesh, self.kinematics)
+        self.dx = kinematics.quadrature_measure("dx", self.mesh, 2)
 
         def facets(name):
             return data.facet_tags.find(data.physical_groups[name].tag)
@@ -91,36 +89,80 @@ class Punch:
         # the constrained groups, whose reactions are reported (the side is free)
         names = ["contact", "bottom", "symmetry_x"] + (["symmetry_y"] if dim == 3 else [])
         self.groups = {name: facets(name) for name in names}
-
-        bcs = [boundary.component(V, 0, facets("symmetry_x")),
-               boundary.component(V, self.vertical, facets("bottom"))]
+        self.bcs = [boundary.component(self.V, 0, facets("symmetry_x")),
+                    boundary.component(self.V, self.vertical, facets("bottom"))]
         if dim == 3:
-            bcs.append(boundary.component(V, 1, facets("symmetry_y")))
-        self.bcs, self.contact_facets = bcs, facets("contact")
+            self.bcs.append(boundary.component(self.V, 1, facets("symmetry_y")))
+        self.contact_facets = facets("contact")
         # force of the whole body from the modelled part (2πr is in the weight)
         self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
+
+    def radius_of(self, x):
+        """Distance from the punch axis (the x coordinate in plane strain)."""
+        return np.sqrt(x[0] ** 2 + x[1] ** 2) if self.model == "3d" else np.abs(x[0])
+
+
+def build_punch(model: str, material, radius: float, a: float, *, refine: int = 1,
+                block: float = 1000.0, growth: float | None = None,
+                comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Punch:
+    """The punch scene in one call (as `demos/punch.py` composes it), for tests and benchmarks.
+
+    `options` go to `Punch` (formulation, gap, newton_options).
+    """
+    body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm)
+    eps = kinematics.small_strain
+    v = ufl.TestFunction(body.V)
+    residual = (ufl.inner(material.stress(eps(body.u, body.kinematics)),
+                          eps(v, body.kinematics)) * body.weight * body.dx)
+    return Punch(body, material, residual, radius, **options)
+
+
+class Punch:
+    """The active-set solver of a block's residual against the rigid punch.
+
+    `indent(δ)` or `push(P)`, each warm-started from the last active set.
+
+    Args:
+        block: the mesh, space and supports (`PunchBlock`).
+        material: its E and ν give Hertz's reference and the force scale of the tolerances.
+        residual: the block's residual R(u; v) (UFL form), zero external load: the punch
+            acts through the contact conditions only.
+        radius: the punch radius R.
+        formulation: ``elimination`` or ``multiplier`` (see `ActiveSetContact`).
+        gap: ``parabola`` (Hertz's) or ``sphere`` (exact).
+        newton_options: passed to the Newton solver of each active-set iteration.
+    """
+
+    def __init__(self, block: PunchBlock, material, residual, radius: float, *,
+                 formulation: str = "elimination", gap: str = "parabola",
+                 newton_options: dict | None = None):
+        if not radius > 0:
+            raise ValueError(f"radius must be > 0, got {radius}")
+        if gap not in ("parabola", "sphere"):
+            raise ValueError(f"gap must be parabola or sphere, got {gap!r}")
+        self.block, self.material, self.residual = block, material, residual
+        self.R, self.gap_shape = radius, gap
+        self.model, self.mesh, self.u, self.bcs = block.model, block.mesh, block.u, block.bcs
         # the force scale of Newton's absolute tolerance: Hertz's force for the expected a
         # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length)
+        a, model = block.a, block.model
         E_star = hertz.effective_modulus(material.E, material.nu)
         force = (np.pi / 4 if model == "plane-strain" else 4 / 3) * E_star * a**3 / radius
         if model == "plane-strain":
             force /= a
         opts = {"line_search": not material.is_linear,
-                "force_scale": force / self.symmetry_factor}
+                "force_scale": force / self.block.symmetry_factor}
         opts.update(newton_options or {})
         self.contact = ActiveSetContact(
-            residual, self.u, bcs, facets("contact"), self.gap(0.0), normal_axis=self.vertical,
-            normal_sign=1, formulation=formulation, initial="penetrating", newton_options=opts,
+            residual, self.u, self.bcs, self.block.contact_facets, self.gap(0.0),
+            normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
+            initial="penetrating", newton_options=opts,
             prefix=f"punch_{model.replace('-', '')}_")
 
     @property
     def dofs(self) -> int:
         """Global number of displacement unknowns."""
         return output.dofs(self.u.function_space)
-
-    def radius_of(self, x):
-        """Distance from the punch axis (the x coordinate in plane strain)."""
-        return np.sqrt(x[0] ** 2 + x[1] ** 2) if self.model == "3d" else np.abs(x[0])
 
     def gap_at(self, r, delta: float):
         """γ(r) = the punch's height above the undeformed surface at distance r, minus δ."""
@@ -132,7 +174,7 @@ class Punch:
 
     def gap(self, delta: float):
         """γ(x) of the punch pressed by δ, for the contact surface."""
-        return lambda x: self.gap_at(self.radius_of(x), delta)
+        return lambda x: self.gap_at(self.block.radius_of(x), delta)
 
     def indent(self, delta: float) -> Indentation:
         """Press the punch down by δ (from the last state's active set)."""
@@ -141,14 +183,14 @@ class Punch:
         c.add_penetrating()  # warm start: the last set and what penetrates now
         res = c.solve()
         radius = self._contact_radius()
-        p_max = global_max(self.mesh.comm, c.pressure(self.weight)[c.active])
-        return Indentation(delta, self.symmetry_factor * c.force, radius, p_max,
+        p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])
+        return Indentation(delta, self.block.symmetry_factor * c.force, radius, p_max,
                            res.active_set_iterations, res.iterations, res.work.factorizations)
 
     def _contact_radius(self) -> float:
         """Distance of the outermost active node from the axis (within h of the true edge)."""
         c = self.contact
-        r = self.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
+        r = self.block.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
         return global_max(self.mesh.comm, r)
 
     def push(self, force: float, delta0: float, rtol: float = 1e-10, max_it: int = 30
@@ -178,8 +220,8 @@ class Punch:
         """
         c = self.contact
         owned = c.owned
-        rows = gather_rows(self.mesh.comm, self.radius_of(c.x[owned].T),
-                           c.pressure(self.weight)[owned], c.active[owned])
+        rows = gather_rows(self.mesh.comm, self.block.radius_of(c.x[owned].T),
+                           c.pressure(self.block.weight)[owned], c.active[owned])
         if rows is None:
             return None
         r, p, active = rows
@@ -192,18 +234,18 @@ class Punch:
 
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (DG0), with the hoop strain in the axisymmetric model."""
-        return self.material.von_mises(self.u, self.kinematics)
+        return self.material.von_mises(self.u, self.block.kinematics)
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal contact pressure and active set (1/0) on S_C, to write out."""
-        return self.contact.fields(self.weight)
+        return self.contact.fields(self.block.weight)
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on each constrained group of the modelled part (`boundary`).
 
         A node shared by two groups (a corner) counts in the first: contact, bottom, symmetry.
         """
-        return boundary.reactions(self.residual, self.u, self.groups)
+        return boundary.reactions(self.residual, self.u, self.block.groups)
 
     def hertz(self, state: Indentation) -> dict[str, float]:
         """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""
