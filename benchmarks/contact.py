@@ -120,7 +120,7 @@ def main():
     punch("axisymmetric", 0, formulation="multiplier").indent(DELTA)
     q = punch("axisymmetric", 0)
     solve_snes_vi(q, DELTA)
-    solve_penalty(q, DELTA, 10 / q.h, prefix="w_")
+    solve_penalty(q, DELTA, 10 / q.block.h, prefix="w_")
     linear_solve_time(q)
     punch("3d", 0).indent(DELTA)
 
