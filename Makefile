@@ -29,6 +29,8 @@ demo: $(VENV)/.installed
 	  --plot results/bracket_curve.png --json results/bracket.json
 	$(PY) demos/newton_scalar.py --plot results/newton_orders.png --json results/newton.json \
 	  > results/newton_scalar.txt
+	$(PY) -m fenics_nl run cases/thick_cylinder.toml --png results/thick_cylinder.png \
+	  --json results/thick_cylinder.json
 	@echo "make demo: pictures (*.png) and results (*.json) in $(CURDIR)/results/"
 
 test: test-serial test-mpi

@@ -1,6 +1,6 @@
 # # A 3D bracket in a non-linear material: Newton variants side by side
 #
-# An L-shaped steel-like bracket (gmsh geometry in `scenes/bracket_geometry.py`) is
+# An L-shaped steel-like bracket (gmsh geometry in `fenics_nl/scenes/bracket_geometry.py`) is
 # bolted through its base and pulled at a hole in its arm. The material is the power law
 # of `fenics_nl`: linear (E, ν) at small strain,
 # $\sigma_{eq} \approx \sigma_0 (\varepsilon_{eq}/\varepsilon_0)^n$ beyond
@@ -103,7 +103,7 @@ def run_variant(args, newton):
 
     # ### The solver
     #
-    # `Bracket` builds the chosen Newton variant (`fenics_nl.solvers.NewtonSolver`: full,
+    # `Bracket` builds the chosen Newton variant (`fenics_nl.solvers.newton.NewtonSolver`: full,
     # modified, periodic, quasi-Newton; or PETSc SNES) on this residual, inside the
     # active-set loop when the base rests on the floor. Its absolute tolerance is
     # `--tolerance` times the load.

@@ -22,7 +22,8 @@
 # settle on it. The steps therefore never grow beyond $1/n$ of the load, and the end state is
 # checked for stability (the tangent's eigenvalue nearest 0, by SLEPc); an unstable end
 # state is pushed along its unstable mode, scaled to the elastica's deflection, and solved
-# again (branch switching), or the run stops with a clear message.
+# again (branch switching); if Newton cannot follow, the path is redone with 4 times the
+# steps (up to 256), and only then does the run stop with a clear message.
 #
 # ## Implementation
 

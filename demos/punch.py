@@ -24,7 +24,8 @@
 # checked against the computed force per unit length $P$.
 #
 # The block must behave like a half-space: it is 1000 contact radii wide and deep (100 in
-# 3D), with elements of a/40 under the punch growing by 5 % of the distance away from it;
+# 3D), with elements of a/40 under the punch (axisymmetric; plane strain a/80, 3D a/12)
+# growing by 5 % of the distance away from it (3D: 10 %);
 # on the axisymmetric model this keeps the block-size and far-field error near 0.15 %,
 # below the 0.5 % asked of the force (the sizes are measured in `fenics_nl/scenes/punch.py`).
 #
@@ -51,7 +52,7 @@ from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz
 
 comm = MPI.COMM_WORLD
-MAX_REFINE = 6  # a/1280 under the punch in 2D: ~1e6 unknowns
+MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
 MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
 FEW_NODES = 10  # below this, a and p0 are coarse: say so
 # -
@@ -73,7 +74,7 @@ def run(args):
         args.indentation = 0.01 * args.radius
     # ### The block
     #
-    # A graded mesh, fine (h = a/40 by default) within 1.5 a of the axis and coarser away
+    # A graded mesh, fine (h = a/40 axisymmetric by default) within 1.5 a of the axis, coarser away
     # from it, in a block 1000 a wide (100 a in 3D) so that it behaves like Hertz's
     # half-space. Its bottom slides on a rigid base; the symmetry planes carry their
     # symmetry conditions; its top is the contact surface $S_C$.
@@ -106,7 +107,7 @@ def run(args):
     # ### The active-set loop, in load steps
     #
     # `Punch` gives the residual, the supports and the gap $\gamma$ to
-    # `fenics_nl.contact.ActiveSetContact`, which runs the course's loop: solve with
+    # `fenics_nl.contact.active_set.ActiveSetContact`, which runs the course's loop: solve with
     # $u_n = \gamma$ on the active nodes (rows eliminated, or Lagrange multipliers), then
     # update the set (leave where $T_n > 0$, join where $u_n > \gamma$) until it stops
     # changing. The load (δ, or the force P by a secant iteration on δ) grows in equal

@@ -68,27 +68,49 @@ class Demos:
         self.tmp_path, self.capfd, self.monkeypatch = tmp_path, capfd, monkeypatch
 
     def run(self, args, check=True, ranks=1) -> subprocess.CompletedProcess:
-        """`python demos/args[0] args[1:]`; with `check`, a non-zero exit fails the test."""
+        """`python demos/args[0] args[1:]`; with `check`, a non-zero exit fails the test.
+
+        args[0] = "-m fenics_nl" runs the case-file command instead of a demo.
+        """
         name, argv = str(args[0]), [str(a) for a in args[1:]]
         proc = self._in_process(name, argv) if ranks == 1 else self._mpiexec(name, argv, ranks)
         if check:
             assert proc.returncode == 0, proc.stderr
         return proc
 
+    def case(self, *args, ranks=1) -> dict:
+        """`python -m fenics_nl run args...` and its JSON."""
+        out = self.tmp_path / f"case{next(_runs)}.json"
+        self.run(["-m fenics_nl", "run", *args, "--json", out], ranks=ranks)
+        return json.loads(out.read_text())
+
     def _in_process(self, name, argv):
-        main = demo_module(name).main
+        if name == "-m fenics_nl":
+            from fenics_nl.__main__ import main
+        else:
+            main = demo_module(name).main
+        from petsc4py import PETSc
+
         self.capfd.readouterr()
+        before = set(PETSc.Options().getAll())
         with self.monkeypatch.context() as m:
             m.chdir(self.tmp_path)
             try:
                 code = main(argv)
             except SystemExit as stop:  # argparse: --help, or a bad flag
                 code = stop.code if isinstance(stop.code, int) else int(stop.code is not None)
+            finally:  # what a failed run may leave behind must not reach the next one
+                for name in set(PETSc.Options().getAll()) - before:
+                    PETSc.Options().delValue(name)
+                import matplotlib.pyplot as plt
+
+                plt.close("all")
         out, err = self.capfd.readouterr()
         return subprocess.CompletedProcess([name, *argv], code, out, err)
 
     def _mpiexec(self, name, argv, ranks):
-        cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, str(DEMOS / name), *argv]
+        script = ["-m", "fenics_nl"] if name == "-m fenics_nl" else [str(DEMOS / name)]
+        cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, *script, *argv]
         return subprocess.run(cmd, cwd=self.tmp_path, capture_output=True, text=True,
                               timeout=900)
 

@@ -343,9 +343,9 @@ def test_bracket_two_ranks_match_serial(support, demo):
 def _box_without_groups(path, fold=False):
     import gmsh
 
-    gmsh.initialize()
-    gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.model.add("box")
+    from fenics_nl.domain.meshes import start_model
+
+    start_model("box")  # gmsh's defaults: no mesh size left over from an earlier bracket
     gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
     gmsh.model.occ.synchronize()
     gmsh.model.addPhysicalGroup(3, [1], 1, name="solid")

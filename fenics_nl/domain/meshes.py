@@ -37,7 +37,8 @@ def _graded_size_field(h_fine: float, fine_radius: float, h_coarse: float, far: 
 
 
 def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: float,
-                 fine_radius: float, growth: float = 0.15) -> gmshio.MeshData:
+                 fine_radius: float, growth: float = 0.15, msh_file: str | None = None
+                 ) -> gmshio.MeshData:
     """A block under a surface load near the origin, refined there.
 
     2D: [0, width] x [-depth, 0] (axisymmetric or half plane-strain model).
@@ -47,7 +48,8 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     origin, then growing by `growth` per unit distance (geometric-like grading).
 
     gmsh works in units of `fine_radius` (its tolerances are absolute) and the coordinates
-    are scaled back, so the mesh is the same, up to scale, in any unit system.
+    are scaled back, so the mesh is the same, up to scale, in any unit system. `msh_file`:
+    also write the mesh there (in the caller's units), e.g. for a case file.
     """
     unit = fine_radius
     width, depth, h_fine, fine_radius = width / unit, depth / unit, h_fine / unit, 1.0
@@ -82,6 +84,10 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
         _graded_size_field(h_fine, fine_radius, h_fine + growth * far, far)
         gmsh.model.mesh.generate(dim)
     data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+    if msh_file is not None and comm.rank == 0:
+        gmsh.model.mesh.affineTransform([unit, 0, 0, 0, 0, unit, 0, 0, 0, 0, unit, 0])
+        gmsh.option.setNumber("Mesh.Binary", 1)  # the coordinates to the last bit
+        gmsh.write(str(msh_file))
     if comm.rank == 0:
         gmsh.model.remove()
     data.mesh.geometry.x[:] *= unit

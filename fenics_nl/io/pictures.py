@@ -131,3 +131,91 @@ def _contact_status_view(pl, pv, warped, status, size) -> None:
         if np.any(active == on):
             pl.add_points(x[active == on] - [0, 0, 0.01 * size], color=colour, point_size=8,
                           render_points_as_spheres=True)
+
+
+def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
+                     marked: dict[str, np.ndarray] | None = None,
+                     arrows: dict[str, np.ndarray] | None = None,
+                     focus: np.ndarray | None = None) -> None:
+    """The deformed body (2D or 3D) coloured by σ_eq over its undeformed outline.
+
+    `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
+    `arrows`: name → (this rank's points of a loaded group, the load's direction);
+    `focus`: this rank's points of what the picture is about (the nodes in contact): the
+    view is cut to a box 2.5 times their extent around them.
+    The displacement is magnified until the largest motion is 5 % of the body (said in
+    the picture). Collective; rank 0 writes `path`.
+    """
+    comm = u.function_space.mesh.comm
+    u1 = vertex_interpolant(u)
+    grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(vm)})
+    points = {k: gather_rows(comm, v) for k, v in (marked or {}).items()}
+    loads = {k: (gather_rows(comm, x), d) for k, (x, d) in (arrows or {}).items()}
+    focus = gather_rows(comm, focus) if focus is not None else None
+    if comm.rank != 0:
+        return
+    pv = off_screen()
+    mesh = grid.pyvista()
+    disp = grid.point_data["u"]
+    if disp.shape[1] == 2:  # a 2D body lies in z = 0
+        disp = np.hstack([disp, np.zeros((len(disp), 1))])
+    mesh.point_data["u"] = disp
+    size = np.ptp(grid.points, axis=0).max()
+    if focus is not None and len(focus[0]):
+        pts = _as_3d(focus[0])
+        half = 1.25 * (np.ptp(pts, axis=0).max() or 0.01 * size)  # one node: 1 % of the body
+        lo, hi = pts.min(axis=0) - half, pts.max(axis=0) + half
+        mesh = mesh.clip_box([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], invert=False)
+        disp = mesh.point_data["u"]
+        size = np.ptp(mesh.points, axis=0).max()
+
+        def inside(rows):
+            x = _as_3d(rows[0])
+            return [x[np.all((x >= lo) & (x <= hi), axis=1)]]
+
+        points = {k: inside(v) for k, v in points.items()}
+        loads = {k: (inside(x), d) for k, (x, d) in loads.items()}
+    u_max = np.linalg.norm(disp, axis=1).max()
+    scale = max(1.0, 0.05 * size / max(u_max, 1e-300))
+    warped = mesh.warp_by_vector("u", factor=scale)
+    flat = bool(np.ptp(grid.points[:, 2]) == 0)
+    pl = pv.Plotter(off_screen=True, window_size=(1100, 850))
+    if flat:  # the undeformed outline; cell edges only while they do not hide the colours
+        outline = mesh.extract_feature_edges(boundary_edges=True, feature_edges=False,
+                                             manifold_edges=False, non_manifold_edges=False)
+        pl.add_mesh(outline, color="gray", line_width=1.5)
+    else:
+        pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.25)
+    pl.add_mesh(warped, scalars="vm", cmap="turbo", show_edges=flat and mesh.n_cells < 3000,
+                edge_color="white", line_width=0.2, scalar_bar_args={
+                    "title": "von Mises stress", "vertical": False, "position_x": 0.2,
+                    "position_y": 0.03, "width": 0.6, "fmt": "%.3g"})
+    colours = ["black", "magenta", "blue", "orange", "green", "brown"]
+    legend = []
+    for (name, rows), colour in zip(points.items(), colours * 4, strict=False):
+        pts = _as_3d(rows[0])
+        if len(pts):
+            pl.add_points(pts, color=colour, point_size=7, render_points_as_spheres=True)
+            legend.append(f"{colour} dots: {name}")
+    for name, (rows, direction) in loads.items():
+        pts = _as_3d(rows[0])
+        if len(pts):  # from the group's centre, along the load
+            d = _as_3d(np.asarray(direction, dtype=float)[None, :])[0]
+            pl.add_arrows(pts.mean(axis=0)[None, :], d[None, :],
+                          mag=0.25 * size / np.linalg.norm(d), color="red")
+            legend.append(f"red arrow: {name}")
+    if legend:
+        pl.add_text("\n".join(legend), font_size=10, position="upper_right")
+    if flat:
+        pl.view_xy()
+    else:
+        pl.view_vector((1.0, -1.6, 0.9))
+    pl.add_text(f"{title}\ndeformed x{scale:.3g} (grey: undeformed); largest displacement "
+                f"{u_max:.3g}", font_size=11, position="upper_left")
+    pl.screenshot(path)
+    pl.close()
+
+
+def _as_3d(points: np.ndarray) -> np.ndarray:
+    """(n, 2) points in the plane z = 0 as (n, 3); (n, 3) unchanged."""
+    return np.hstack([points, np.zeros((len(points), 3 - points.shape[1]))])

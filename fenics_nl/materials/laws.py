@@ -79,6 +79,28 @@ class Material(ABC):
     def internal_work(self, u, v, model: str = "3d"):
         """Integrand of the internal virtual work of `u` in the direction `v`."""
 
+    @abstractmethod
+    def cauchy_stress(self, u, model: str = "3d"):
+        """The Cauchy stress of the displacement `u` (3x3; 2x2 in plane stress)."""
+
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u`, one value per cell (DG0 Function).
+
+        Plane stress: σ is embedded in 3D with σ_zz = 0 (the deviator is the 3D one).
+        """
+        from dolfinx import fem
+
+        sigma = self.cauchy_stress(u, model)
+        if sigma.ufl_shape[0] == 2:
+            sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0],
+                                   [sigma[1, 0], sigma[1, 1], 0], [0, 0, 0]])
+        s = ufl.dev(sigma)
+        Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
+        f = fem.Function(Q, name="von_mises")
+        f.interpolate(fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)),
+                                     Q.element.interpolation_points))
+        return f
+
 
 class SmallStrain(Material):
     """Stress, tangent and virtual work derived from `energy(ε)`."""
@@ -102,16 +124,9 @@ class SmallStrain(Material):
         eps_v = kinematics.small_strain(v, model)
         return ufl.inner(self.stress(eps_u), eps_v) * kinematics.measure_weight(mesh, model)
 
-    def von_mises(self, u, model: str = "3d"):
-        """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u`, one value per cell (DG0 Function)."""
-        from dolfinx import fem
-
-        s = ufl.dev(self.stress(kinematics.small_strain(u, model)))
-        Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
-        f = fem.Function(Q, name="von_mises")
-        f.interpolate(fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)),
-                                     Q.element.interpolation_points))
-        return f
+    def cauchy_stress(self, u, model: str = "3d"):
+        """σ(ε(u)): in small strain the Cauchy stress is the energy's derivative."""
+        return self.stress(kinematics.small_strain(u, model))
 
 
 class FiniteStrain(Material):
@@ -128,6 +143,11 @@ class FiniteStrain(Material):
         """P = F·S(e(u))."""
         F = kinematics.deformation_gradient(u, model)
         return F * self.second_piola(kinematics.green_lagrange(u, model))
+
+    def cauchy_stress(self, u, model: str = "3d"):
+        """σ = F S Fᵀ / det F (plane stress: det of the in-plane F, thickness change ignored)."""
+        F = kinematics.deformation_gradient(u, model)
+        return F * self.second_piola(kinematics.green_lagrange(u, model)) * F.T / ufl.det(F)
 
     def internal_work(self, u, v, model: str = "3d"):
         """Integrand of P(u) : ∇v over the reference configuration (times 2πR if axisymmetric)."""

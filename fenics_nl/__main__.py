@@ -1,0 +1,83 @@
+"""``python -m fenics_nl run CASE.toml`` (or ``fenics-nl run``): a problem from a case file.
+
+``run`` solves it (JSON, VTX fields and a picture on request, PETSc options under the
+prefix ``-case_``); ``check`` reads the file and the mesh and reports every mistake at once
+without solving.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+from mpi4py import MPI
+
+from fenics_nl.case.spec import FORMAT, CaseError, read_case
+from fenics_nl.io import cli
+from fenics_nl.io.cli import say
+
+
+class _Help(cli.HelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Defaults once, and the format reference as written."""
+
+
+def parser() -> argparse.ArgumentParser:
+    """The command line: `run` or `check`, a case file, outputs and PETSc options."""
+    p = cli.ArgumentParser(
+        prog="fenics-nl", formatter_class=_Help,
+        description="Solve a solid-mechanics problem described by a case file (a gmsh mesh "
+                    "with named physical groups and a TOML file), or check the file without "
+                    "solving. Units are the user's, consistent (e.g. N, mm, MPa).",
+        epilog="Case file format (TOML; every key shown, unknown keys are errors):\n\n"
+               + FORMAT + "\nPETSc options take the prefix -case_ (Newton's KSP: "
+               "-case_ksp_view; SNES: -case_snes_; contact: -case_elim_).")
+    p.add_argument("command", choices=["run", "check"], help="solve the case, or only check it")
+    p.add_argument("case", help="the case file (.toml)")
+    cli.add_outputs(p, json="the steps (load factor, iterations, probes, reactions) and "
+                            "totals",
+                    output="displacement, von Mises stress (and contact pressure)",
+                    png="the deformed body coloured by von Mises stress")
+    return p
+
+
+def main(argv=None) -> int:
+    """The command; returns the exit status (0, or 1/2 on a failed output/bad input)."""
+    p = parser()
+    args, petsc = cli.parse_with_petsc_options(p, argv)
+    if args.command == "check" and (args.json or args.output or args.png or petsc):
+        p.error("check takes the case file only")
+    t0 = time.perf_counter()
+    try:
+        from fenics_nl.case.problem import CaseProblem
+
+        case = read_case(args.case)
+        problem = CaseProblem(case)
+    except CaseError as err:
+        for line in err.problems:
+            cli.error(line)
+        return 2
+    say(f"{case.path.name}: {case.model}, P{case.degree}, {problem.dofs} unknowns, "
+        f"{case.law}, {len(case.factors)} load factors, {MPI.COMM_WORLD.size} rank(s)")
+    if args.command == "check":
+        say("check: the case is complete and consistent with its mesh")
+        return 0
+
+    def solve():
+        from fenics_nl.case.run import solve_case, write_outputs
+
+        out = solve_case(problem)
+        out["setup_time_s"] = time.perf_counter() - t0
+        return out, write_outputs(problem, args.output, args.png)
+
+    what = "Newton's KSP (case_), SNES (case_snes_), contact (case_elim_)"
+    return cli.run_scene(solve, petsc_argv=petsc, json_path=args.json,
+                         prefixes={"case_": what})
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,74 @@
+"""The mesh of a case: a .msh read, or a .geo meshed by gmsh at run time, checked."""
+
+from __future__ import annotations
+
+import gmsh
+import numpy as np
+from dolfinx.io import gmsh as gmshio
+from mpi4py import MPI
+
+from fenics_nl.case.spec import Case, CaseError
+from fenics_nl.domain.mesh_check import check_cells
+from fenics_nl.domain.meshes import start_model
+
+
+def load_mesh(case: Case, comm: MPI.Comm = MPI.COMM_WORLD) -> gmshio.MeshData:
+    """MeshData of the case's mesh (physical groups by name), or CaseError naming the key."""
+    data = _read(case, comm)
+    if case.mesh_file.suffix == ".msh":
+        check_cells(data.mesh, name=str(case.mesh_file))  # a file may hold anything
+    if case.model == "axisymmetric":
+        x = data.mesh.geometry.x
+        x_min = comm.allreduce(float(x[:, 0].min(initial=np.inf)), MPI.MIN)
+        size = comm.allreduce(float(np.ptp(x[:, :2], axis=0).max()) if len(x) else 0.0,
+                              MPI.MAX)
+        if x_min < -1e-12 * size:
+            raise CaseError([f"mesh.model: axisymmetric meshes lie in x >= 0 (x is the "
+                             f"radius); {case.mesh_file.name} reaches x = {x_min:g}"])
+    return data
+
+
+def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
+    """The mesh, built and checked on rank 0, then distributed.
+
+    A .msh is opened; a .geo is meshed with gmsh's default options, then the file's, then
+    `size`. gmsh reports a bad file in its log, not by an exception: the log is read.
+    """
+    error, name = None, case.mesh_file.name
+    action = "mesh" if case.mesh_file.suffix == ".geo" else "read"
+    if comm.rank == 0:
+        try:
+            start_model("case")
+            gmsh.logger.start()
+            gmsh.open(str(case.mesh_file))
+            dim = gmsh.model.getDimension()
+            if case.mesh_file.suffix == ".geo" and dim >= 0:
+                if case.mesh_size is not None:
+                    gmsh.option.setNumber("Mesh.MeshSizeMax", case.mesh_size)
+                gmsh.model.mesh.generate(dim)
+            logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
+            gmsh.logger.stop()
+            if logged or dim < 0:
+                error = (f"mesh.file: gmsh cannot {action} {name}: "
+                         f"{logged[0] if logged else 'no geometry in it'}")
+            elif dim != case.dim:
+                error = (f"mesh.model: {case.model!r} needs a {case.dim}D mesh, {name} has "
+                         f"{dim}D cells")
+            elif not any(len(gmsh.model.mesh.getElements(dim, t)[1])
+                         for _, t in gmsh.model.getEntities(dim)):
+                error = f"mesh.file: {name} has no {dim}D element"
+            elif not gmsh.model.getPhysicalGroups(dim):
+                error = (f"mesh.file: {name} has no {dim}D physical group (dolfinx keeps only "
+                         f"the cells of physical groups)")
+        except Exception as err:  # gmsh raises Exception with its own message
+            error = (f"mesh.file: gmsh cannot {action} {name}: "
+                     f"{' '.join(str(err).split()) or type(err).__name__}")
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        if comm.rank == 0 and gmsh.model.list():
+            gmsh.model.remove()
+        raise CaseError([error])
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=case.dim)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    return data

@@ -1,0 +1,280 @@
+"""A case file turned into the library's pieces: a residual, supports, a solver, probes.
+
+The same composition as a scene: mesh → displacement space → material → residual
+R(u; v) = ∫ internal work − ∫ loads → Dirichlet conditions → a Newton variant (or the
+active-set loop when a group touches an obstacle) → load steps. Every load of the case
+(prescribed displacements, tractions, pressures, the obstacle's motion) is scaled by one
+load factor.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import fem, geometry
+from dolfinx import mesh as dmesh
+from mpi4py import MPI
+
+from fenics_nl.case.mesh import load_mesh
+from fenics_nl.case.spec import Case, CaseError, Condition
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.domain import boundary
+from fenics_nl.io import output
+from fenics_nl.materials import kinematics
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.result import SolveResult
+from fenics_nl.solvers.snes import SnesSolver
+
+PREFIX = "case_"
+
+
+class CaseProblem:
+    """Build a case (without solving): every mesh-related mistake raises CaseError."""
+
+    def __init__(self, case: Case, comm: MPI.Comm = MPI.COMM_WORLD):
+        self.case = case
+        data = load_mesh(case, comm)
+        self.mesh = msh = data.mesh
+        self.facets = self._groups(data)
+        self.model, dim = case.model, case.dim
+        self.V = fem.functionspace(msh, ("Lagrange", case.degree, (dim,)))
+        self.u = fem.Function(self.V, name="displacement")
+        self.material = case.material()
+        self.t = fem.Constant(msh, 0.0)  # the load factor
+        tags = data.facet_tags
+        # 2 × degree: exact for the linear part of every law on affine cells (bracket's table)
+        q = 2 * case.degree
+        self.dx = kinematics.quadrature_measure("dx", msh, q)
+        self.ds = kinematics.quadrature_measure("ds", msh, q + 1, subdomain_data=tags)
+        self.weight = kinematics.measure_weight(msh, self.model)
+        self.residual = self._residual(data)
+        self.force_scale = self._load_magnitude(data)
+        self.bcs, self._prescribed = self._dirichlet()
+        # the contact group first: a node on it and on a support (the axis under a punch)
+        # carries the contact force, not the support's reaction
+        order = sorted(case.conditions, key=lambda c: c.kind != "contact")
+        self.supports = {c.group: self.facets[c.group] for c in order
+                         if c.kind in ("displacement", "contact")}
+        self.contact = self._contact()
+        self.probes = self._locate_probes()
+        self.solver = None  # make_solver(): compiling the forms is for a run, not a check
+
+    # -- the pieces ---------------------------------------------------------------------
+
+    def _groups(self, data) -> dict[str, np.ndarray]:
+        """Facets of every group the conditions name; unknown names listed at once."""
+        fdim = data.mesh.topology.dim - 1
+        have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == fdim}
+        problems, out = [], {}
+        for c in self.case.conditions:
+            if c.group in have:
+                out[c.group] = data.facet_tags.find(have[c.group])
+            else:
+                problems.append(f"{c.key.rsplit('.', 1)[0]}.group: {c.group!r} is not a "
+                                f"boundary group of the mesh (it has: "
+                                f"{', '.join(sorted(have)) or 'none'})")
+        if problems:
+            raise CaseError(problems)
+        return out
+
+    def _residual(self, data) -> ufl.Form:
+        """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
+        u, v = self.u, ufl.TestFunction(self.V)
+        tag = {n: g.tag for n, g in data.physical_groups.items()}
+        R = self.material.internal_work(u, v, self.model) * self.dx
+        w = self.weight
+        for c in self.case.conditions:
+            ds = self.ds(tag[c.group])
+            if c.kind == "traction":
+                T = ufl.as_vector(c.value)
+                R -= self.t * ufl.dot(T, v) * w * ds
+            elif c.kind == "pressure":
+                R += self.t * c.value * ufl.dot(self._pressure_direction(c), v) * w * ds
+        return R
+
+    def _load_magnitude(self, data) -> float | None:
+        """Σ |traction| or |pressure| × area over the loaded groups at load factor 1.
+
+        The force Newton's absolute tolerance is relative to (None: displacements or an
+        obstacle drive the body, and the first residual sets the scale).
+        """
+        tag = {n: g.tag for n, g in data.physical_groups.items()}
+        total = 0.0
+        for c in self.case.conditions:
+            if c.kind in ("traction", "pressure"):
+                size = float(np.linalg.norm(c.value)) if c.kind == "traction" else abs(c.value)
+                area = fem.assemble_scalar(fem.form(self.weight * self.ds(tag[c.group])))
+                total += size * self.mesh.comm.allreduce(area)
+        return total or None
+
+    def _pressure_direction(self, c: Condition):
+        """The reference normal N (dead), or J F⁻ᵀ N (follower) of the 2D or 3D model."""
+        N = ufl.FacetNormal(self.mesh)
+        if not c.follower:
+            return N
+        F = kinematics.deformation_gradient(self.u, self.model)
+        if F.ufl_shape[0] == len(N):  # 3D, plane stress
+            return ufl.det(F) * ufl.inv(F).T * N
+        n3 = ufl.det(F) * ufl.inv(F).T * ufl.as_vector([N[0], N[1], 0])
+        return ufl.as_vector([n3[0], n3[1]])
+
+    def _dirichlet(self):
+        """One condition per prescribed component; its value follows the load factor."""
+        bcs, prescribed = [], []
+        for c in self.case.conditions:
+            if c.kind != "displacement":
+                continue
+            for i, value in enumerate(c.value):
+                if value is not None:
+                    bc = boundary.component(self.V, i, self.facets[c.group], 0.0)
+                    bcs.append(bc)
+                    prescribed.append((bc.g.x.array, value))
+        return bcs, prescribed
+
+    def _contact(self):
+        """The contact group's obstacle, or None: (condition, facets, axis, sign)."""
+        c = next((c for c in self.case.conditions if c.kind == "contact"), None)
+        if c is None:
+            return None
+        axis, sign = self._flat_normal(c)
+        return c, self.facets[c.group], axis, sign
+
+    def _flat_normal(self, c: Condition) -> tuple[int, int]:
+        """The group's outward normal ±e_axis, or CaseError if it is not flat and aligned."""
+        comm = self.mesh.comm
+        n = ufl.FacetNormal(self.mesh)
+        f = np.sort(self.facets[c.group])
+        mt = dmesh.meshtags(self.mesh, self.mesh.topology.dim - 1, f,
+                            np.ones(len(f), dtype=np.int32))
+        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=mt)(1)
+        area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)))
+        if area <= 0:
+            raise CaseError([f"{c.key}: group {c.group!r} has no facet on the boundary"])
+        mean = np.array([comm.allreduce(fem.assemble_scalar(fem.form(n[i] * ds)))
+                         for i in range(self.case.dim)]) / area
+        axis = int(np.argmax(np.abs(mean)))
+        if abs(abs(mean[axis]) - 1) > 1e-8:
+            raise CaseError([f"{c.key}: the contact group must be flat with its outward "
+                             f"normal along an axis (mean normal {np.round(mean, 4).tolist()})"
+                             f"; the active set constrains one displacement component"])
+        return axis, int(np.sign(mean[axis]))
+
+    def gap(self, t: float):
+        """γ(x) at load factor t: distance from S_C to the obstacle along the outward normal."""
+        c, _, axis, sign = self.contact
+        ob = c.value
+        w = t * np.asarray(ob["displacement"])
+
+        def plane(x):
+            p, m = np.asarray(ob["point"]) + w, np.asarray(ob["normal"])
+            dot_n = sign * m[axis]
+            if dot_n == 0:  # the plane is parallel to the normal: never met
+                return np.full(x.shape[1], np.inf)
+            return ((p[:, None] - x[: len(p)]) * m[:, None]).sum(axis=0) / dot_n
+
+        def sphere(x):
+            centre, R = np.asarray(ob["center"]) + w, ob["radius"]
+            d = x[: len(centre)] - centre[:, None]
+            a = sign * d[axis]  # along the outward normal, negative when facing the sphere
+            r2 = np.maximum((d * d).sum(axis=0) - a * a, 0.0)
+            return np.where(r2 < R * R, -a - np.sqrt(np.maximum(R * R - r2, 0.0)), -a)
+
+        return plane if ob["obstacle"] == "plane" else sphere
+
+    def make_solver(self):
+        """The case's solver (compiles the forms; reads the PETSc options under case_)."""
+        self.solver = self._solver()
+        return self.solver
+
+    def _solver(self):
+        case = self.case
+        method = {"quasi-newton": "bfgs"}.get(case.newton, case.newton)
+        linear = "lu" if case.linear == "direct" else "gamg"
+        opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
+                "line_search": not self.material.is_linear, "force_scale": self.force_scale}
+        if self.contact is not None:
+            _, facets, axis, sign = self.contact
+            contact = ActiveSetContact(
+                self.residual, self.u, self.bcs, facets, self.gap(0.0), normal_axis=axis,
+                normal_sign=sign, initial="penetrating", prefix=PREFIX,
+                newton_options={"method": method, **opts})
+            return ContactSteps(contact, self)
+        if case.newton == "snes":
+            return SnesSolver(self.residual, self.u, self.bcs, prefix=PREFIX + "snes_",
+                              rtol=opts["rtol"], atol=case.tolerance,
+                              force_scale=self.force_scale, max_it=case.max_iterations,
+                              linear_solver=linear)
+        return NewtonSolver(self.residual, self.u, self.bcs, method=method, prefix=PREFIX,
+                            linear_solver=linear, **opts)
+
+    # -- loads and results --------------------------------------------------------------
+
+    @property
+    def dofs(self) -> int:
+        """Global number of scalar unknowns."""
+        return output.dofs(self.V)
+
+    def set_load(self, t: float) -> None:
+        """Scale every load of the case by t."""
+        self.t.value = t
+        for array, value in self._prescribed:
+            array[:] = t * value
+
+    def reactions(self) -> dict[str, list[float]]:
+        """Resultant force of each displacement (and the contact) group on the body.
+
+        The whole revolution if axisymmetric; a node in two groups counts in the contact
+        group, else in the first listed.
+        """
+        return boundary.reactions(self.residual, self.u, self.supports)
+
+    def von_mises(self) -> fem.Function:
+        """σ_eq per cell (Cauchy stress; DG0)."""
+        return self.material.von_mises(self.u, self.model)
+
+    def _locate_probes(self):
+        """(name, point, owning rank, local cell) of every probe; outside → CaseError."""
+        comm, msh = self.mesh.comm, self.mesh
+        tree = geometry.bb_tree(msh, msh.topology.dim)
+        out, problems = [], []
+        for p in self.case.probes:
+            x = np.zeros((1, 3))
+            x[0, : len(p.point)] = p.point
+            cells = geometry.compute_colliding_cells(
+                msh, geometry.compute_collisions_points(tree, x), x).links(0)
+            # the lowest rank holding the point owns the probe
+            owner = comm.allreduce(comm.rank if len(cells) else comm.size, MPI.MIN)
+            if owner == comm.size:
+                problems.append(f"{p.key}: {p.point} is outside the mesh")
+            out.append((p.name, x, owner, int(cells[0]) if len(cells) else -1))
+        if problems:
+            raise CaseError(problems)
+        return out
+
+    def probe_values(self, vm: fem.Function | None = None) -> dict[str, dict]:
+        """Displacement (and von Mises stress of `vm`) at every probe. Collective."""
+        comm, out = self.mesh.comm, {}
+        for name, x, owner, cell in self.probes:
+            value = None
+            if comm.rank == owner:
+                value = {"displacement": self.u.eval(x, np.array([cell], dtype=np.int32))
+                         .tolist()}
+                if vm is not None:
+                    value["von_mises"] = float(vm.x.array[vm.function_space.dofmap
+                                                          .cell_dofs(cell)[0]])
+            out[name] = comm.bcast(value, root=owner)
+        return out
+
+
+class ContactSteps:
+    """The active-set loop as a load-step solver: each step moves the obstacle first."""
+
+    def __init__(self, contact: ActiveSetContact, problem: CaseProblem):
+        self.contact, self.problem, self.u = contact, problem, problem.u
+
+    def solve(self) -> SolveResult:
+        """The contact state at the current load factor, from the last active set."""
+        c = self.contact
+        c.set_gap(self.problem.gap(float(self.problem.t.value)))
+        c.add_penetrating()
+        return c.solve()

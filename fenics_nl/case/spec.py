@@ -1,0 +1,406 @@
+"""The case-file format: a TOML file read into a `Case`, every mistake reported at once.
+
+Read with the standard library's `tomllib`. Every key is checked: an unknown key is an
+error (a misspelt optional key would otherwise be silently ignored), so is a missing
+required one, a value of the wrong type or out of range. Each message names the key as
+``table.key`` (``boundary[2].traction``: tables counted from 1) and what it accepts.
+`FORMAT` below is the reference, printed by ``python -m fenics_nl --help``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import MISSING, dataclass, field, fields
+from pathlib import Path
+
+from fenics_nl.materials import laws
+
+FORMAT = """\
+[mesh]
+file = "part.geo"        # .msh, or .geo meshed by gmsh at run time (path relative to the case)
+size = 2.0               # .geo only, optional: largest element size (gmsh Mesh.MeshSizeMax)
+model = "plane_strain"   # 3d | plane_strain | plane_stress | axisymmetric (x = r, y = z)
+degree = 2               # Lagrange degree of the displacement (default 1)
+
+[material]
+law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean
+E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n
+nu = 0.3
+
+[[boundary]]             # one table per condition, on a physical group of the mesh
+group = "clamped"
+displacement = [0.0, 0.0]     # a component may be "free"; values scale with the load factor
+
+[[boundary]]
+group = "loaded"
+traction = [0.0, -1.0]        # force per unit area (per unit length in 2D), reference
+                              # configuration (a dead load), scaled by the load factor
+
+[[boundary]]
+group = "inner"
+pressure = 1.0                # normal pressure, positive pushing on the body; dead (along the
+follower = false              # undeformed normal) unless follower = true (finite strain only)
+
+[[boundary]]                  # one contact group: rigid, frictionless, may separate
+group = "top"                 # flat, its outward normal along an axis
+contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
+# or { obstacle = "sphere", center = [0.0, 2.0], radius = 1.0 }; either may move:
+# displacement = [0.0, -0.01] (the obstacle's, scaled by the load factor)
+
+[loading]
+steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
+                         # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
+
+[solver]                 # every key optional
+newton = "full"          # full | modified | periodic | quasi-newton | snes
+linear = "direct"        # direct (MUMPS LU) | iterative (CG + GAMG)
+tolerance = 1e-9         # |R| <= tolerance x the force scale of the step ends Newton
+max_iterations = 50      # Newton iterations per step
+
+[[probe]]                # optional: displacement and von Mises stress at a point, every step
+name = "tip"
+point = [10.0, 1.0]
+"""
+
+LAWS: dict[str, type[laws.Material]] = {
+    "linear-elastic": laws.LinearElastic,
+    "power-law": laws.PowerLaw,
+    "saint-venant-kirchhoff": laws.StVenantKirchhoff,
+    "neo-hookean": laws.NeoHookean,
+}
+MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
+NEWTON = ("full", "modified", "periodic", "quasi-newton", "snes")
+LINEAR = ("direct", "iterative")
+CONDITIONS = ("displacement", "traction", "pressure", "contact")
+OBSTACLES = {"plane": ("point", "normal"), "sphere": ("center", "radius")}
+
+
+class CaseError(ValueError):
+    """Everything wrong with a case file, one problem per line."""
+
+    def __init__(self, problems: list[str]):
+        self.problems = problems
+        super().__init__("\n".join(problems))
+
+
+@dataclass
+class Condition:
+    """A boundary condition on a physical group."""
+
+    group: str
+    kind: str  # displacement | traction | pressure | contact
+    value: object  # components (None = free), a vector, a pressure, or the obstacle table
+    follower: bool = False
+    key: str = ""  # where it is in the file, for messages
+
+
+@dataclass
+class Probe:
+    """A point where displacement and von Mises stress are reported every step."""
+
+    name: str
+    point: list[float]
+    key: str = ""
+
+
+@dataclass
+class Case:
+    """A problem as data: mesh, material, conditions, load path, solver, probes."""
+
+    path: Path
+    mesh_file: Path
+    mesh_size: float | None
+    model: str
+    degree: int
+    law: str
+    parameters: dict[str, float]
+    conditions: list[Condition]
+    factors: list[float]  # the load factors to reach, in order
+    adaptive: bool
+    equal_steps: bool  # factors are k/n (loading.steps = n)
+    newton: str = "full"
+    linear: str = "direct"
+    tolerance: float = 1e-9
+    max_iterations: int = 50
+    probes: list[Probe] = field(default_factory=list)
+
+    @property
+    def dim(self) -> int:
+        """Geometric dimension of the model."""
+        return 3 if self.model == "3d" else 2
+
+    def material(self) -> laws.Material:
+        """The material law with its parameters (validated by the law)."""
+        return LAWS[self.law](**self.parameters)
+
+
+class _Reader:
+    """Typed look-ups in the TOML tables, collecting problems instead of stopping."""
+
+    def __init__(self):
+        self.problems: list[str] = []
+
+    def fail(self, key: str, message: str) -> None:
+        self.problems.append(f"{key}: {message}")
+
+    def table(self, data: dict, name: str, allowed: tuple[str, ...], required: bool = True):
+        value = data.get(name)
+        if value is None:
+            if required:
+                self.fail(name, "missing table")
+            return {}
+        if not isinstance(value, dict):
+            self.fail(name, "must be a table [" + name + "]")
+            return {}
+        self.unknown(value, name, allowed)
+        return value
+
+    def unknown(self, table: dict, where: str, allowed: tuple[str, ...]) -> None:
+        for k in table:
+            if k not in allowed:
+                self.fail(f"{where}.{k}", f"unknown key (accepted: {', '.join(allowed)})")
+
+    def get(self, table: dict, key: str, where: str, kind, *, default=None, required=False,
+            choices=None, positive=False, minimum=None):
+        name = f"{where}.{key}"
+        if key not in table:
+            if required:
+                self.fail(name, "missing" + (f" (one of {', '.join(choices)})" if choices
+                                             else ""))
+            return default
+        value = table[key]
+        if kind is float and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
+            self.fail(name, f"must be {_kind_name(kind)}, got {value!r}")
+            return default
+        if choices is not None and value not in choices:
+            self.fail(name, f"{value!r} is not one of {', '.join(choices)}")
+            return default
+        if kind is float and not math.isfinite(value):
+            self.fail(name, f"must be a finite number, got {value!r}")
+            return default
+        if positive and not value > 0:
+            self.fail(name, f"must be > 0, got {value!r}")
+            return default
+        if minimum is not None and value < minimum:
+            self.fail(name, f"must be >= {minimum}, got {value!r}")
+            return default
+        return value
+
+    def vector(self, value, name: str, n: int, free: bool = False):
+        """A list of n finite numbers (or "free" where `free`); None if wrong."""
+        if not isinstance(value, list) or len(value) != n:
+            self.fail(name, f"must be a list of {n} components (the model is {n}D), got "
+                            f"{value!r}")
+            return None
+        out = []
+        for v in value:
+            if free and v == "free":
+                out.append(None)
+            elif isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v):
+                out.append(float(v))
+            else:
+                accepted = 'a finite number or "free"' if free else "a finite number"
+                self.fail(name, f"component {v!r} is not {accepted}")
+                return None
+        return out
+
+
+def _kind_name(kind) -> str:
+    return {float: "a number", int: "an integer", str: "a string", bool: "true or false",
+            list: "a list", dict: "a table"}.get(kind, kind.__name__)
+
+
+def read_case(path: str | Path) -> Case:
+    """The case in `path`, or CaseError listing every problem found in the file itself.
+
+    What needs the mesh (group names, dimension, probe points) is checked by
+    `fenics_nl.case.problem.CaseProblem`.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CaseError([f"{path}: no such case file"])
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise CaseError([f"{path}: not valid TOML: {err}"]) from None
+    r = _Reader()
+    r.unknown(data, "case", ("mesh", "material", "boundary", "loading", "solver", "probe"))
+
+    m = r.table(data, "mesh", ("file", "size", "model", "degree"))
+    file = r.get(m, "file", "mesh", str, required=True)
+    size = r.get(m, "size", "mesh", float, positive=True)
+    model = r.get(m, "model", "mesh", str, required=True, choices=MODELS)
+    degree = r.get(m, "degree", "mesh", int, default=1, minimum=1)
+    mesh_file = None
+    if file is not None:
+        mesh_file = (path.parent / file).resolve()
+        if mesh_file.suffix not in (".msh", ".geo"):
+            r.fail("mesh.file", f"{file!r} must be a .msh or a .geo file")
+        elif not mesh_file.is_file():
+            r.fail("mesh.file", f"{mesh_file} not found")
+        if size is not None and mesh_file.suffix == ".msh":
+            r.fail("mesh.size", "applies to a .geo only (a .msh is already meshed)")
+    if degree is not None and degree > 3:
+        r.fail("mesh.degree", f"must be 1, 2 or 3, got {degree}")
+    dim = 3 if model == "3d" else 2
+
+    law, parameters = _material(r, data, model)
+    conditions = _conditions(r, data, dim, law)
+    factors, adaptive = _loading(r, data)
+    s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
+                required=False)
+    newton = r.get(s, "newton", "solver", str, default="full", choices=NEWTON)
+    linear = r.get(s, "linear", "solver", str, default="direct", choices=LINEAR)
+    tolerance = r.get(s, "tolerance", "solver", float, default=1e-9, positive=True)
+    if tolerance is not None and tolerance >= 1:
+        r.fail("solver.tolerance", f"must be < 1 (relative to the force scale), got {tolerance}")
+    max_it = r.get(s, "max_iterations", "solver", int, default=50, minimum=1)
+    if newton == "snes" and any(c.kind == "contact" for c in conditions):
+        r.fail("solver.newton", '"snes" cannot run the contact active-set loop: use full, '
+                                "modified, periodic or quasi-newton")
+    probes = _probes(r, data, dim)
+    if r.problems:
+        raise CaseError(r.problems)
+    equal = isinstance(data.get("loading", {}).get("steps"), int)
+    return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
+                adaptive, equal, newton, linear, tolerance, max_it, probes)
+
+
+def _material(r: _Reader, data: dict, model: str | None):
+    m = data.get("material")
+    if not isinstance(m, dict):
+        r.fail("material", "missing table" if m is None else "must be a table [material]")
+        return None, {}
+    law = r.get(m, "law", "material", str, required=True, choices=tuple(LAWS))
+    if law is None:
+        return None, {}
+    accepted = tuple(f.name for f in fields(LAWS[law]))
+    r.unknown(m, "material", ("law", *accepted))
+    parameters, complete = {}, True
+    for f in fields(LAWS[law]):
+        value = r.get(m, f.name, "material", float, required=f.default is MISSING)
+        if value is not None:
+            parameters[f.name] = value
+        complete &= value is not None or f.default is not MISSING
+    if complete:
+        try:
+            LAWS[law](**parameters)
+        except ValueError as err:  # the law's own range check names the parameter
+            r.fail("material", str(err))
+    if law in ("neo-hookean", "power-law") and model == "plane_stress":
+        r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
+                               f"\"plane_strain\" or another law")
+    return law, parameters
+
+
+def _conditions(r: _Reader, data: dict, dim: int, law: str | None) -> list[Condition]:
+    tables = data.get("boundary", [])
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        r.fail("boundary", "must be [[boundary]] tables")
+        return []
+    if not tables:
+        r.fail("boundary", "no [[boundary]] table: a body needs supports and loads")
+    out = []
+    for i, t in enumerate(tables, start=1):
+        where = f"boundary[{i}]"
+        r.unknown(t, where, ("group", *CONDITIONS, "follower"))
+        group = r.get(t, "group", where, str, required=True)
+        kinds = [k for k in CONDITIONS if k in t]
+        if len(kinds) != 1:
+            r.fail(where, f"needs exactly one of {', '.join(CONDITIONS)}, got "
+                          f"{', '.join(kinds) or 'none'}")
+            continue
+        kind = kinds[0]
+        key = f"{where}.{kind}"
+        follower = r.get(t, "follower", where, bool, default=False)
+        if "follower" in t and kind != "pressure":
+            r.fail(f"{where}.follower", "applies to a pressure only")
+        if follower and law is not None and not LAWS[law].finite_strain:
+            r.fail(f"{where}.follower", f"needs a finite-strain law ({law} is small strain: "
+                                        f"its loads act on the undeformed body)")
+        if kind == "displacement":
+            value = r.vector(t[kind], key, dim, free=True)
+        elif kind == "traction":
+            value = r.vector(t[kind], key, dim)
+        elif kind == "pressure":
+            value = r.get(t, "pressure", where, float)
+        else:
+            value = _obstacle(r, t[kind], key, dim)
+        if group is not None and value is not None:
+            out.append(Condition(group, kind, value, bool(follower), key))
+    contact = [c for c in out if c.kind == "contact"]
+    if len(contact) > 1:
+        r.fail(contact[1].key, "one contact group per case (the active-set loop takes one "
+                               "surface)")
+    return out
+
+
+def _obstacle(r: _Reader, table, key: str, dim: int):
+    if not isinstance(table, dict):
+        r.fail(key, 'must be a table, e.g. { obstacle = "plane", point = [...], normal = [...] }')
+        return None
+    shape = r.get(table, "obstacle", key, str, required=True, choices=tuple(OBSTACLES))
+    if shape is None:
+        return None
+    r.unknown(table, key, ("obstacle", *OBSTACLES[shape], "displacement"))
+    out = {"obstacle": shape, "displacement": [0.0] * dim}
+    for k in (*OBSTACLES[shape], "displacement"):
+        if k == "radius":
+            out[k] = r.get(table, k, key, float, required=True, positive=True)
+        elif k in table:
+            out[k] = r.vector(table[k], f"{key}.{k}", dim)
+        elif k != "displacement":
+            r.fail(f"{key}.{k}", "missing")
+            out[k] = None
+    if shape == "plane" and out.get("normal") is not None and not any(out["normal"]):
+        r.fail(f"{key}.normal", "must not be zero")
+    return None if any(v is None for v in out.values()) else out
+
+
+def _loading(r: _Reader, data: dict):
+    t = r.table(data, "loading", ("steps", "adaptive"))
+    adaptive = r.get(t, "adaptive", "loading", bool, default=True)
+    steps = t.get("steps")
+    if steps is None:
+        if t:
+            r.fail("loading.steps", "missing")
+        return [], adaptive
+    if isinstance(steps, int) and not isinstance(steps, bool):
+        if steps < 1:
+            r.fail("loading.steps", f"must be >= 1, got {steps}")
+            return [], adaptive
+        return [k / steps for k in range(1, steps + 1)], adaptive
+    factors = r.vector(steps, "loading.steps", len(steps)) if isinstance(steps, list) else None
+    if factors is None:
+        if not isinstance(steps, list):
+            r.fail("loading.steps", f"must be an integer or a list of load factors, got "
+                                    f"{steps!r}")
+        return [], adaptive
+    if not factors or any(a == b for a, b in zip([0.0, *factors], factors, strict=False)):
+        r.fail("loading.steps", "load factors must be a non-empty list, each different from "
+                                "the one before (the first from 0)")
+    return factors, adaptive
+
+
+def _probes(r: _Reader, data: dict, dim: int) -> list[Probe]:
+    tables = data.get("probe", [])
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        r.fail("probe", "must be [[probe]] tables")
+        return []
+    out, names = [], set()
+    for i, t in enumerate(tables, start=1):
+        where = f"probe[{i}]"
+        r.unknown(t, where, ("name", "point"))
+        name = r.get(t, "name", where, str, required=True)
+        point = r.vector(t["point"], f"{where}.point", dim) if "point" in t else None
+        if "point" not in t:
+            r.fail(f"{where}.point", "missing")
+        if name in names:
+            r.fail(f"{where}.name", f"{name!r} is used twice")
+        names.add(name)
+        if name is not None and point is not None:
+            out.append(Probe(name, point, f"{where}.point"))
+    return out

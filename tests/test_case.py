@@ -1,0 +1,252 @@
+"""Case files against closed forms, through `python -m fenics_nl` only."""
+
+import math
+from pathlib import Path
+
+import pytest
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+BAR_GEO = """SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 10, 1, 2};
+Physical Surface("x0") = Surface In BoundingBox{-0.1, -0.1, -0.1, 0.1, 1.1, 2.1};
+Physical Surface("end") = Surface In BoundingBox{9.9, -0.1, -0.1, 10.1, 1.1, 2.1};
+Physical Surface("y0") = Surface In BoundingBox{-0.1, -0.1, -0.1, 10.1, 0.1, 2.1};
+Physical Surface("z0") = Surface In BoundingBox{-0.1, -0.1, -0.1, 10.1, 1.1, 0.1};
+Physical Volume("bar") = {1};
+Mesh.MeshSizeMax = 0.5;
+"""
+
+BAR = """[mesh]
+file = "bar.geo"
+model = "3d"
+
+[material]
+law = "linear-elastic"
+E = 1000.0
+nu = 0.25
+
+[[boundary]]
+group = "x0"
+displacement = [0.0, "free", "free"]
+
+[[boundary]]
+group = "y0"
+displacement = ["free", 0.0, "free"]
+
+[[boundary]]
+group = "z0"
+displacement = ["free", "free", 0.0]
+
+[[boundary]]
+group = "end"
+traction = [50.0, 0.0, 0.0]
+
+[loading]
+steps = 2
+
+[[probe]]
+name = "corner"
+point = [10.0, 1.0, 2.0]
+"""
+
+
+def write(tmp_path, name, text):
+    (tmp_path / name).write_text(text)
+    return tmp_path / name
+
+
+def test_bar_in_tension_is_exact(tmp_path, demo):
+    # σ = 50 on the end: u = (σx/E, −νσy/E, −νσz/E), linear, so P1 is exact
+    write(tmp_path, "bar.geo", BAR_GEO)
+    d = demo.case(write(tmp_path, "bar.toml", BAR))
+    ux, uy, uz = d["probes"]["corner"]["displacement"]
+    assert [ux, uy, uz] == pytest.approx([0.5, -0.0125, -0.025], rel=1e-9)
+    assert d["probes"]["corner"]["von_mises"] == pytest.approx(50.0, rel=1e-9)
+    # half the load at the first of the two steps
+    assert d["steps"][0]["probes"]["corner"]["displacement"][0] == pytest.approx(0.25, rel=1e-9)
+    # the supports balance the applied force σ A = 100 to round-off
+    total = [sum(r[i] for r in d["reactions"].values()) for i in range(3)]
+    assert total == pytest.approx([-100.0, 0.0, 0.0], abs=1e-9 * 100)
+
+
+def lame(r, a=10.0, b=20.0, p=100.0, E=210000.0, nu=0.3):
+    """Radial displacement of a thick cylinder under internal pressure (plane strain)."""
+    A, B = p * a * a / (b * b - a * a), p * a * a * b * b / (b * b - a * a)
+    return (1 + nu) / E * ((1 - 2 * nu) * A * r + B / r)
+
+
+def test_thick_cylinder_plane_strain_matches_lame(demo):
+    d = demo.case(CASES / "thick_cylinder.toml")
+    # P2 on curved (quadratic) edges, h = 1.5 mm: measured 6e-5 and 9e-6 relative
+    assert d["probes"]["inner"]["displacement"][0] == pytest.approx(lame(10.0), rel=3e-4)
+    assert d["probes"]["outer"]["displacement"][0] == pytest.approx(lame(20.0), rel=3e-4)
+    # the quarter's symmetry planes carry the pressure's resultant p a = 1000 N/mm
+    assert d["reactions"]["symmetry_x"][0] == pytest.approx(-1000.0, rel=1e-9)
+    assert d["reactions"]["symmetry_y"][1] == pytest.approx(-1000.0, rel=1e-9)
+
+
+AXI_GEO = """a = 10; b = 20; H = 4; h = 1;
+Point(1) = {a, 0, 0, h}; Point(2) = {b, 0, 0, h}; Point(3) = {b, H, 0, h}; Point(4) = {a, H, 0, h};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Physical Curve("bottom") = {1}; Physical Curve("outer") = {2};
+Physical Curve("top") = {3}; Physical Curve("inner") = {4};
+Physical Surface("wall") = {1};
+"""
+
+AXI = """[mesh]
+file = "ring.geo"
+model = "axisymmetric"
+degree = 2
+
+[material]
+law = "linear-elastic"
+E = 210000.0
+nu = 0.3
+
+[[boundary]]
+group = "bottom"
+displacement = ["free", 0.0]
+
+[[boundary]]
+group = "top"
+displacement = ["free", 0.0]
+
+[[boundary]]
+group = "inner"
+pressure = 100.0
+
+[loading]
+steps = 1
+
+[[probe]]
+name = "inner"
+point = [10.0, 2.0]
+
+[[probe]]
+name = "outer"
+point = [20.0, 2.0]
+"""
+
+
+def test_thick_cylinder_axisymmetric_matches_lame(tmp_path, demo):
+    # ends held axially: plane strain, the same u_r(r) as the 2D case
+    write(tmp_path, "ring.geo", AXI_GEO)
+    d = demo.case(write(tmp_path, "ring.toml", AXI))
+    assert d["probes"]["inner"]["displacement"][0] == pytest.approx(lame(10.0), rel=3e-4)
+    assert d["probes"]["outer"]["displacement"][0] == pytest.approx(lame(20.0), rel=3e-4)
+    # each end holds σ_zz = 2νA over π(b² − a²): 2ν p a² π, whole revolution
+    axial = 2 * 0.3 * 100.0 * 100.0 * math.pi
+    assert d["reactions"]["top"][1] == pytest.approx(axial, rel=1e-3)
+    assert d["reactions"]["bottom"][1] == pytest.approx(-axial, rel=1e-3)
+
+
+PUNCH = """[mesh]
+file = "block.msh"
+model = "axisymmetric"
+
+[material]
+law = "linear-elastic"
+E = 1.0
+nu = 0.3
+
+[[boundary]]
+group = "symmetry_x"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "bottom"
+displacement = ["free", 0.0]
+
+[[boundary]]
+group = "contact"
+contact = { obstacle = "sphere", center = [0.0, 1.0], radius = 1.0, displacement = [0.0, -0.01] }
+
+[loading]
+steps = 1
+"""
+
+
+def test_hertz_punch_as_a_case_equals_the_demo(tmp_path, demo):
+    # the demo's mesh (axisymmetric, --refine 0: h = a/20, 1000 a wide, 5 % growth), written
+    # to a .msh by the same gmsh code, and the sphere pressed by δ = 0.01 R
+    from mpi4py import MPI
+
+    from fenics_nl.domain.meshes import graded_block
+
+    a = 0.1
+    graded_block(MPI.COMM_WORLD, 2, 1000 * a, 1000 * a, a / 20, 1.5 * a, 0.05,
+                 msh_file=tmp_path / "block.msh")
+    case = demo.case(write(tmp_path, "punch.toml", PUNCH))
+    ref = demo.punch("--refine", "0", "--gap", "sphere")
+    assert case["dofs"] == ref["dofs"]
+    assert case["contact_force"] == pytest.approx(ref["force"], rel=1e-8)
+    assert case["steps"][-1]["nodes_in_contact"] == ref["nodes_in_contact"]
+    # the supports balance the contact force, which the contact group's reaction is
+    r = case["reactions"]
+    assert r["contact"][1] == pytest.approx(-case["contact_force"], rel=1e-8)
+    assert r["symmetry_x"][1] + r["bottom"][1] == pytest.approx(case["contact_force"], rel=1e-8)
+
+
+@pytest.mark.parametrize("path", sorted(CASES.glob("*.toml")), ids=lambda p: p.stem)
+def test_every_shipped_case_checks(demo, path):
+    proc = demo.run(["-m fenics_nl", "check", path])
+    assert "the case is complete" in proc.stdout
+
+
+def test_two_ranks_give_the_serial_answer(demo):
+    s = demo.case(CASES / "thick_cylinder.toml")
+    p = demo.case(CASES / "thick_cylinder.toml", ranks=2)
+    assert p["ranks"] == 2
+    for name in ("inner", "outer"):
+        assert p["probes"][name]["displacement"] == pytest.approx(
+            s["probes"][name]["displacement"], rel=1e-9, abs=1e-15)
+    assert p["reactions"]["symmetry_x"] == pytest.approx(s["reactions"]["symmetry_x"],
+                                                         rel=1e-9, abs=1e-9)
+
+
+def check(demo, tmp_path, text, geo=None):
+    if geo is not None:
+        write(tmp_path, "part.geo", geo)
+    proc = demo.run(["-m fenics_nl", "check", write(tmp_path, "bad.toml", text)], check=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    return proc.stderr.strip().splitlines()
+
+
+def test_every_mistake_of_a_file_at_once(tmp_path, demo):
+    text = BAR.replace('file = "bar.geo"', 'file = "bar.geo"\nsise = 2.0')
+    text = text.replace("nu = 0.25", "nu = 0.7").replace("[50.0, 0.0, 0.0]", "[50.0, 0.0]")
+    text = text.replace("steps = 2", "step = 2").replace('law = "linear-elastic"',
+                                                         'law = "linear-elastic"\nsigma0 = 1.0')
+    write(tmp_path, "bar.geo", BAR_GEO)
+    lines = check(demo, tmp_path, text)
+    expected = ["mesh.sise: unknown key", "nu must be in (-1, 0.5), got 0.7",
+                "material.sigma0: unknown key", "boundary[4].traction: must be a list of 3",
+                "loading.step: unknown key", "loading.steps: missing"]
+    for e in expected:
+        assert sum(e in line for line in lines) == 1, (e, lines)
+    assert len(lines) == len(expected)
+
+
+def test_a_2d_model_on_a_3d_mesh_is_one_line(tmp_path, demo):
+    write(tmp_path, "bar.geo", BAR_GEO)
+    text = """[mesh]\nfile = "bar.geo"\nmodel = "plane_strain"\n[material]\nlaw = "linear-elastic"
+E = 1.0\nnu = 0.3\n[[boundary]]\ngroup = "end"\npressure = 1.0\n[loading]\nsteps = 1\n"""
+    lines = check(demo, tmp_path, text)
+    assert lines == ["error: mesh.model: 'plane_strain' needs a 2D mesh, bar.geo has 3D cells"]
+
+
+@pytest.mark.parametrize("change,message", [
+    (('group = "end"', 'group = "tip"'), "'tip' is not a boundary group of the mesh (it has: "
+                                         "end, x0, y0, z0)"),
+    (("point = [10.0, 1.0, 2.0]", "point = [10.0, 1.0, 2.5]"), "probe[1].point: [10.0, 1.0, "
+                                                                "2.5] is outside the mesh"),
+    (('file = "bar.geo"', 'file = "broken.geo"'), "mesh.file: gmsh cannot mesh broken.geo"),
+    (('file = "bar.geo"', 'file = "nowhere.msh"'), "nowhere.msh not found"),
+])
+def test_a_mistake_against_the_mesh_is_one_line(tmp_path, demo, change, message):
+    write(tmp_path, "bar.geo", BAR_GEO)
+    write(tmp_path, "broken.geo", "Point(1) = {0, 0, 0;\n")
+    lines = check(demo, tmp_path, BAR.replace(*change))
+    assert len(lines) == 1 and message in lines[0], lines
