@@ -47,66 +47,135 @@ from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket, BracketPart
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import stalled_at_round_off
 
+if __name__ == "__main__":  # `python demos/bracket.py [options]`: the cells below, run by
+    sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
+
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
 MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit
 DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README table)
 # -
 
+# ### Parameters
+#
+# From the command line (`python demos/bracket.py --help`); in a notebook, the defaults.
+# PETSc options take the prefix `-bracket_` (Newton's KSP), `-bracket_snes_` or
+# `-bracket_elim_` (the floor contact).
 
-def run(args):
-    out = compare(args) if args.compare else None
-    if out is None:
-        b, steps, wall = run_variant(args, args.newton)
-        out, vm = summary(b, steps, wall, args)
-        u = args.units
-        strain = (f" (ε_eq ≈ {out['max_eps_eq_over_eps0']:.3g} ε0)"
-                  if "max_eps_eq_over_eps0" in out else "")
-        say(f"|u_load| = {out['load_point_displacement']:.6g} {u}, max σ_eq = "
-            f"{out['max_von_mises']:.4g} N/{u}²{strain}, {out['newton_iterations']} Newton "
-            f"iterations, {out['factorizations']} factorizations, {b.dofs} unknowns"
-            + (f", lifted-off area {out['lifted_off_area']:.4g} {u}²"
-               if "lifted_off_area" in out else ""))
-        return out, writers(b, vm, steps, args)
-    return out, []
+# +
+def parser():
+    """Every parameter of the scene, with its unit and default."""
+    p = cli.parser(
+        "3D L-bracket in a power-law material, Newton variants side by side. Lengths in "
+        "--units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa).",
+        epilog="PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
+               "(--newton snes) or -bracket_elim_ (--support contact), e.g. "
+               "-bracket_ksp_view. An option no solver reads is an error.")
+    p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
+                   help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
+    p.add_argument("--newton", choices=VARIANTS, default=None,
+                   help="non-linear solver (default full)")
+    p.add_argument("--compare", action="store_true",
+                   help="run every variant on the same mesh and print one table")
+    p.add_argument("--force", type=cli.positive, default=8e3,
+                   help="total load on the arm's hole [N]")
+    p.add_argument("--steps", type=cli.at_least(1), default=4, help="equal load steps")
+    p.add_argument("--tolerance", type=cli.finite, default=1e-9,
+                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
+    p.add_argument("--units", choices=list(MM), default="mm",
+                   help="length unit of the geometry, --size and the results")
+    p.add_argument("--size", type=cli.positive, default=None,
+                   help=f"largest element size (default {DEFAULT_SIZE_MM:g} mm), at most "
+                        f"twice the {THICKNESS_MM:g} mm plate thickness")
+    p.add_argument("--degree", type=int, choices=[1, 2], default=2,
+                   help="Lagrange degree (P1 is far too stiff here: see the README)")
+    p.add_argument("--mesh", metavar="MSH",
+                   help="a .msh file with groups bolts, load, base (in --units; not with --size)")
+    p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
+                   help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
+    p.add_argument("--material", choices=["power-law", "linear"], default="power-law",
+                   help="the power law below, or linear elasticity (E, nu): one Newton "
+                        "iteration per load step")
+    p.add_argument("--E", type=cli.positive, default=None,
+                   help="Young's modulus (default 200 GPa, in N/unit²)")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--sigma0", type=cli.positive, default=None,
+                   help="power law: reference stress (default 200 MPa, in N/unit²)")
+    p.add_argument("--n", type=cli.positive, default=None,
+                   help="power law exponent [-] (default 0.2)")
+    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
+                              "floor pressure and active set",
+                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
+                    plot="load against load-point displacement")
+    return p
 
 
-def run_variant(args, newton):
+p = parser()
+args = cli.arguments(p, prefixes={
+    "bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"})
+if args.compare and args.newton:
+    p.error("--compare runs every Newton variant: drop --newton")
+args.newton = args.newton or "full"
+if args.compare and (args.png or args.plot or args.output):
+    p.error("--compare prints a table of the variants: --png, --plot and --output "
+            "go with one --newton")
+if args.mesh and args.size is not None:
+    p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
+mm = MM[args.units]
+args.E = args.E if args.E is not None else 200e3 / mm**2
+cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
+if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
+    p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
+            f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
+
+
+# -
+
+# ### The part
+#
+# The gmsh geometry (or the user's .msh) with its physical groups: the bolt holes are
+# clamped, the loaded hole carries a uniform traction of total force F along +x.
+
+# +
+mm = MM[args.units]
+size_mm = args.size / mm if args.size is not None else DEFAULT_SIZE_MM
+say("reading " + args.mesh if args.mesh else f"meshing the bracket (size {size_mm:g} mm) ...")
+part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
+                   degree=args.degree, length_scale=1.0 if args.mesh else mm)
+# -
+
+# ### The material
+#
+# The power law's energy $\varphi(\varepsilon)$ (or Hooke's); $\sigma$ and the tangent are
+# its derivatives, taken by UFL.
+
+material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
+            if args.material == "power-law" else LinearElastic(args.E, args.nu))
+
+# ### The residual
+#
+# $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,dx -
+# \int_{S_{load}} t \cdot v\,ds$, the traction $t$ scaled by the load factor.
+
+# +
+u, v = part.u, ufl.TestFunction(part.V)
+eps = kinematics.small_strain
+residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
+            - ufl.dot(part.traction, v) * part.ds_load)
+# -
+
+# ### The solver and the load steps
+#
+# `Bracket` builds the chosen Newton variant (`fenics_nl.solvers.newton.NewtonSolver`: full,
+# modified, periodic, quasi-Newton; or PETSc SNES) on this residual, inside the active-set
+# loop when the base rests on the floor; its absolute tolerance is `--tolerance` times the
+# load. Equal load steps, each from the last converged state. With `--compare`, every
+# variant runs on the same mesh from u = 0.
+
+# +
+def solve(newton):
     """Load steps with one Newton variant; returns the bracket and a record per step."""
-    # ### The part
-    #
-    # The gmsh geometry (or the user's .msh) with its physical groups: the bolt holes are
-    # clamped, the loaded hole carries a uniform traction of total force F along +x.
-    mm = MM[args.units]
-    size_mm = args.size / mm if args.size is not None else DEFAULT_SIZE_MM
-    say("reading " + args.mesh if args.mesh else f"meshing the bracket (size {size_mm:g} mm) ...")
-    part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
-                       degree=args.degree, length_scale=1.0 if args.mesh else mm)
-
-    # ### The material
-    #
-    # The power law's energy $\varphi(\varepsilon)$ (or Hooke's); $\sigma$ and the
-    # tangent are its derivatives, taken by UFL.
-    material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
-                if args.material == "power-law" else LinearElastic(args.E, args.nu))
-
-    # ### The residual
-    #
-    # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,dx -
-    # \int_{S_{load}} t \cdot v\,ds$, the traction $t$ scaled by the load factor.
-    # +
-    u, v = part.u, ufl.TestFunction(part.V)
-    eps = kinematics.small_strain
-    residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
-                - ufl.dot(part.traction, v) * part.ds_load)
-    # -
-
-    # ### The solver
-    #
-    # `Bracket` builds the chosen Newton variant (`fenics_nl.solvers.newton.NewtonSolver`: full,
-    # modified, periodic, quasi-Newton; or PETSc SNES) on this residual, inside the
-    # active-set loop when the base rests on the floor. Its absolute tolerance is
-    # `--tolerance` times the load.
+    u.x.array[:] = 0.0
     b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
                 tolerance=args.tolerance,
                 linear_solver="lu" if args.solver == "direct" else "gamg")
@@ -128,10 +197,6 @@ def run_variant(args, newton):
             f"{r.iterations} Newton iterations{sets}, |u_load| = "
             f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
 
-    # ### Load steps
-    #
-    # Equal steps, each from the last converged state (no predictor, no step control).
-    # +
     t0 = time.perf_counter()
     try:
         solve_incrementally(b.solver, lambda t: b.set_load(t * args.force), args.steps,
@@ -146,6 +211,33 @@ def run_variant(args, newton):
     # -
     wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     return b, steps, wall
+
+
+variants = [n for n in VARIANTS if not (n == "snes" and args.support == "contact")]
+if args.compare and args.support == "contact":
+    say("  (snes skipped: the floor contact runs the hand-written active-set loop)")
+runs = {n: solve(n) for n in (variants if args.compare else [args.newton])}
+# -
+
+# ### Equilibrium
+#
+# There is no closed form for this part (its |u_load| is checked by mesh convergence in the
+# README); what must hold is equilibrium: the bolts (and the floor) hold the load,
+# $\sum R = (-F, 0, 0)$ to the solver's tolerance.
+
+# +
+b, steps, wall = runs[args.newton if not args.compare else "full"]
+reactions = b.reactions()
+held = [sum(r[i] for r in reactions.values()) for i in range(3)]
+say(f"supports hold ({', '.join(f'{x:.6g}' for x in held)}) N against the load "
+    f"({args.force:.6g}, 0, 0) N: imbalance {abs(held[0] + args.force) / args.force:.1e} F")
+# -
+
+# ## Outputs
+#
+# The JSON (the load-point displacement, the largest σ_eq and the strain it means, the
+# work counts; with `--compare` one table of the variants) and, when asked, the fields for
+# ParaView, the load-displacement curve and the picture.
 
 
 def summary(b, steps, wall, args):
@@ -201,15 +293,10 @@ def _strain_ratio(s, n):
     return brentq(lambda x: x * (1 + x * x) ** ((n - 1) / 2) - s, 0.0, 1e9) if s > 0 else 0.0
 
 
-def compare(args):
-    """Every variant on the same mesh: one table, and their answers side by side."""
-    rows = {}
-    for newton in VARIANTS:
-        if newton == "snes" and args.support == "contact":
-            say("  (snes skipped: the floor contact runs the hand-written active-set loop)")
-            continue
-        b, steps, wall = run_variant(args, newton)
-        rows[newton], _ = summary(b, steps, wall, args)
+
+def compare():
+    """Every variant's summary and one table of them."""
+    rows = {n: summary(*r, args)[0] for n, r in runs.items()}
     ref = rows["full"]["load_point_displacement"]
     say(f"\n| Newton | iterations per step | factorizations | tangent assemblies | "
         f"time (s) | |u_load| ({args.units}) | rel. diff. to full |\n|---|---|---|---|---|---|---|")
@@ -261,75 +348,16 @@ def picture(b, vm, args):
     say(f"wrote {args.png}")
 
 
-# ## The command line
 
-def parse_args(argv=None):
-    p = cli.parser(
-        "3D L-bracket in a power-law material, Newton variants side by side. Lengths in "
-        "--units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa).",
-        epilog="PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
-               "(--newton snes) or -bracket_elim_ (--support contact), e.g. "
-               "-bracket_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
-                   help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
-    p.add_argument("--newton", choices=VARIANTS, default=None,
-                   help="non-linear solver (default full)")
-    p.add_argument("--compare", action="store_true",
-                   help="run every variant on the same mesh and print one table")
-    p.add_argument("--force", type=cli.positive, default=8e3,
-                   help="total load on the arm's hole [N]")
-    p.add_argument("--steps", type=cli.at_least(1), default=4, help="equal load steps")
-    p.add_argument("--tolerance", type=cli.finite, default=1e-9,
-                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
-    p.add_argument("--units", choices=list(MM), default="mm",
-                   help="length unit of the geometry, --size and the results")
-    p.add_argument("--size", type=cli.positive, default=None,
-                   help=f"largest element size (default {DEFAULT_SIZE_MM:g} mm), at most "
-                        f"twice the {THICKNESS_MM:g} mm plate thickness")
-    p.add_argument("--degree", type=int, choices=[1, 2], default=2,
-                   help="Lagrange degree (P1 is far too stiff here: see the README)")
-    p.add_argument("--mesh", metavar="MSH",
-                   help="a .msh file with groups bolts, load, base (in --units; not with --size)")
-    p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
-                   help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
-    p.add_argument("--material", choices=["power-law", "linear"], default="power-law",
-                   help="the power law below, or linear elasticity (E, nu): one Newton "
-                        "iteration per load step")
-    p.add_argument("--E", type=cli.positive, default=None,
-                   help="Young's modulus (default 200 GPa, in N/unit²)")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--sigma0", type=cli.positive, default=None,
-                   help="power law: reference stress (default 200 MPa, in N/unit²)")
-    p.add_argument("--n", type=cli.positive, default=None,
-                   help="power law exponent [-] (default 0.2)")
-    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
-                              "floor pressure and active set",
-                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
-                    plot="load against load-point displacement")
-    args, petsc_args = cli.parse_with_petsc_options(p, argv)
-    if args.compare and args.newton:
-        p.error("--compare runs every Newton variant: drop --newton")
-    args.newton = args.newton or "full"
-    if args.compare and (args.png or args.plot or args.output):
-        p.error("--compare prints a table of the variants: --png, --plot and --output "
-                "go with one --newton")
-    if args.mesh and args.size is not None:
-        p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
-    mm = MM[args.units]
-    args.E = args.E if args.E is not None else 200e3 / mm**2
-    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
-    if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
-        p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
-                f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
-    return args, petsc_args
-
-
-def main(argv=None) -> int:
-    args, petsc_args = parse_args(argv)
-    prefixes = {"bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"}
-    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
-                         prefixes=prefixes)
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+if args.compare:
+    cli.results(compare())
+else:
+    out, vm = summary(b, steps, wall, args)
+    strain = (f" (ε_eq ≈ {out['max_eps_eq_over_eps0']:.3g} ε0)"
+              if "max_eps_eq_over_eps0" in out else "")
+    lifted = (f", lifted-off area {out['lifted_off_area']:.4g} {args.units}²"
+              if "lifted_off_area" in out else "")
+    say(f"|u_load| = {out['load_point_displacement']:.6g} {args.units}, max σ_eq = "
+        f"{out['max_von_mises']:.4g} N/{args.units}²{strain}, {out['newton_iterations']} Newton "
+        f"iterations, {out['factorizations']} factorizations, {b.dofs} unknowns{lifted}")
+    cli.results(out, writers(b, vm, steps, args))

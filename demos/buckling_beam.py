@@ -46,10 +46,114 @@ from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
 
+if __name__ == "__main__":  # `python demos/buckling_beam.py [options]`: the cells below,
+    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
+
 comm = MPI.COMM_WORLD
 # -
 
+# ### Parameters
+#
+# From the command line (`python demos/buckling_beam.py --help`); in a notebook, the
+# defaults. PETSc options take the prefix `-beam_` (`-beam_full_ksp_view`, ...).
 
+# +
+def parser():
+    """Every parameter of the scene, with its unit and default."""
+    p = cli.parser(
+        "Buckling of a compressed cantilever: SLEPc critical load and the post-buckling path "
+        "against the elastica. Units are the user's, consistent (e.g. N, m, Pa).",
+        epilog="PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
+               "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
+               "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
+               "the pre-stress). An option no solver reads is an error.")
+    p.add_argument("--length", type=cli.positive, default=1.0, help="beam length L [length]")
+    p.add_argument("--thickness", type=cli.positive, default=0.02,
+                   help="beam height h [length]")
+    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--plane", choices=["stress", "strain"], default="stress",
+                   help="plane stress or plane strain (unit width)")
+    p.add_argument("--material", choices=["svk", "neo-hookean"], default="svk",
+                   help="St Venant-Kirchhoff or compressible neo-Hookean (plane strain)")
+    p.add_argument("--load-ratio", type=cli.positive, default=1.5,
+                   help="final load P / P_cr (Euler), at most 20")
+    p.add_argument("--steps", type=cli.at_least(1), default=40,
+                   help="equal load steps to the final load (a failed step is cut in half)")
+    p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"], default="full",
+                   help="Newton variant of each load step")
+    p.add_argument("--imperfection", type=cli.finite, default=1e-4,
+                   help="lateral end load as a fraction of P [-], in [0, 0.1)")
+    p.add_argument("--refine", type=cli.at_least(0), default=0,
+                   help="mesh: 2·2^refine Q2 elements through the height, square elements")
+    cli.add_outputs(p, output="the final displacement",
+                    png="deformed shapes along the path, with the elastica's",
+                    plot="P/P_cr against tip rotation and deflection")
+    return p
+
+
+p = parser()
+args = cli.arguments(p, prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
+if args.load_ratio > 20:
+    p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")
+if not 0 <= args.imperfection < 0.1:
+    p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
+if args.material == "neo-hookean" and args.plane == "stress":
+    p.error("neo-hookean is implemented in plane strain only (--plane strain)")
+
+
+# -
+
+# ### The cantilever
+#
+# Q2 quadrilaterals (square, 2·2^refine through the height), clamped at $x = 0$, a dead
+# traction $(-P, \varepsilon P)/h$ on the end face.
+
+cantilever = Cantilever(args.length, args.thickness, plane=args.plane,
+                        refine=args.refine, imperfection=args.imperfection)
+
+# ### The material
+#
+# A free energy of the Green–Lagrange strain $e = (F^TF - I)/2$; the second
+# Piola–Kirchhoff stress $S = \partial\varphi/\partial e$ is derived by UFL.
+
+material = MATERIALS[args.material](args.E, args.nu)
+
+# ### The residual
+#
+# Total Lagrangian: $R(u; v) = \int_{\Omega_0} P(u) : \nabla v\,d\Omega_0 -
+# \int_{end} t \cdot v\,dS_0$ with $P = F S$ the first Piola–Kirchhoff stress and $t$
+# the dead traction.
+
+# +
+u, v = cantilever.u, ufl.TestFunction(cantilever.V)
+grad_v = kinematics.displacement_gradient(v, cantilever.model)
+residual = (ufl.inner(material.first_piola(u, cantilever.model), grad_v) * cantilever.dx
+            - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
+# -
+beam = Beam(cantilever, material, residual)
+say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
+    f"{args.material}, plane {args.plane}")
+
+# ### Linear buckling (SLEPc) against Euler
+#
+# $(K + \lambda K_G)\varphi = 0$ around the straight state: $K$ is the residual's tangent at
+# $u = 0$ (Hooke's law: the small-strain limit of the energy), $K_G$ the geometric stiffness of
+# the pre-stress of a unit load (`Beam.critical_loads`, SLEPc shift-and-invert).
+
+# +
+loads, _ = beam.critical_loads(3)
+P_cr = loads[0]
+say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
+    f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
+# -
+
+# ### The post-buckling path
+#
+# Load steps to $r P_{Euler}$ (never larger than $1/n$ of it, cut on failure), then the
+# stability check of the end state and, if needed, branch switching (`Beam.solve_path`).
+
+# +
 def progress(steps):
     """Show about ten of the path's step lines, and every cut or branch switch."""
     every = max(1, steps // 10)
@@ -64,117 +168,6 @@ def progress(steps):
     return show
 
 
-def run(args):
-    # ### The cantilever
-    #
-    # Q2 quadrilaterals (square, 2·2^refine through the height), clamped at $x = 0$, a dead
-    # traction $(-P, \varepsilon P)/h$ on the end face.
-    cantilever = Cantilever(args.length, args.thickness, plane=args.plane,
-                            refine=args.refine, imperfection=args.imperfection)
-
-    # ### The material
-    #
-    # A free energy of the Green–Lagrange strain $e = (F^TF - I)/2$; the second
-    # Piola–Kirchhoff stress $S = \partial\varphi/\partial e$ is derived by UFL.
-    material = MATERIALS[args.material](args.E, args.nu)
-
-    # ### The residual
-    #
-    # Total Lagrangian: $R(u; v) = \int_{\Omega_0} P(u) : \nabla v\,d\Omega_0 -
-    # \int_{end} t \cdot v\,dS_0$ with $P = F S$ the first Piola–Kirchhoff stress and $t$
-    # the dead traction.
-    # +
-    u, v = cantilever.u, ufl.TestFunction(cantilever.V)
-    grad_v = kinematics.displacement_gradient(v, cantilever.model)
-    residual = (ufl.inner(material.first_piola(u, cantilever.model), grad_v) * cantilever.dx
-                - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
-    # -
-    beam = Beam(cantilever, material, residual)
-    say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
-        f"{args.material}, plane {args.plane}")
-
-    # ### Linear buckling (SLEPc) against Euler
-    #
-    # $(K + \lambda K_G)\varphi = 0$ around the straight state pre-stressed by a unit load.
-    # +
-    loads, _ = beam.critical_loads(3)
-    P_cr = loads[0]
-    say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
-        f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
-    # -
-
-    # ### The post-buckling path
-    #
-    # Post-buckling path: load steps to r·P_Euler (never larger than 1/n, cut on failure),
-    # then the stability check of the end state and, if needed, branch switching.
-    # +
-    history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
-
-    def record(t, result):
-        r = t * args.load_ratio
-        # a redone path, or the branch-switched end state, replaces what it passes again
-        while len(history) > 1 and history[-1][0] >= r:
-            history.pop()
-        while shapes and shapes[-1][0] >= r:
-            shapes.pop()
-        tip = beam.tip()
-        history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
-                        tip["axial"]))
-        if args.png:
-            shapes.append((r, centreline(beam)))
-
-    say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
-    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                     on_step=record, progress=progress(args.steps))
-    redone = [] if beam.path_steps == args.steps else [
-        f"the {args.steps}-step path ended on the straight (unstable) branch; it was redone "
-        f"with {beam.path_steps} steps"]
-    # -
-
-    # ### Against the elastica
-    #
-    # Tip rotation, lateral deflection and axial displacement at the last load.
-    # +
-    tip = beam.tip()
-    alpha = math.degrees(abs(tip["rotation"]))
-    alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
-    d_el, x_el = elastica.tip_position(args.load_ratio)
-    say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
-        f"{alpha_el:.3f}), lateral deflection {abs(tip['lateral']):.5g} (elastica "
-        f"{d_el * args.length:.5g}), axial displacement {tip['axial']:.5g} (elastica "
-        f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
-        f"{path.iterations} Newton iterations, {path.failures} step cuts")
-    out = {
-        "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
-        "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
-        "tip_rotation_deg": alpha, "tip_deflection": abs(tip["lateral"]),
-        "tip_axial_displacement": tip["axial"], "elastica_tip_rotation_deg": alpha_el,
-        "elastica_tip_deflection": d_el * args.length,
-        "elastica_tip_axial_displacement": (x_el - 1) * args.length,
-        "load_steps": len(path.factors), "step_cuts": path.failures,
-        "newton_iterations": sum(r.iterations for r in path.results),
-        "factorizations": path.work.factorizations, "branch_switched": switched,
-        "newton": args.newton, "reactions": beam.reactions(),
-        "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
-        "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
-                 for h in history],
-        "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
-                     "by O((h/L)²)", *redone],
-    }
-    # -
-    writers = []
-    if args.output:
-        def fields():
-            paths = output.write_fields(args.output, [beam.u])
-            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-        writers.append(fields)
-    if args.plot:
-        writers.append(lambda: plot(history, args))
-    if args.png:
-        writers.append(lambda: picture(shapes, args))
-    return out, writers
-
-
 def centreline(beam):
     """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
     X = beam.V.tabulate_dof_coordinates()
@@ -185,6 +178,70 @@ def centreline(beam):
         return None
     x0, pts = rows
     return pts[np.argsort(x0)]
+
+
+history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
+
+
+def record(t, result):
+    r = t * args.load_ratio
+    # a redone path, or the branch-switched end state, replaces what it passes again
+    while len(history) > 1 and history[-1][0] >= r:
+        history.pop()
+    while shapes and shapes[-1][0] >= r:
+        shapes.pop()
+    tip = beam.tip()
+    history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
+                    tip["axial"]))
+    if args.png:
+        shapes.append((r, centreline(beam)))
+
+
+say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
+path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
+                                 on_step=record, progress=progress(args.steps))
+redone = [] if beam.path_steps == args.steps else [
+    f"the {args.steps}-step path ended on the straight (unstable) branch; it was redone "
+    f"with {beam.path_steps} steps"]
+# -
+
+# ### Against the elastica
+#
+# Tip rotation, lateral deflection and axial displacement at the last load.
+
+# +
+tip = beam.tip()
+alpha = math.degrees(abs(tip["rotation"]))
+alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
+d_el, x_el = elastica.tip_position(args.load_ratio)
+say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
+    f"{alpha_el:.3f}), lateral deflection {abs(tip['lateral']):.5g} (elastica "
+    f"{d_el * args.length:.5g}), axial displacement {tip['axial']:.5g} (elastica "
+    f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
+    f"{path.iterations} Newton iterations, {path.failures} step cuts")
+out = {
+    "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
+    "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
+    "tip_rotation_deg": alpha, "tip_deflection": abs(tip["lateral"]),
+    "tip_axial_displacement": tip["axial"], "elastica_tip_rotation_deg": alpha_el,
+    "elastica_tip_deflection": d_el * args.length,
+    "elastica_tip_axial_displacement": (x_el - 1) * args.length,
+    "load_steps": len(path.factors), "step_cuts": path.failures,
+    "newton_iterations": sum(r.iterations for r in path.results),
+    "factorizations": path.work.factorizations, "branch_switched": switched,
+    "newton": args.newton, "reactions": beam.reactions(),
+    "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
+    "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
+             for h in history],
+    "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
+                 "by O((h/L)²)", *redone],
+}
+# -
+
+# ## Outputs
+#
+# The JSON (above), and when asked the final displacement for ParaView, the load path
+# against the elastica and the deformed shapes.
 
 
 def plot(history, args):
@@ -260,53 +317,14 @@ def picture(shapes, args):
     pictures.save_figure(fig, args.png)
 
 
-# ## The command line
-
-def parse_args(argv=None):
-    p = cli.parser(
-        "Buckling of a compressed cantilever: SLEPc critical load and the post-buckling path "
-        "against the elastica. Units are the user's, consistent (e.g. N, m, Pa).",
-        epilog="PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
-               "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
-               "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
-               "the pre-stress). An option no solver reads is an error.")
-    p.add_argument("--length", type=cli.positive, default=1.0, help="beam length L [length]")
-    p.add_argument("--thickness", type=cli.positive, default=0.02,
-                   help="beam height h [length]")
-    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--plane", choices=["stress", "strain"], default="stress",
-                   help="plane stress or plane strain (unit width)")
-    p.add_argument("--material", choices=["svk", "neo-hookean"], default="svk",
-                   help="St Venant-Kirchhoff or compressible neo-Hookean (plane strain)")
-    p.add_argument("--load-ratio", type=cli.positive, default=1.5,
-                   help="final load P / P_cr (Euler), at most 20")
-    p.add_argument("--steps", type=cli.at_least(1), default=40,
-                   help="equal load steps to the final load (a failed step is cut in half)")
-    p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"], default="full",
-                   help="Newton variant of each load step")
-    p.add_argument("--imperfection", type=cli.finite, default=1e-4,
-                   help="lateral end load as a fraction of P [-], in [0, 0.1)")
-    p.add_argument("--refine", type=cli.at_least(0), default=0,
-                   help="mesh: 2·2^refine Q2 elements through the height, square elements")
-    cli.add_outputs(p, output="the final displacement",
-                    png="deformed shapes along the path, with the elastica's",
-                    plot="P/P_cr against tip rotation and deflection")
-    args, petsc_args = cli.parse_with_petsc_options(p, argv)
-    if args.load_ratio > 20:
-        p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")
-    if not 0 <= args.imperfection < 0.1:
-        p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
-    if args.material == "neo-hookean" and args.plane == "stress":
-        p.error("neo-hookean is implemented in plane strain only (--plane strain)")
-    return args, petsc_args
-
-
-def main(argv=None) -> int:
-    args, petsc_args = parse_args(argv)
-    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
-                         prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+writers = []
+if args.output:
+    def fields():
+        paths = output.write_fields(args.output, [beam.u])
+        say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
+    writers.append(fields)
+if args.plot:
+    writers.append(lambda: plot(history, args))
+if args.png:
+    writers.append(lambda: picture(shapes, args))
+cli.results(out, writers)

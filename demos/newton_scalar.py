@@ -20,10 +20,8 @@
 # ## Implementation
 
 # +
-import json
 import math
 import sys
-import time
 
 import mpmath
 import numpy as np
@@ -31,7 +29,11 @@ import numpy as np
 from fenics_nl.io import cli
 from fenics_nl.solvers import scalar
 
+if __name__ == "__main__":  # `python demos/newton_scalar.py [options]`: the cells below, run
+    sys.exit(cli.run_file(__file__))  # by cli.run_file (one-line errors, the JSON written)
+
 # Each function: r(u), a starting point, and what it models.
+
 FUNCTIONS = {
     "spring": (lambda u: mpmath.tanh(u) + 0.2 * u - 1, 0.0,
                "softening spring tanh(u) + 0.2 u = 1 (initial slope stiffer than at the root)"),
@@ -41,10 +43,19 @@ FUNCTIONS = {
     "kepler": (lambda u: u - 0.5 * mpmath.sin(u) - 1.0, 1.0,
                "Kepler's equation E - e sin E = M (e = 0.5, M = 1)"),
 }
+EXPECTED = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
 # -
 
 
-def parse_args(argv=None):
+
+# ### Parameters
+#
+# From the command line (`python demos/newton_scalar.py --help`); in a notebook, the
+# defaults.
+
+# +
+def parser():
+    """The equation, the arithmetic and the outputs."""
     p = cli.parser("Newton (order 2), modified Newton (order 1) and secant (order 1.618) on a "
                    "scalar equation r(u) = 0, in many-digit arithmetic so that the orders show.")
     p.add_argument("--function", choices=FUNCTIONS, default="spring",
@@ -60,63 +71,32 @@ def parse_args(argv=None):
                    help="iteration limit per method")
     cli.add_outputs(p, json="orders and iteration counts",
                     plot="draw |e_k+1| against |e_k| (log-log: the slopes are the orders)")
-    args = p.parse_args(argv)
-    if args.digits > 1000:
-        p.error(f"--digits must be in [16, 1000], got {args.digits}")
-    if args.slope is not None and args.slope == 0:
-        p.error("--slope must be non-zero")
-    return args
+    return p
 
 
-EXPECTED = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
+p = parser()
+args = cli.arguments(p, prefixes={})
+if args.digits > 1000:
+    p.error(f"--digits must be in [16, 1000], got {args.digits}")
+if args.slope is not None and args.slope == 0:
+    p.error("--slope must be non-zero")
+r, u0_default, what = FUNCTIONS[args.function]
+u0 = args.u0 if args.u0 is not None else u0_default
+if args.digits > 16:
+    mpmath.mp.dps = args.digits
+    num, tol = mpmath.mpf, mpmath.mpf(10) ** (5 - args.digits)
+else:
+    num, tol = float, 1e-14
+    r = (lambda f: lambda u: float(f(u)))(r)
+print(f"r(u) = 0: {what}; u0 = {u0}, {args.digits} digits")
+# -
 
+# ### The three methods
+#
+# A method that fails (modified Newton with a slope less than half the true one diverges)
+# is a result too: its iterates are shown.
 
-def main(argv=None) -> int:
-    args = parse_args(argv)
-    t0 = time.perf_counter()
-    r, u0_default, what = FUNCTIONS[args.function]
-    u0 = args.u0 if args.u0 is not None else u0_default
-    if args.digits > 16:
-        mpmath.mp.dps = args.digits
-        num, tol = mpmath.mpf, mpmath.mpf(10) ** (5 - args.digits)
-    else:
-        num, tol = float, 1e-14
-        r = (lambda f: lambda u: float(f(u)))(r)
-    print(f"r(u) = 0: {what}; u0 = {u0}, {args.digits} digits")
-
-    # Solve with the three methods. A method that fails (modified Newton with a slope less
-    # than half the true one diverges) is a result too: its iterates are shown.
-    # +
-    results, failures = {}, {}
-    for method in scalar.METHODS:
-        k = num(args.slope) if args.slope is not None else None
-        try:
-            results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, maxit=args.maxit)
-        except scalar.ScalarSolveError as err:
-            results[method], failures[method] = err.result, str(err)
-    # -
-
-    summary = {}
-    for method, res in results.items():
-        orders = [float(q) for q in res.orders]
-        summary[method] = {"converged": res.converged, "iterations": res.iterations,
-                           "order": orders[-1] if orders else None,
-                           "expected_order": EXPECTED[method], "orders": orders,
-                           "root": float(res.root) if res.converged else None}
-        table(method, res, orders, failures.get(method))
-        if method in failures:
-            summary[method]["failure"] = failures[method]
-    summary["function"] = args.function
-    summary["wall_time_s"] = time.perf_counter() - t0
-
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(summary, f, indent=2, allow_nan=False)
-    if args.plot:
-        plot(results, args.plot, what)
-    return 0
-
-
+# +
 def table(method, res, orders, failure):
     """Iterates, residuals and observed orders of one method (long runs elided)."""
     state = f"root {mpmath.nstr(res.root, 17)}" if res.converged else "FAILED"
@@ -134,6 +114,32 @@ def table(method, res, orders, failure):
         print(f"  {failure}")
     elif orders:
         print(f"  observed order {orders[-1]:.3f} (theory {EXPECTED[method]:.3f})")
+
+
+results, failures = {}, {}
+for method in scalar.METHODS:
+    k = num(args.slope) if args.slope is not None else None
+    try:
+        results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, maxit=args.maxit)
+    except scalar.ScalarSolveError as err:
+        results[method], failures[method] = err.result, str(err)
+
+summary = {}
+for method, res in results.items():
+    orders = [float(q) for q in res.orders]
+    summary[method] = {"converged": res.converged, "iterations": res.iterations,
+                       "order": orders[-1] if orders else None,
+                       "expected_order": EXPECTED[method], "orders": orders,
+                       "root": float(res.root) if res.converged else None}
+    table(method, res, orders, failures.get(method))
+    if method in failures:
+        summary[method]["failure"] = failures[method]
+summary["function"] = args.function
+# -
+
+# ## Outputs
+#
+# The JSON (orders and iteration counts) and, when asked, $e_{k+1}$ against $e_k$.
 
 
 def plot(results, path, title):
@@ -170,5 +176,4 @@ def plot(results, path, title):
     pictures.save_figure(fig, path)
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+cli.results(summary, [lambda: plot(results, args.plot, what)] if args.plot else [])

@@ -47,100 +47,198 @@ from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad
+from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz
 
+if __name__ == "__main__":  # `python demos/punch.py [options]`: the cells below, run by
+    sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
+
 comm = MPI.COMM_WORLD
 MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
-MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
-FEW_NODES = 10  # below this, a and p0 are coarse: say so
 # -
 
+# ### Parameters
+#
+# From the command line (`python demos/punch.py --help` lists them); in a notebook, the
+# defaults. The PETSc options of the run's solver take the prefix
+# `-punch_<model>_<form>_`.
 
-def expected_radius(args):
-    """The contact radius the mesh is built for: Hertz's a for a sphere pushed by P (and
-    the cylinder's half-width), else √(Rδ) (a safe overestimate of a cylinder's)."""
-    E, nu, R = args.E, args.nu, args.radius
-    if args.force is not None:
-        if args.model == "plane-strain":
-            return hertz.cylinder_from_force(E, nu, R, args.force)["contact_radius"]
-        return hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
-    return math.sqrt(R * abs(args.indentation))
+# +
+def parser():
+    """Every parameter of the scene, with its unit and default."""
+    p = cli.parser(
+        "Rigid spherical punch on an elastic block (Hertz contact, the course's active set). "
+        "Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa).",
+        epilog="PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
+               "<model> = axisymmetric | 3d | planestrain, <form> = elim (KSP of each "
+               "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
+               "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
+    p.add_argument("--model", choices=["axisymmetric", "3d", "plane-strain"],
+                   default="axisymmetric", help="axisymmetric (r,z), 3D quarter, plane strain")
+    p.add_argument("--E", type=cli.positive, default=1.0, help="Young's modulus [stress]")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--radius", type=cli.positive, default=1.0, help="punch radius R [length]")
+    load = p.add_mutually_exclusive_group()
+    load.add_argument("--indentation", type=cli.finite, default=None,
+                      help="displacement control: indentation δ [length] (default 0.01 R)")
+    load.add_argument("--force", type=cli.positive, default=None,
+                      help="force control: total force P [force] (per unit length in plane "
+                           "strain)")
+    p.add_argument("--steps", type=cli.at_least(1), default=1,
+                   help="load steps from 0 to the load")
+    p.add_argument("--formulation", choices=["elimination", "multiplier"], default="elimination",
+                   help="active normal displacements as Dirichlet rows, or Lagrange multipliers")
+    p.add_argument("--gap", choices=["parabola", "sphere"], default="parabola",
+                   help="punch shape: Hertz's parabola or the exact sphere")
+    p.add_argument("--material", choices=["linear", "power-law"], default="linear",
+                   help="linear elastic (Hertz applies), or the power law (Newton inside)")
+    p.add_argument("--sigma0", type=cli.positive, default=None,
+                   help="power law: stress where it turns non-linear [stress] (default 0.01)")
+    p.add_argument("--n", type=cli.positive, default=None,
+                   help="power law exponent [-] (default 0.3)")
+    p.add_argument("--refine", type=cli.at_least(0), default=1,
+                   help=f"element size under the punch a/(20·2^refine) (3D: a/(6·2^refine)), "
+                        f"at most {MAX_REFINE}")
+    p.add_argument("--block", type=cli.positive, default=None,
+                   help="block size in contact radii, >= 10 (default 1000, 3D 100)")
+    cli.add_outputs(p, output="displacement, von Mises stress, contact pressure and active set",
+                    png="the deformed contact zone (von Mises stress) beside the contact "
+                        "pressure, against Hertz",
+                    plot="force-indentation and pressure against Hertz")
+    return p
 
 
-def run(args):
-    if args.indentation is None and args.force is None:
-        args.indentation = 0.01 * args.radius
-    # ### The block
-    #
-    # A graded mesh, fine (h = a/40 axisymmetric by default) within 1.5 a of the axis, coarser away
-    # from it, in a block 1000 a wide (100 a in 3D) so that it behaves like Hertz's
-    # half-space. Its bottom slides on a rigid base; the symmetry planes carry their
-    # symmetry conditions; its top is the contact surface $S_C$.
-    a = expected_radius(args)
-    size = args.block or (100.0 if args.model == "3d" else 1000.0)
-    say(f"meshing the {args.model} block ({size:g} contact radii) ...")
-    block = PunchBlock(args.model, a, refine=args.refine, block=size)
+p = parser()
+args = cli.arguments(p, prefixes=lambda a: {
+    f"punch_{a.model.replace('-', '')}_{a.formulation[:4]}_":
+        "KSP" if a.formulation == "elimination" else "SNES and KSP"})
+cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
+if args.refine > MAX_REFINE:
+    p.error(f"--refine must be <= {MAX_REFINE}, got {args.refine}")
+if args.indentation is not None and args.indentation == 0:
+    p.error("--indentation must be non-zero (negative: the punch stays clear)")
+if args.indentation is None and args.force is None:
+    args.indentation = 0.01 * args.radius
+# -
 
-    # ### The material
-    #
-    # A free energy $\varphi(\varepsilon)$; the stress $\sigma = \partial\varphi/\partial
-    # \varepsilon$ and the tangent are derived from it by UFL. Hertz's theory is linear
-    # elastic; the power law puts a Newton loop inside every active-set iteration.
-    material = (LinearElastic(args.E, args.nu) if args.material == "linear"
-                else PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n))
+# ### The block
+#
+# A graded mesh, fine (h = a/40 axisymmetric by default) within 1.5 a of the axis, coarser
+# away from it, in a block 1000 a wide (100 a in 3D) so that it behaves like Hertz's
+# half-space. Its bottom slides on a rigid base; the symmetry planes carry their symmetry
+# conditions; its top is the contact surface $S_C$. The contact radius the mesh is built
+# for is Hertz's $a$ for the force (sphere, or the cylinder's half-width), else
+# $\sqrt{R\delta}$ (for a cylinder, a safe overestimate).
 
-    # ### The residual
-    #
-    # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega$, and no
-    # external load: the punch acts only through the contact conditions. In the
-    # axisymmetric model $\varepsilon$ has the hoop strain $u_r/r$ and the weight is
-    # $2\pi r$, so that $R$ is the whole body's.
-    # +
-    u, v = block.u, ufl.TestFunction(block.V)
-    eps = kinematics.small_strain
-    residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
-                * block.weight * block.dx)
-    # -
+# +
+E, nu, R = args.E, args.nu, args.radius
+if args.force is None:
+    a = math.sqrt(R * abs(args.indentation))
+elif args.model == "plane-strain":
+    a = hertz.cylinder_from_force(E, nu, R, args.force)["contact_radius"]
+else:
+    a = hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
+size = args.block or (100.0 if args.model == "3d" else 1000.0)
+say(f"meshing the {args.model} block ({size:g} contact radii) ...")
+block = PunchBlock(args.model, a, refine=args.refine, block=size)
+# -
 
-    # ### The active-set loop, in load steps
-    #
-    # `Punch` gives the residual, the supports and the gap $\gamma$ to
-    # `fenics_nl.contact.active_set.ActiveSetContact`, which runs the course's loop: solve with
-    # $u_n = \gamma$ on the active nodes (rows eliminated, or Lagrange multipliers), then
-    # update the set (leave where $T_n > 0$, join where $u_n > \gamma$) until it stops
-    # changing. The load (δ, or the force P by a secant iteration on δ) grows in equal
-    # steps, each started from the last active set.
-    # +
-    punch = Punch(block, material, residual, args.radius, formulation=args.formulation,
-                  gap=args.gap)
-    say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
-    load = PunchLoad(punch, indentation=args.indentation, force=args.force,
-                     first_guess=a * a / args.radius)
-    states = load.states
+# ### The material
+#
+# A free energy $\varphi(\varepsilon)$; the stress $\sigma = \partial\varphi/\partial
+# \varepsilon$ and the tangent are derived from it by UFL. Hertz's theory is linear
+# elastic; the power law puts a Newton loop inside every active-set iteration.
 
-    def report(t, result):
-        s = states[-1]
-        say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
-            f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
-            f"{s.active_set_iterations} active-set iterations")
+material = (LinearElastic(E, nu) if args.material == "linear"
+            else PowerLaw(E, nu, sigma0=args.sigma0, n=args.n))
 
-    solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
-                        on_step=report)
-    # -
+# ### The residual
+#
+# $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega$, and no
+# external load: the punch acts only through the contact conditions. In the axisymmetric
+# model $\varepsilon$ has the hoop strain $u_r/r$ and the weight is $2\pi r$, so that $R$
+# is the whole body's.
 
-    # ### Against Hertz
-    #
-    # The force, the radius of the outermost active node and the largest nodal pressure,
-    # with their relative errors (`check_against_hertz` below also refuses a contact zone
-    # the mesh cannot resolve); with several steps, the exponent of P ∝ δ^m (Hertz: 1.5).
-    # +
-    last = states[-1]
+# +
+u, v = block.u, ufl.TestFunction(block.V)
+eps = kinematics.small_strain
+residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
+            * block.weight * block.dx)
+# -
+
+# ### The active-set loop, in load steps
+#
+# `Punch` gives the residual, the supports and the gap $\gamma$ to
+# `fenics_nl.contact.active_set.ActiveSetContact`, which runs the course's loop: solve with
+# $u_n = \gamma$ on the active nodes (rows eliminated, or Lagrange multipliers), then
+# update the set (leave where $T_n > 0$, join where $u_n > \gamma$) until it stops
+# changing. The load (δ, or the force P by a secant iteration on δ) grows in equal steps,
+# each started from the last active set.
+
+# +
+punch = Punch(block, material, residual, R, formulation=args.formulation, gap=args.gap)
+say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
+load = PunchLoad(punch, indentation=args.indentation, force=args.force,
+                 first_guess=a * a / R)
+states = load.states
+
+
+def report(t, result):
+    s = states[-1]
+    say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
+        f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
+        f"{s.active_set_iterations} active-set iterations")
+
+
+solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
+                    on_step=report)
+last = states[-1]
+# -
+
+# ### Against Hertz
+#
+# The force (not for the cylinder: its indentation depends on the block, Hertz gives no
+# $P(\delta)$), the radius of the outermost active node (within h of the true edge) and the
+# largest nodal pressure, against Hertz's values for the computed state; with several steps,
+# the exponent of $P \propto \delta^m$ (Hertz: 1.5). A contact zone the mesh cannot resolve
+# (fewer than 4 nodes) is refused.
+
+# +
+nodes = punch.nodes_in_contact()
+warnings = check_contact_resolution(nodes, block.h, last)
+ref = punch.hertz(last) if last.force > 0 else None
+errors = {}
+if ref is None:
+    say("the punch does not touch the block: zero contact force")
+else:
+    errors = {k: getattr(last, k) / ref[k] - 1 for k in ("force", "contact_radius",
+                                                         "max_pressure") if k in ref}
+    checked = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
+               f"{100 * e:+.3f} %)" for k, e in errors.items()]
+    if args.model == "plane-strain":  # a cylinder: Hertz's a and p0 for the computed P
+        checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
+    say("; ".join(checked) + f"; h = {block.h:.2g}")
+exponent = None
+if len(states) >= 2 and all(s.force > 0 for s in states):
+    exponent = float(np.polyfit(np.log([s.indentation for s in states]),
+                                np.log([s.force for s in states]), 1)[0])
+    say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if args.model == "plane-strain"
+                                                   else " (Hertz: 1.5)"))
+# -
+
+# ## Outputs
+#
+# The JSON (every quantity above, the reactions of the supports, the work done) and, when
+# asked, the fields for ParaView, the force-indentation curve and the picture.
+
+
+def summary():
+    """The quantities of the run, for --json."""
     out = {"model": args.model, "formulation": args.formulation, "material": args.material,
            "force": last.force, "indentation": last.indentation,
            "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
-           "element_size": block.h, "nodes_in_contact": punch.nodes_in_contact(),
+           "element_size": block.h, "nodes_in_contact": nodes,
            "active_set_iterations": sum(s.active_set_iterations for s in states),
            "newton_iterations": sum(s.newton_iterations for s in states),
            "factorizations": sum(s.factorizations for s in states),
@@ -151,66 +249,23 @@ def run(args):
            "reactions_of": {"axisymmetric": "the whole body (2πr in the residual)",
                             "3d": "the modelled quarter",
                             "plane-strain": "the modelled half, per unit length"}[args.model],
-           "dofs": punch.dofs, "ranks": comm.size, "warnings": []}
-    ref = check_against_hertz(punch, last, args, out)
-    if len(states) >= 2 and all(s.force > 0 for s in states):
-        d = np.log([s.indentation for s in states])
-        f = np.log([s.force for s in states])
-        out["fitted_exponent"] = float(np.polyfit(d, f, 1)[0])
-        theory = " (Hertz: 1.5)" if args.model != "plane-strain" else ""
-        say(f"P ∝ δ^{out['fitted_exponent']:.4f} over the steps{theory}")
-    # -
-    writers = []
-    vm = punch.von_mises() if args.output or args.png else None  # once for both
-    if args.output:
-        writers.append(lambda: write_fields(punch, vm, args.output))
-    if args.plot:
-        writers.append(lambda: plot(punch, states, ref, args))
-    if args.png:
-        writers.append(lambda: picture(punch, vm, last, ref, args))
-    return out, writers
-
-
-def check_against_hertz(punch, last, args, out):
-    """Hertz's values where theory gives them, relative errors, and what is not checked."""
-    n, h = out["nodes_in_contact"], punch.block.h
-    if last.force > 0 and n < MIN_NODES:
-        raise ValueError(f"only {n} node(s) of the surface are in contact (h = {h:.3g}, "
-                         f"contact radius {last.contact_radius:.3g}): the mesh cannot resolve "
-                         f"the contact zone; lower --refine or check the load")
-    if last.force > 0 and n < FEW_NODES:
-        out["warnings"].append(f"only {n} nodes in contact: contact radius and p0 are "
-                               f"resolved to about h = {punch.block.h:.3g} only")
+           "dofs": punch.dofs, "ranks": comm.size, "warnings": warnings}
+    if exponent is not None:
+        out["fitted_exponent"] = exponent
+    for k, e in errors.items():
+        out[f"hertz_{k}"], out[f"{k}_rel_error"] = ref[k], e
     if args.material != "linear":
-        out["warnings"].append("power-law material: Hertz's values are the linear reference, "
-                               "not a check")
-    if last.force == 0.0:
-        say("the punch does not touch the block: zero contact force")
-        return None
-    ref = punch.hertz(last)
-    for key in ("force", "contact_radius", "max_pressure"):
-        if key in ref:
-            out[f"hertz_{key}"] = ref[key]
-            out[f"{key}_rel_error"] = getattr(last, key) / ref[key] - 1
-    if args.model == "plane-strain":
-        out["warnings"].append("plane strain: the force is not checked (a cylinder's "
-                               "indentation depends on the block, Hertz gives no P(δ)); "
-                               "half-width and p0 are checked against Hertz for the computed P")
-        say(f"P = {last.force:.6g} per unit length (not checked); half-width "
-            f"{last.contact_radius:.5g} (Hertz {ref['contact_radius']:.5g}, "
-            f"{100 * out['contact_radius_rel_error']:+.2f} %, h = {punch.block.h:.2g}); p0 "
-            f"{last.max_pressure:.5g} (Hertz {ref['max_pressure']:.5g}, "
-            f"{100 * out['max_pressure_rel_error']:+.2f} %)")
-    else:
-        say(f"force {last.force:.6g} (Hertz {ref['force']:.6g}, "
-            f"{100 * out['force_rel_error']:+.3f} %); radius {last.contact_radius:.5g} (Hertz "
-            f"{ref['contact_radius']:.5g}, h = {punch.block.h:.2g}); p0 {last.max_pressure:.5g} "
-            f"(Hertz {ref['max_pressure']:.5g}, {100 * out['max_pressure_rel_error']:+.2f} %)")
-    return ref
+        warnings.append("power-law material: Hertz's values are the linear reference, "
+                        "not a check")
+    if args.model == "plane-strain" and ref is not None:
+        warnings.append("plane strain: the force is not checked (a cylinder's indentation "
+                        "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
+                        "checked against Hertz for the computed P")
+    return out
 
 
-def write_fields(punch, vm, folder):
-    paths = output.write_fields(folder, [punch.u, *punch.contact_fields(), vm])
+def write_fields(vm):
+    paths = output.write_fields(args.output, [punch.u, *punch.contact_fields(), vm])
     say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
 
 
@@ -325,64 +380,13 @@ def picture(punch, vm, state, ref, args):
     pictures.save_figure(fig, args.png)
 
 
-# ## The command line
 
-def parse_args(argv=None):
-    p = cli.parser(
-        "Rigid spherical punch on an elastic block (Hertz contact, the course's active set). "
-        "Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa).",
-        epilog="PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
-               "<model> = axisymmetric | 3d | planestrain, <form> = elim (KSP of each "
-               "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
-               "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--model", choices=["axisymmetric", "3d", "plane-strain"],
-                   default="axisymmetric", help="axisymmetric (r,z), 3D quarter, plane strain")
-    p.add_argument("--E", type=cli.positive, default=1.0, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--radius", type=cli.positive, default=1.0, help="punch radius R [length]")
-    load = p.add_mutually_exclusive_group()
-    load.add_argument("--indentation", type=cli.finite, default=None,
-                      help="displacement control: indentation δ [length] (default 0.01 R)")
-    load.add_argument("--force", type=cli.positive, default=None,
-                      help="force control: total force P [force] (per unit length in plane "
-                           "strain)")
-    p.add_argument("--steps", type=cli.at_least(1), default=1,
-                   help="load steps from 0 to the load")
-    p.add_argument("--formulation", choices=["elimination", "multiplier"], default="elimination",
-                   help="active normal displacements as Dirichlet rows, or Lagrange multipliers")
-    p.add_argument("--gap", choices=["parabola", "sphere"], default="parabola",
-                   help="punch shape: Hertz's parabola or the exact sphere")
-    p.add_argument("--material", choices=["linear", "power-law"], default="linear",
-                   help="linear elastic (Hertz applies), or the power law (Newton inside)")
-    p.add_argument("--sigma0", type=cli.positive, default=None,
-                   help="power law: stress where it turns non-linear [stress] (default 0.01)")
-    p.add_argument("--n", type=cli.positive, default=None,
-                   help="power law exponent [-] (default 0.3)")
-    p.add_argument("--refine", type=cli.at_least(0), default=1,
-                   help=f"element size under the punch a/(20·2^refine) (3D: a/(6·2^refine)), "
-                        f"at most {MAX_REFINE}")
-    p.add_argument("--block", type=cli.positive, default=None,
-                   help="block size in contact radii, >= 10 (default 1000, 3D 100)")
-    cli.add_outputs(p, output="displacement, von Mises stress, contact pressure and active set",
-                    png="the deformed contact zone (von Mises stress) beside the contact "
-                        "pressure, against Hertz",
-                    plot="force-indentation and pressure against Hertz")
-    args, petsc_args = cli.parse_with_petsc_options(p, argv)
-    cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
-    if args.refine > MAX_REFINE:
-        p.error(f"--refine must be <= {MAX_REFINE}, got {args.refine}")
-    if args.indentation is not None and args.indentation == 0:
-        p.error("--indentation must be non-zero (negative: the punch stays clear)")
-    return args, petsc_args
-
-
-def main(argv=None) -> int:
-    args, petsc_args = parse_args(argv)
-    prefix = f"punch_{args.model.replace('-', '')}_{args.formulation[:4]}_"
-    what = "KSP" if args.formulation == "elimination" else "SNES and KSP"
-    return cli.run_scene(lambda: run(args), petsc_argv=petsc_args, json_path=args.json,
-                         prefixes={prefix: f"{what} of each active-set iteration"})
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+writers = []
+vm = punch.von_mises() if args.output or args.png else None  # once for both
+if args.output:
+    writers.append(lambda: write_fields(vm))
+if args.plot:
+    writers.append(lambda: plot(punch, states, ref, args))
+if args.png:
+    writers.append(lambda: picture(punch, vm, last, ref, args))
+cli.results(summary(), writers)

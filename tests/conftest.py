@@ -14,7 +14,6 @@ import fenics_nl  # noqa: F401
 
 # isort: split
 
-import importlib.util
 import itertools
 import json
 import math
@@ -38,31 +37,19 @@ if MPI.COMM_WORLD.size > 1:
         gc.collect()
 
 
-_modules = {}
 _runs = itertools.count()
-
-
-def demo_module(name: str):
-    """demos/`name` imported once (its `main(argv)` runs a scene in this process)."""
-    if name not in _modules:
-        spec = importlib.util.spec_from_file_location(f"demo_{Path(name).stem}", DEMOS / name)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        _modules[name] = module
-    return _modules[name]
 
 
 class Demos:
     """Runs demos/<name> as a user does, in `tmp_path`.
 
-    Serially the demo's `main(argv)` runs in this process (scikit-fem's test_examples
-    style: no interpreter start, forms stay compiled); with ranks > 1 it runs under
+    Serially the demo's cells run in this process through `cli.run_file`, as its
+    ``__main__`` line does (scikit-fem's test_examples style: no interpreter start, forms
+    stay compiled); with ranks > 1 it runs under
     `mpiexec -n ranks` in a subprocess. Either way the result is a CompletedProcess with
     the exit status, stdout and stderr (captured at the file descriptors, so PETSc's own
     output is in it).
     """
-
-    module = staticmethod(demo_module)
 
     def __init__(self, tmp_path, capfd, monkeypatch):
         self.tmp_path, self.capfd, self.monkeypatch = tmp_path, capfd, monkeypatch
@@ -88,7 +75,10 @@ class Demos:
         if name == "-m fenics_nl":
             from fenics_nl.__main__ import main
         else:
-            main = demo_module(name).main
+            from fenics_nl.io.cli import run_file
+
+            def main(argv):
+                return run_file(DEMOS / name, argv)
         from petsc4py import PETSc
 
         self.capfd.readouterr()

@@ -127,16 +127,18 @@ def test_a_failing_picture_keeps_the_json(tmp_path, demo):
     assert json.loads((tmp_path / "o.json").read_text())["force"] > 0
 
 
-def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve(demo):
-    # the check behind every punch report, called in-process on a state with 3 nodes in
-    # contact (the CLI's --refine bound keeps a default run far from it)
+def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve():
+    # the check behind every punch report, on a state with 3 nodes in contact (the CLI's
+    # --refine bound keeps a default run far from it)
     from types import SimpleNamespace
 
+    from fenics_nl.scenes.punch import check_contact_resolution
+
     state = SimpleNamespace(force=1.0, contact_radius=0.1)
-    punch = SimpleNamespace(block=SimpleNamespace(h=0.05))
     with pytest.raises(ValueError, match=r"only 3 node.* cannot resolve the contact zone"):
-        demo.module("punch.py").check_against_hertz(punch, state, None,
-                                                    {"nodes_in_contact": 3, "warnings": []})
+        check_contact_resolution(3, 0.05, state)
+    assert "only 7 nodes" in check_contact_resolution(7, 0.05, state)[0]
+    assert check_contact_resolution(12, 0.05, state) == []
 
 
 def test_punch_outputs_and_options_on_two_ranks(tmp_path, demo):

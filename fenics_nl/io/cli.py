@@ -1,11 +1,12 @@
 """Command-line plumbing shared by the demos: argument types, PETSc options, the run itself.
 
-A demo parses its flags with `parser(...)` (every default shown once, numeric flags that
-refuse NaN and infinities by name), passes the rest to `PetscOptions` (only options under
-the run's own prefixes are accepted; an option no solver read ends the run with an error),
-and hands its work to `run_scene`, which turns the library's errors into one line and a
-non-zero exit, writes the JSON first and then every other output, each on its own, so that
-a failing picture never loses the numbers.
+A demo is a script of top-level cells. Its ``if __name__ == "__main__"`` line hands the file
+to `run_file`, which runs the cells again: the first calls `arguments` (flags from
+`parser(...)`: every default shown once, numeric flags that refuse NaN and infinities by
+name; PETSc options accepted only under the run's own prefixes), the last `results`.
+`run_file` turns the library's errors into one line and a non-zero exit, writes the JSON
+first and then every other output, each on its own, so that a failing picture never loses
+the numbers, and reports a PETSc option that no solver read.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import json
 import math
 import os
 import re
+import runpy
 import sys
 import time
 import traceback
@@ -184,15 +186,80 @@ def error(message: str) -> None:
         print(f"error: {message}", file=sys.stderr, flush=True)
 
 
+class _Run:
+    """A demo run in progress: its command line, PETSc options, results and writers."""
+
+    def __init__(self, argv: Sequence[str]):
+        self.argv = list(argv)
+        self.options: PetscOptions | None = None
+        self.json_path: str | None = None
+        self.out: dict | None = None
+        self.writers: Sequence[Callable[[], None]] = ()
+
+
+_current: _Run | None = None
+
+
+def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
+    """Run a demo file's top-level cells under the scene contract; returns the exit status.
+
+    A demo is a script (jupytext light format) whose cells call `arguments` first and
+    `results` last; its ``if __name__ == "__main__"`` line hands the file to this function,
+    which executes it again (as ``__scene__``) with `argv` (default: the command line).
+    Library errors end the run with one line and status 2; the JSON is written first, then
+    every writer on its own (a failing one: status 1); a PETSc option no solver read:
+    status 2. Outside `run_file` (a notebook, an import), `arguments` gives the defaults.
+    """
+    global _current
+    from petsc4py import PETSc
+
+    run = _current = _Run(sys.argv[1:] if argv is None else argv)
+    t0 = time.perf_counter()
+    try:
+        runpy.run_path(str(path), run_name="__scene__")
+    except SystemExit as stop:  # argparse: --help, or a bad flag (already said)
+        _forget(run.options)
+        return stop.code if isinstance(stop.code, int) else int(stop.code is not None)
+    except (*EXPECTED_ERRORS, PETSc.Error) as err:
+        error(_one_line(err))
+        _forget(run.options)
+        return 2
+    finally:
+        _current = None
+    if run.out is None:
+        raise RuntimeError(f"{path} ended without calling cli.results")
+    return _finish(run.out, run.writers, run.options, run.json_path, t0)
+
+
+def arguments(parser: argparse.ArgumentParser,
+              prefixes: dict[str, str] | Callable[[argparse.Namespace], dict[str, str]]
+              ) -> argparse.Namespace:
+    """The demo's parameters: its command line inside `run_file`, else the defaults.
+
+    `prefixes` (or a function of the parsed arguments giving them): the PETSc options
+    prefixes of the run's solvers, with what reads each; an option outside them is refused.
+    """
+    run = _current
+    args, petsc = parse_with_petsc_options(parser, run.argv if run else [])
+    if run is not None:
+        run.json_path = getattr(args, "json", None)
+        run.options = PetscOptions(petsc, prefixes(args) if callable(prefixes) else prefixes)
+    return args
+
+
+def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
+    """The run's quantities (the JSON) and its output writers, for `run_file` to write."""
+    if _current is not None:
+        _current.out, _current.writers = out, writers
+
+
 def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
               petsc_argv: Sequence[str] = (), prefixes: dict[str, str] | None = None,
               json_path: str | None = None) -> int:
-    """Run a scene: `solve()` returns (quantities for the JSON, output writers).
+    """Run `solve()`, which returns quantities for the JSON and output writers.
 
-    Errors of the library end the run with one line and exit status 2. The JSON is written
-    first (with `wall_time_s` and `warnings`), then each writer runs on its own: a failing
-    writer is reported (exit status 1) without losing the others. PETSc options that no
-    solver read end the run with exit status 2.
+    The same contract as `run_file` (one-line errors, the JSON first, PETSc options checked)
+    for a command whose work is a function (the case files).
     """
     from petsc4py import PETSc
 
@@ -203,9 +270,20 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
         out, writers = solve()
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
         error(_one_line(err))
-        if options is not None:
-            options.unused()  # leaves PETSc's database as it was
+        _forget(options)
         return 2
+    return _finish(out, writers, options, json_path, t0)
+
+
+def _forget(options: PetscOptions | None) -> None:
+    """Leave PETSc's options database as it was before the run."""
+    if options is not None:
+        options.unused()
+
+
+def _finish(out: dict, writers: Sequence[Callable[[], None]], options: PetscOptions | None,
+            json_path: str | None, t0: float) -> int:
+    """Warnings, the JSON (first), every writer on its own, unread PETSc options."""
     out["wall_time_s"] = time.perf_counter() - t0
     out.setdefault("warnings", [])
     for w in out["warnings"]:
@@ -215,7 +293,7 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
         text = json.dumps(out, indent=2, allow_nan=False)
     except ValueError:  # a NaN among the results: a defect, never a silent answer
         error("a result is not a finite number: no output written")
-        options.unused()
+        _forget(options)
         return 2
     if json_path and MPI.COMM_WORLD.rank == 0:
         try:
@@ -231,7 +309,7 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
             if MPI.COMM_WORLD.rank == 0 and "FENICS_NL_DEBUG" in os.environ:
                 traceback.print_exc()
             status = 1
-    left = options.unused()
+    left = options.unused() if options is not None else []
     if left:
         error(f"PETSc option -{left[0]} was read by no solver (misspelt?); this run's options "
               f"prefixes are {options.describe()}")

@@ -37,6 +37,24 @@ from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
 
 MODELS = ("axisymmetric", "3d", "plane-strain")
+MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
+FEW_NODES = 10  # below this, a and p0 are coarse: say so
+
+
+def check_contact_resolution(nodes: int, h: float, state: Indentation) -> list[str]:
+    """Refuse a contact zone of fewer than MIN_NODES nodes (ValueError).
+
+    Returns the warnings: one below FEW_NODES, none when the zone is resolved or there is
+    no contact.
+    """
+    if state.force > 0 and nodes < MIN_NODES:
+        raise ValueError(f"only {nodes} node(s) of the surface are in contact (h = {h:.3g}, "
+                         f"contact radius {state.contact_radius:.3g}): the mesh cannot "
+                         f"resolve the contact zone; lower --refine or check the load")
+    if state.force > 0 and nodes < FEW_NODES:
+        return [f"only {nodes} nodes in contact: contact radius and p0 are resolved to about "
+                f"h = {h:.3g} only"]
+    return []
 
 
 @dataclass
