@@ -35,8 +35,11 @@ class CaseProblem:
         self.case = case
         data = load_mesh(case, comm)
         self.mesh = msh = data.mesh
-        self.facets = self._groups(data)
         self.model, dim = case.model, case.dim
+        self.facets, problems = self._groups(data)
+        self.probes, outside = self._locate_probes()
+        if problems + outside:
+            raise CaseError(problems + outside)
         self.V = fem.functionspace(msh, ("Lagrange", case.degree, (dim,)))
         self.u = fem.Function(self.V, name="displacement")
         self.material = case.material()
@@ -50,32 +53,37 @@ class CaseProblem:
         self.residual = self._residual(data)
         self.force_scale = self._load_magnitude(data)
         self.bcs, self._prescribed = self._dirichlet()
-        # the contact group first: a node on it and on a support (the axis under a punch)
-        # carries the contact force, not the support's reaction
-        order = sorted(case.conditions, key=lambda c: c.kind != "contact")
-        self.supports = {c.group: self.facets[c.group] for c in order
-                         if c.kind in ("displacement", "contact")}
         self.contact = self._contact()
-        self.probes = self._locate_probes()
+        self.supports, self.held = self._supports()
+        self._probe_stress = {}  # σ_eq for the probes: its DG field and Expression
         self.solver = None  # make_solver(): compiling the forms is for a run, not a check
 
     # -- the pieces ---------------------------------------------------------------------
 
-    def _groups(self, data) -> dict[str, np.ndarray]:
-        """Facets of every group the conditions name; unknown names listed at once."""
-        fdim = data.mesh.topology.dim - 1
+    def _groups(self, data) -> tuple[dict[str, np.ndarray], list[str]]:
+        """Facets of every group the conditions name, and what is wrong with them.
+
+        A group must be a boundary group of the mesh, all on the boundary: a load on an
+        interior facet would silently do nothing (ds integrates exterior facets only).
+        """
+        msh = data.mesh
+        fdim = msh.topology.dim - 1
+        msh.topology.create_connectivity(fdim, fdim + 1)
+        exterior = dmesh.exterior_facet_indices(msh.topology)
         have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == fdim}
         problems, out = [], {}
         for c in self.case.conditions:
-            if c.group in have:
-                out[c.group] = data.facet_tags.find(have[c.group])
-            else:
-                problems.append(f"{c.key.rsplit('.', 1)[0]}.group: {c.group!r} is not a "
-                                f"boundary group of the mesh (it has: "
-                                f"{', '.join(sorted(have)) or 'none'})")
-        if problems:
-            raise CaseError(problems)
-        return out
+            where = c.key.rsplit(".", 1)[0] + ".group"
+            if c.group not in have:
+                problems.append(f"{where}: {c.group!r} is not a boundary group of the mesh "
+                                f"(it has: {', '.join(sorted(have)) or 'none'})")
+                continue
+            out[c.group] = facets = data.facet_tags.find(have[c.group])
+            inside = msh.comm.allreduce(int(np.isin(facets, exterior, invert=True).sum()))
+            if inside:
+                problems.append(f"{where}: {inside} facet(s) of {c.group!r} are inside the "
+                                f"body; conditions act on its boundary")
+        return out, problems
 
     def _residual(self, data) -> ufl.Form:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
@@ -131,6 +139,27 @@ class CaseProblem:
                     prescribed.append((bc.g.x.array, value))
         return bcs, prescribed
 
+    def _supports(self):
+        """The groups whose reactions are reported, and the components each holds.
+
+        The contact group first: a node on it and on a support (the axis under a punch)
+        carries the contact force. Axisymmetric: the radial resultant of a revolution is
+        zero by symmetry, so only the axial one is reported.
+        """
+        groups, held = {}, {}
+        for c in sorted(self.case.conditions, key=lambda c: c.kind != "contact"):
+            if c.kind == "displacement":
+                comps = [i for i, v in enumerate(c.value) if v is not None]
+            elif c.kind == "contact":
+                comps = [self.contact[2]]
+            else:
+                continue
+            if self.model == "axisymmetric":
+                comps = [i for i in comps if i != 0]
+            groups[c.group] = self.facets[c.group]
+            held[c.group] = sorted(set(held.get(c.group, [])) | set(comps))
+        return groups, held
+
     def _contact(self):
         """The contact group's obstacle, or None: (condition, facets, axis, sign)."""
         c = next((c for c in self.case.conditions if c.kind == "contact"), None)
@@ -177,7 +206,8 @@ class CaseProblem:
             d = x[: len(centre)] - centre[:, None]
             a = sign * d[axis]  # along the outward normal, negative when facing the sphere
             r2 = np.maximum((d * d).sum(axis=0) - a * a, 0.0)
-            return np.where(r2 < R * R, -a - np.sqrt(np.maximum(R * R - r2, 0.0)), -a)
+            # beside the sphere (r >= R) nothing is met before its far pole's level
+            return np.where(r2 < R * R, -a - np.sqrt(np.maximum(R * R - r2, 0.0)), R - a)
 
         return plane if ob["obstacle"] == "plane" else sphere
 
@@ -223,47 +253,69 @@ class CaseProblem:
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of each displacement (and the contact) group on the body.
 
-        The whole revolution if axisymmetric; a node in two groups counts in the contact
-        group, else in the first listed.
+        Each group reports the components it holds (0 elsewhere; axisymmetric: the axial
+        resultant of the whole revolution). A node component held by two groups counts in
+        the contact group, else in the first listed.
         """
-        return boundary.reactions(self.residual, self.u, self.supports)
+        return boundary.reactions(self.residual, self.u, self.supports, self.held)
 
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (Cauchy stress; DG0)."""
         return self.material.von_mises(self.u, self.model)
 
     def _locate_probes(self):
-        """(name, point, owning rank, local cell) of every probe; outside → CaseError."""
+        """Where every probe is, and a line for every probe outside the mesh.
+
+        Each probe: (name, point, the lowest rank holding it, this rank's cells holding it,
+        the owned ones among them).
+        """
         comm, msh = self.mesh.comm, self.mesh
-        tree = geometry.bb_tree(msh, msh.topology.dim)
+        tdim = msh.topology.dim
+        tree = geometry.bb_tree(msh, tdim)
+        n_owned = msh.topology.index_map(tdim).size_local
         out, problems = [], []
         for p in self.case.probes:
             x = np.zeros((1, 3))
             x[0, : len(p.point)] = p.point
             cells = geometry.compute_colliding_cells(
                 msh, geometry.compute_collisions_points(tree, x), x).links(0)
-            # the lowest rank holding the point owns the probe
+            # the lowest rank holding the point gives the displacement (continuous)
             owner = comm.allreduce(comm.rank if len(cells) else comm.size, MPI.MIN)
             if owner == comm.size:
                 problems.append(f"{p.key}: {p.point} is outside the mesh")
-            out.append((p.name, x, owner, int(cells[0]) if len(cells) else -1))
-        if problems:
-            raise CaseError(problems)
-        return out
+            out.append((p.name, x, owner, np.asarray(cells, dtype=np.int32),
+                        [int(c) for c in cells if c < n_owned]))
+        return out, problems
 
-    def probe_values(self, vm: fem.Function | None = None) -> dict[str, dict]:
-        """Displacement (and von Mises stress of `vm`) at every probe. Collective."""
+    def probe_values(self) -> dict[str, dict]:
+        """Displacement and von Mises stress at every probe. Collective.
+
+        σ_eq is interpolated cell by cell into a discontinuous space of the displacement's
+        degree and evaluated at the point; on cell faces (a node, an edge) it is the mean
+        over the owned cells that hold the point: the same on any number of ranks.
+        """
         comm, out = self.mesh.comm, {}
-        for name, x, owner, cell in self.probes:
+        vm = self._stress_field()
+        for name, x, owner, cells, owned in self.probes:
             value = None
             if comm.rank == owner:
-                value = {"displacement": self.u.eval(x, np.array([cell], dtype=np.int32))
-                         .tolist()}
-                if vm is not None:
-                    value["von_mises"] = float(vm.x.array[vm.function_space.dofmap
-                                                          .cell_dofs(cell)[0]])
-            out[name] = comm.bcast(value, root=owner)
+                value = {"displacement": self.u.eval(x, cells[:1]).tolist()}
+            total = sum(float(vm.eval(x, np.array([c], dtype=np.int32))[0]) for c in owned)
+            value = comm.bcast(value, root=owner)
+            value["von_mises"] = comm.allreduce(total) / comm.allreduce(len(owned))
+            out[name] = value
         return out
+
+    def _stress_field(self) -> fem.Function:
+        """σ_eq in DG(degree), interpolated now (its Expression compiled once, collectively)."""
+        if not self._probe_stress:
+            Q = fem.functionspace(self.mesh, ("DG", self.case.degree))
+            expr = self.material.von_mises_expression(self.u, self.model)
+            self._probe_stress = {"field": fem.Function(Q),
+                                  "expr": fem.Expression(expr, Q.element.interpolation_points)}
+        f = self._probe_stress["field"]
+        f.interpolate(self._probe_stress["expr"])
+        return f
 
 
 class ContactSteps:

@@ -39,8 +39,8 @@ def solve_case(problem: CaseProblem) -> dict:
             def load(s, a=previous, b=target):
                 problem.set_load(a + s * (b - a))
 
-            def record(s, result, a=previous, b=target):
-                steps.append(step_record(problem, a + s * (b - a), result))
+            def record(s, result, a=previous, b=target):  # the target itself when reached
+                steps.append(step_record(problem, b if s == 1 else a + s * (b - a), result))
 
             path = solve_incrementally(solver, load, 1, adaptive=case.adaptive,
                                        on_step=record, progress=show)
@@ -62,9 +62,8 @@ def solve_case(problem: CaseProblem) -> dict:
 
 def step_record(problem: CaseProblem, t: float, result) -> dict:
     """What one converged step reports (collective)."""
-    vm = problem.von_mises() if problem.probes else None
     rec = {"load_factor": t, "newton_iterations": result.iterations,
-           "probes": problem.probe_values(vm), "reactions": problem.reactions()}
+           "probes": problem.probe_values(), "reactions": problem.reactions()}
     if problem.contact is not None:
         c = problem.solver.contact
         rec["active_set_iterations"] = result.active_set_iterations

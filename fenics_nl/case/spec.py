@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from fenics_nl.materials import laws
@@ -45,12 +45,14 @@ follower = false              # undeformed normal) unless follower = true (finit
 [[boundary]]                  # one contact group: rigid, frictionless, may separate
 group = "top"                 # flat, its outward normal along an axis
 contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
-# or { obstacle = "sphere", center = [0.0, 2.0], radius = 1.0 }; either may move:
-# displacement = [0.0, -0.01] (the obstacle's, scaled by the load factor)
+# or { obstacle = "sphere", center = [0.0, 2.0], radius = 1.0, displacement = [0.0, -0.01] }:
+# inside the braces, displacement moves the obstacle (scaled by the load factor). In the
+# axisymmetric model a sphere is centred on the axis and a plane is normal to it.
 
 [loading]
 steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
+adaptive = true          # optional: false stops at the first failed step instead of cutting it
 
 [solver]                 # every key optional
 newton = "full"          # full | modified | periodic | quasi-newton | snes
@@ -248,7 +250,7 @@ def read_case(path: str | Path) -> Case:
     dim = 3 if model == "3d" else 2
 
     law, parameters = _material(r, data, model)
-    conditions = _conditions(r, data, dim, law)
+    conditions = _conditions(r, data, dim, law, model)
     factors, adaptive = _loading(r, data)
     s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
                 required=False)
@@ -279,24 +281,25 @@ def _material(r: _Reader, data: dict, model: str | None):
         return None, {}
     accepted = tuple(f.name for f in fields(LAWS[law]))
     r.unknown(m, "material", ("law", *accepted))
-    parameters, complete = {}, True
-    for f in fields(LAWS[law]):
-        value = r.get(m, f.name, "material", float, required=f.default is MISSING)
+    parameters = {}
+    for f in fields(LAWS[law]):  # every parameter, even one the class defaults: say it
+        value = r.get(m, f.name, "material", float, required=True)
         if value is not None:
             parameters[f.name] = value
-        complete &= value is not None or f.default is not MISSING
-    if complete:
+    if len(parameters) == len(fields(LAWS[law])):
         try:
             LAWS[law](**parameters)
-        except ValueError as err:  # the law's own range check names the parameter
-            r.fail("material", str(err))
+        except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5), ..."
+            name, _, rest = str(err).partition(" ")
+            r.fail(f"material.{name}" if name in parameters else "material", rest or name)
     if law in ("neo-hookean", "power-law") and model == "plane_stress":
         r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters
 
 
-def _conditions(r: _Reader, data: dict, dim: int, law: str | None) -> list[Condition]:
+def _conditions(r: _Reader, data: dict, dim: int, law: str | None, model: str | None
+                ) -> list[Condition]:
     tables = data.get("boundary", [])
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
         r.fail("boundary", "must be [[boundary]] tables")
@@ -318,9 +321,12 @@ def _conditions(r: _Reader, data: dict, dim: int, law: str | None) -> list[Condi
         follower = r.get(t, "follower", where, bool, default=False)
         if "follower" in t and kind != "pressure":
             r.fail(f"{where}.follower", "applies to a pressure only")
-        if follower and law is not None and not LAWS[law].finite_strain:
+        if follower and kind == "pressure" and law is not None and not LAWS[law].finite_strain:
             r.fail(f"{where}.follower", f"needs a finite-strain law ({law} is small strain: "
                                         f"its loads act on the undeformed body)")
+        if follower and kind == "pressure" and model == "plane_stress":
+            r.fail(f"{where}.follower", "not in plane stress (the thickness change is not "
+                                        "modelled): use plane_strain or 3d")
         if kind == "displacement":
             value = r.vector(t[kind], key, dim, free=True)
         elif kind == "traction":
@@ -335,6 +341,30 @@ def _conditions(r: _Reader, data: dict, dim: int, law: str | None) -> list[Condi
     if len(contact) > 1:
         r.fail(contact[1].key, "one contact group per case (the active-set loop takes one "
                                "surface)")
+    held = {}
+    for c in out:
+        if c.kind == "displacement":
+            for i, value in enumerate(c.value):
+                if value is not None and (c.group, i) in held:
+                    r.fail(c.key, f"component {i} of group {c.group!r} is already prescribed "
+                                  f"by {held[(c.group, i)]}")
+                elif value is not None:
+                    held[(c.group, i)] = c.key
+    if tables and not held and not contact:
+        r.fail("boundary", "no displacement or contact condition: nothing holds the body "
+                           "(it would move as a rigid body)")
+    if model == "axisymmetric":
+        for c in contact:
+            ob = c.value
+            if ob["obstacle"] == "sphere" and ob["center"][0] != 0:
+                r.fail(f"{c.key}.center", "axisymmetric: the sphere is centred on the axis "
+                                          "(r = 0); off the axis it would be a torus")
+            if ob["obstacle"] == "plane" and ob["normal"][0] != 0:
+                r.fail(f"{c.key}.normal", "axisymmetric: the plane is normal to the axis "
+                                          "(normal = [0, ±1]); tilted it would be a cone")
+            if ob["displacement"][0] != 0:
+                r.fail(f"{c.key}.displacement", "axisymmetric: the obstacle moves along the "
+                                                "axis only")
     return out
 
 

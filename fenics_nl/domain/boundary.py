@@ -29,15 +29,16 @@ def component(V: fem.FunctionSpace, i: int, facets: np.ndarray, value: float = 0
     return fem.dirichletbc(g, dofs, V.sub(i))
 
 
-def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np.ndarray]
-              ) -> dict[str, list[float]]:
+def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np.ndarray],
+              components: dict[str, list[int]] | None = None) -> dict[str, list[float]]:
     """Resultant force on each facet group: Σ R(u) over its nodes, per component.
 
     R = f_int − f_ext assembled without any Dirichlet row, at the current u: on a supported
     group it is the force the support exerts on the body (an axisymmetric residual carries
-    2πr, so this is the force on the whole revolution). A node shared by several groups (the
-    edge of a clamped bolt hole on a floor) counts in the first of them only: list the
-    groups that hold a node fully (clamped) first. Collective.
+    2πr, so this is the force on the whole revolution). `components`: the components each
+    group holds (default: all); the others are reported as 0. A node component held by
+    several groups (the edge of a clamped bolt hole on a floor) counts in the first of them
+    only: list the groups that hold a node fully (clamped) first. Collective.
     """
     from dolfinx.fem import petsc
     from mpi4py import MPI
@@ -52,13 +53,15 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
     R = b.array_r[: n_owned * bs].reshape(-1, bs).copy()
     b.destroy()
     fdim = V.mesh.topology.dim - 1
-    counted = np.zeros(n_owned, dtype=bool)
+    counted = np.zeros((n_owned, bs), dtype=bool)
     out = {}
     for name, facets in groups.items():
         nodes = fem.locate_dofs_topological(V, fdim, facets)
         nodes = nodes[nodes < n_owned]
-        nodes = nodes[~counted[nodes]]
-        counted[nodes] = True
-        total = R[nodes].sum(axis=0)
+        total = np.zeros(bs)
+        for i in (components or {}).get(name, range(bs)):
+            mine = nodes[~counted[nodes, i]]
+            counted[mine, i] = True
+            total[i] = R[mine, i].sum()
         out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]
     return out

@@ -83,21 +83,25 @@ class Material(ABC):
     def cauchy_stress(self, u, model: str = "3d"):
         """The Cauchy stress of the displacement `u` (3x3; 2x2 in plane stress)."""
 
-    def von_mises(self, u, model: str = "3d"):
-        """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u`, one value per cell (DG0 Function).
+    def von_mises_expression(self, u, model: str = "3d"):
+        """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u` (UFL).
 
         Plane stress: σ is embedded in 3D with σ_zz = 0 (the deviator is the 3D one).
         """
-        from dolfinx import fem
-
         sigma = self.cauchy_stress(u, model)
         if sigma.ufl_shape[0] == 2:
             sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0],
                                    [sigma[1, 0], sigma[1, 1], 0], [0, 0, 0]])
         s = ufl.dev(sigma)
+        return ufl.sqrt(1.5 * ufl.inner(s, s))
+
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq of the displacement `u`, one value per cell (DG0 Function, at the centroid)."""
+        from dolfinx import fem
+
         Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
         f = fem.Function(Q, name="von_mises")
-        f.interpolate(fem.Expression(ufl.sqrt(1.5 * ufl.inner(s, s)),
+        f.interpolate(fem.Expression(self.von_mises_expression(u, model),
                                      Q.element.interpolation_points))
         return f
 
