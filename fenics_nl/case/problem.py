@@ -216,6 +216,14 @@ class CaseProblem:
         self.solver = self._solver()
         return self.solver
 
+    def obstacle_now(self) -> dict:
+        """The contact obstacle at the current load factor (moved by t × its displacement)."""
+        ob = dict(self.contact[0].value)
+        w = float(self.t.value) * np.asarray(ob["displacement"])
+        key = "center" if ob["obstacle"] == "sphere" else "point"
+        ob[key] = (np.asarray(ob[key]) + w).tolist()
+        return ob
+
     def _solver(self):
         case = self.case
         method = {"quasi-newton": "bfgs"}.get(case.newton, case.newton)
@@ -307,9 +315,17 @@ class CaseProblem:
         return out
 
     def _stress_field(self) -> fem.Function:
-        """σ_eq in DG(degree), interpolated now (its Expression compiled once, collectively)."""
+        """σ_eq in DG(degree), interpolated now (its Expression compiled once, collectively).
+
+        Legendre variant: its interpolation points are inside the cells, so the hoop strain
+        u_r/r of the axisymmetric model is never evaluated on the axis (0/0 at r = 0).
+        """
         if not self._probe_stress:
-            Q = fem.functionspace(self.mesh, ("DG", self.case.degree))
+            import basix.ufl
+
+            el = basix.ufl.element("DG", self.mesh.basix_cell(), self.case.degree,
+                                   lagrange_variant=basix.LagrangeVariant.legendre)
+            Q = fem.functionspace(self.mesh, el)
             expr = self.material.von_mises_expression(self.u, self.model)
             self._probe_stress = {"field": fem.Function(Q),
                                   "expr": fem.Expression(expr, Q.element.interpolation_points)}

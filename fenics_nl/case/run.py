@@ -116,12 +116,16 @@ def write_outputs(problem: CaseProblem, folder: str | None, png: str | None):
                       for c in problem.case.conditions if c.kind == "traction" and any(c.value)}
             title = (f"{problem.case.path.name}: load factor {float(problem.t.value):.3g}, "
                      f"{problem.case.law}, {problem.case.model}")
-            focus = None
+            focus = obstacle = None
             if problem.contact is not None:
-                c = problem.solver.contact
-                focus = c.x[c.owned][c.active[c.owned]][:, : problem.case.dim]
-                title += f", {c.surface.count(c.active)} nodes in contact"
-            deformed_picture(problem.u, vm, png, title, marked, arrows, focus)
+                c, S = problem.solver.contact, problem.solver.contact.surface
+                axis = problem.contact[2]
+                moved = c.x.copy()  # the nodes in contact where they are now
+                moved[:, axis] += S.sign * S.normal_displacement(problem.u)
+                focus = moved[c.owned & c.active][:, : problem.case.dim]
+                obstacle = problem.obstacle_now()
+                title += f", {S.count(c.active)} nodes in contact"
+            deformed_picture(problem.u, vm, png, title, marked, arrows, focus, obstacle)
             say(f"wrote {png}")
         writers.append(picture)
     return writers

@@ -136,13 +136,16 @@ def _contact_status_view(pl, pv, warped, status, size) -> None:
 def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                      marked: dict[str, np.ndarray] | None = None,
                      arrows: dict[str, np.ndarray] | None = None,
-                     focus: np.ndarray | None = None) -> None:
+                     focus: np.ndarray | None = None, obstacle: dict | None = None) -> None:
     """The deformed body (2D or 3D) coloured by σ_eq over its undeformed outline.
 
     `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
     `arrows`: name → (this rank's points of a loaded group, the load's direction);
-    `focus`: this rank's points of what the picture is about (the nodes in contact): the
-    view is cut to a box 2.5 times their extent around them.
+    `focus`: this rank's points of what the picture is about (the nodes in contact, at
+    their deformed positions): the view is cut to a box 2.5 times their extent around
+    them, and they are drawn. `obstacle`: a rigid sphere (center, radius) or plane (point,
+    normal) at its current position, drawn; the body is then drawn at true scale, since
+    a magnified displacement would pass through the obstacle.
     The displacement is magnified until the largest motion is 5 % of the body (said in
     the picture). Collective; rank 0 writes `path`.
     """
@@ -176,13 +179,15 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
         points = {k: inside(v) for k, v in points.items()}
         loads = {k: (inside(x), d) for k, (x, d) in loads.items()}
     u_max = np.linalg.norm(disp, axis=1).max()
-    scale = max(1.0, 0.05 * size / max(u_max, 1e-300))
+    scale = 1.0 if obstacle else max(1.0, 0.05 * size / max(u_max, 1e-300))
     warped = mesh.warp_by_vector("u", factor=scale)
     flat = bool(np.ptp(grid.points[:, 2]) == 0)
     pl = pv.Plotter(off_screen=True, window_size=(1100, 850))
     if flat:  # the undeformed outline; cell edges only while they do not hide the colours
-        outline = mesh.extract_feature_edges(boundary_edges=True, feature_edges=False,
-                                             manifold_edges=False, non_manifold_edges=False)
+        # (clean: the gathered mesh repeats the nodes of partition interfaces)
+        merged = mesh.clean(tolerance=1e-9 * size)
+        outline = merged.extract_feature_edges(boundary_edges=True, feature_edges=False,
+                                               manifold_edges=False, non_manifold_edges=False)
         pl.add_mesh(outline, color="gray", line_width=1.5)
     else:
         pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.25)
@@ -204,6 +209,13 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
             pl.add_arrows(pts.mean(axis=0)[None, :], d[None, :],
                           mag=0.25 * size / np.linalg.norm(d), color="red")
             legend.append(f"red arrow: {name}")
+    if focus is not None and len(focus[0]):
+        pl.add_points(_as_3d(focus[0]), color="white", point_size=8,
+                      render_points_as_spheres=True)
+        legend.append("white dots: nodes in contact")
+    if obstacle:
+        _draw_obstacle(pl, pv, obstacle, flat, mesh.bounds)
+        legend.append(f"red: the rigid {obstacle['obstacle']}")
     if legend:
         pl.add_text("\n".join(legend), font_size=10, position="upper_right")
     if flat:
@@ -219,3 +231,30 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
 def _as_3d(points: np.ndarray) -> np.ndarray:
     """(n, 2) points in the plane z = 0 as (n, 3); (n, 3) unchanged."""
     return np.hstack([points, np.zeros((len(points), 3 - points.shape[1]))])
+
+
+def _draw_obstacle(pl, pv, ob: dict, flat: bool, bounds) -> None:
+    """A rigid sphere or plane, within the picture's bounds (a circle or a line in 2D)."""
+    lo, hi = np.array(bounds[::2]), np.array(bounds[1::2])
+    span = float(np.max(hi - lo))
+    if ob["obstacle"] == "sphere":
+        c = _as_3d(np.asarray(ob["center"], dtype=float)[None, :])[0]
+        if flat:  # the arc within the picture
+            t = np.linspace(0, 2 * np.pi, 4001)
+            ring = c + ob["radius"] * np.stack([np.cos(t), np.sin(t), 0 * t], axis=1)
+            near = np.all((ring >= lo - 0.1 * span) & (ring <= hi + 0.1 * span), axis=1)
+            if near.sum() > 1:
+                pl.add_mesh(pv.lines_from_points(ring[near]), color="red", line_width=3)
+        else:
+            pl.add_mesh(pv.Sphere(radius=ob["radius"], center=c, theta_resolution=60,
+                                  phi_resolution=60), color="red", opacity=0.35)
+        return
+    p0 = _as_3d(np.asarray(ob["point"], dtype=float)[None, :])[0]
+    n = _as_3d(np.asarray(ob["normal"], dtype=float)[None, :])[0]
+    n /= np.linalg.norm(n)
+    if flat:
+        d = np.array([-n[1], n[0], 0.0])
+        pl.add_mesh(pv.Line(p0 - span * d, p0 + span * d), color="red", line_width=3)
+    else:
+        pl.add_mesh(pv.Plane(center=p0, direction=n, i_size=2 * span, j_size=2 * span),
+                    color="red", opacity=0.35)
