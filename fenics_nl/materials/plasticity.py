@@ -1,0 +1,129 @@
+"""Von Mises (J2) plasticity, small strain, linear isotropic (H) and kinematic (C) hardening.
+
+The state of a load step is the committed plastic strain ε_pⁿ and cumulated plastic strain
+pⁿ at the quadrature points. Over the step the material is the *incremental* (condensed)
+energy of the course: for the current strain ε,
+
+    ψ(ε) = min over Δε_p of  W(ε − ε_p) + H/2 p² + C/3 ε_p:ε_p + σ0 Δp,
+    ε_p = ε_pⁿ + Δε_p,  p = pⁿ + Δp,  Δp = √(2/3) |Δε_p|,
+
+with W Hooke's energy. For these hardenings the minimiser is the radial return in closed
+form: trial stress σ_tr = ∂W(ε − ε_pⁿ), relative deviator ξ = dev σ_tr − X, X = (2/3) C ε_pⁿ,
+f = √(3/2) |ξ| − (σ0 + H pⁿ); if f > 0, Δp = f / (3μ + H + C) along n = (3/2) ξ / |ξ|_eq.
+It is written in UFL, so σ = ∂ψ/∂ε (the minimiser's own variation vanishes: σ is the
+return-mapped stress) and the consistent tangent ∂²ψ/∂ε∂ε both come from UFL, not typed.
+
+The state is updated only by `commit(u)`, when a load step has converged: a cut step leaves
+it as it was, so there is nothing to restore. `bind(mesh, degree)` creates it; the residual
+must then integrate with `kinematics.quadrature_measure("dx", mesh, degree)`, the same rule.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import ufl
+
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import Isotropic, SmallStrain, check_range
+
+
+@dataclass(frozen=True, eq=False)
+class J2Plasticity(Isotropic, SmallStrain):
+    """J2 plasticity: yield stress σ0 > 0, isotropic hardening H ≥ 0, kinematic C ≥ 0.
+
+    H = C = 0 is perfect plasticity. Models: 3D, plane strain, axisymmetric (3x3 strains);
+    plane stress needs its own return mapping and is refused.
+    """
+
+    sigma0: float = 1.0
+    H: float = 0.0
+    C: float = 0.0
+    _state: dict | None = field(default=None, repr=False, compare=False)
+
+    path_dependent = True
+
+    def __post_init__(self):
+        super().__post_init__()
+        check_range("sigma0", self.sigma0, 0.0, math.inf)
+        for name in ("H", "C"):
+            value = float(getattr(self, name))
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be >= 0 and finite, got {getattr(self, name)!r}")
+
+    def bind(self, mesh, degree: int) -> None:
+        """Create the state (zero) at the quadrature points of `degree` on `mesh`."""
+        import basix.ufl
+        from dolfinx import fem
+
+        cell = mesh.basix_cell()
+        T = fem.functionspace(mesh, basix.ufl.quadrature_element(
+            cell, value_shape=(3, 3), scheme="default", degree=degree))
+        S = fem.functionspace(mesh, basix.ufl.quadrature_element(
+            cell, value_shape=(), scheme="default", degree=degree))
+        state = {"eps_p": fem.Function(T, name="plastic_strain"),
+                 "p": fem.Function(S, name="cumulated_plastic_strain"),
+                 "points": T.element.interpolation_points, "commit": None}
+        object.__setattr__(self, "_state", state)  # the parameters stay frozen
+
+    @property
+    def plastic_strain(self):
+        """The committed plastic strain ε_p (quadrature Function, 3x3)."""
+        return self._bound()["eps_p"]
+
+    @property
+    def cumulated_plastic_strain(self):
+        """The committed cumulated plastic strain p (quadrature Function)."""
+        return self._bound()["p"]
+
+    def _bound(self) -> dict:
+        if self._state is None:
+            raise ValueError("J2Plasticity has no state: call bind(mesh, quadrature degree) "
+                             "before writing a form with it")
+        return self._state
+
+    def return_map(self, eps):
+        """(ε_p, p, Δp) at the strain ε from the committed state (UFL, radial return)."""
+        self.require_3x3(eps)
+        st = self._bound()
+        eps_p_n, p_n = st["eps_p"], st["p"]
+        mu, lmbda = self.mu, self.lmbda
+        eps_e = eps - eps_p_n
+        xi = ufl.dev(lmbda * ufl.tr(eps_e) * ufl.Identity(3) + 2 * mu * eps_e) \
+            - 2.0 / 3.0 * self.C * eps_p_n
+        q = ufl.sqrt(1.5 * ufl.inner(xi, xi))
+        f = q - (self.sigma0 + self.H * p_n)
+        plastic = ufl.gt(f, 0)
+        dp = ufl.conditional(plastic, f / (3 * mu + self.H + self.C), 0)
+        # the direction only where it is defined (q > 0 there): no 0/0 in the elastic branch
+        n = ufl.conditional(plastic, 1.5 * xi / q, ufl.zero(3, 3))
+        return eps_p_n + dp * n, p_n + dp, dp
+
+    def energy(self, eps):
+        """ψ(ε): the step's condensed energy at the return-mapped state."""
+        eps_p, p, dp = self.return_map(eps)
+        eps_e = eps - eps_p
+        return (0.5 * self.lmbda * ufl.tr(eps_e) ** 2 + self.mu * ufl.inner(eps_e, eps_e)
+                + 0.5 * self.H * p**2 + self.C / 3.0 * ufl.inner(eps_p, eps_p)
+                + self.sigma0 * dp)
+
+    def commit(self, u, model: str = "3d") -> None:
+        """Store the return-mapped state of the displacement `u` (a converged step).
+
+        The update is compiled for the first `u` given: one displacement per bound material.
+        """
+        from dolfinx import fem
+
+        st = self._bound()
+        if st["commit"] is None:  # compiled once
+            eps_p, p, _ = self.return_map(kinematics.small_strain(u, model))
+            st["commit"] = (fem.Expression(eps_p, st["points"]), fem.Expression(p, st["points"]))
+        new_eps_p, new_p = st["commit"]
+        # evaluate both before storing: each reads the committed state
+        a = fem.Function(st["eps_p"].function_space)
+        a.interpolate(new_eps_p)
+        b = fem.Function(st["p"].function_space)
+        b.interpolate(new_p)
+        st["eps_p"].x.array[:] = a.x.array
+        st["p"].x.array[:] = b.x.array

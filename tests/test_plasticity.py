@@ -1,0 +1,140 @@
+"""J2 plasticity: parameters, a homogeneous uniaxial path against the closed form, the
+consistent tangent's Taylor test in the plastic regime."""
+
+import math
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from dolfinx.fem import petsc
+from mpi4py import MPI
+
+from fenics_nl.domain import boundary
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.solvers.newton import NewtonSolver
+
+E, NU, S0 = 1000.0, 0.3, 1.0
+EPS_Y = S0 / E
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    ({"sigma0": 0.0}, "sigma0 must be in"), ({"sigma0": -1.0}, "sigma0 must be in"),
+    ({"H": -1.0}, "H must be >= 0"), ({"C": -0.5}, "C must be >= 0"),
+    ({"H": math.nan}, "H must be >= 0"), ({"sigma0": math.nan}, "sigma0 must be in"),
+])
+def test_bad_parameters_name_themselves(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        J2Plasticity(E, NU, **{"sigma0": S0, **kwargs})
+
+
+def test_plane_stress_is_refused():
+    m = mesh.create_unit_square(MPI.COMM_WORLD, 1, 1)
+    law = J2Plasticity(E, NU, sigma0=S0)
+    law.bind(m, 2)
+    u = fem.Function(fem.functionspace(m, ("Lagrange", 1, (2,))))
+    with pytest.raises(ValueError, match="plane-stress"):
+        law.stress(kinematics.small_strain(u, "plane_stress"))
+
+
+class Bar:
+    """A unit cube in uniaxial stress: u_i = 0 on the planes x_i = 0, u_x = e on x = 1."""
+
+    def __init__(self, law, n=1):
+        self.mesh = m = mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n)
+        V = fem.functionspace(m, ("Lagrange", 1, (3,)))
+        self.u = fem.Function(V)
+        law.bind(m, 2)
+        self.law = law
+        dx = kinematics.quadrature_measure("dx", m, 2)
+        v = ufl.TestFunction(V)
+        self.residual = law.internal_work(self.u, v) * dx
+        facets = [mesh.locate_entities_boundary(m, 2, lambda x, i=i: np.isclose(x[i], 0))
+                  for i in range(3)]
+        end = mesh.locate_entities_boundary(m, 2, lambda x: np.isclose(x[0], 1))
+        self.pull = boundary.component(V, 0, end, 0.0)
+        bcs = [boundary.component(V, i, f) for i, f in enumerate(facets)] + [self.pull]
+        self.solver = NewtonSolver(self.residual, self.u, bcs, rtol=1e-13, atol=1e-13,
+                                   force_scale=S0, max_it=20, prefix=f"bar{id(self)}_")
+        self.stress = fem.form(law.stress(kinematics.small_strain(self.u))[0, 0] * dx)
+
+    def go(self, strains):
+        """σ_xx after each of the prescribed end strains (one load step each)."""
+        out, previous = [], 0.0
+        for e in strains:
+            def load(t, a=previous, b=e):
+                self.pull.g.x.array[:] = a + t * (b - a)
+
+            solve_incrementally(self.solver, load, 1, adaptive=False, predictor=False,
+                                commit=lambda: self.law.commit(self.u))
+            out.append(self.mesh.comm.allreduce(fem.assemble_scalar(self.stress)))
+            previous = e
+        return np.array(out)
+
+
+def uniaxial(strains, H, C):
+    """The 1D closed form: backward-Euler radial return, exact for linear hardening."""
+    eps_p = p = 0.0
+    out = []
+    for e in strains:
+        trial = E * (e - eps_p)
+        xi = trial - C * eps_p
+        f = abs(xi) - (S0 + H * p)
+        if f > 0:
+            dp = f / (E + H + C)
+            eps_p += dp * math.copysign(1.0, xi)
+            p += dp
+        out.append(E * (e - eps_p))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("H,C", [(100.0, 0.0), (0.0, 100.0), (50.0, 50.0), (0.0, 0.0)])
+def test_uniaxial_load_unload_reverse_is_the_closed_form(H, C):
+    # up to 3 ε_y, back to 0, on to −3 ε_y: yield, elastic unloading, reverse yield
+    strains = EPS_Y * np.array([0.5, 1.5, 2.0, 3.0, 2.0, 1.0, 0.0, -1.0, -2.0, -3.0])
+    bar = Bar(J2Plasticity(E, NU, sigma0=S0, H=H, C=C))
+    sigma = bar.go(strains)
+    assert sigma == pytest.approx(uniaxial(strains, H, C), rel=1e-10, abs=1e-10 * S0)
+    # the peak against the continuous closed form σ0 + E_t (ε − ε_y)
+    E_t = E * (H + C) / (E + H + C)
+    assert sigma[3] == pytest.approx(S0 + E_t * (3 * EPS_Y - EPS_Y), rel=1e-10)
+    if H == 0 and C > 0:  # Bauschinger: reverse yield 2σ0 below the peak
+        assert sigma[4] - sigma[3] == pytest.approx(-E * EPS_Y, rel=1e-10)  # elastic
+        reverse = sigma[3] - 2 * S0
+        assert sigma[6] == pytest.approx(reverse + E_t * (0.0 - (3 * EPS_Y - 2 * EPS_Y)),
+                                         rel=1e-9)
+
+
+def test_consistent_tangent_taylor_slope_two_in_the_plastic_regime():
+    law = J2Plasticity(E, NU, sigma0=S0, H=30.0, C=20.0)
+    bar = Bar(law, n=2)
+    bar.go([1.5 * EPS_Y, 3.0 * EPS_Y])  # committed plastic state
+    bar.pull.g.x.array[:] = 4.0 * EPS_Y  # and a plastic step from it
+    bar.solver.solve()
+    rng = np.random.default_rng(1)
+    u0 = bar.u.x.array.copy()
+    du = fem.Function(bar.u.function_space)
+    du.x.array[:] = EPS_Y * 0.05 * rng.standard_normal(du.x.array.size)
+    R, K = fem.form(bar.residual), fem.form(ufl.derivative(bar.residual, bar.u))
+
+    def residual_at(h):
+        bar.u.x.array[:] = u0 + h * du.x.array
+        b = petsc.assemble_vector(R)
+        b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
+        return b
+
+    r0 = residual_at(0.0)
+    A = petsc.assemble_matrix(K)
+    A.assemble()
+    Kdu = r0.duplicate()
+    A.mult(du.x.petsc_vec, Kdu)
+    errs = []
+    for h in (1e-2, 5e-3, 2.5e-3, 1.25e-3):
+        rh = residual_at(h)
+        rh.axpy(-1.0, r0)
+        rh.axpy(-h, Kdu)
+        errs.append(rh.norm())
+    slopes = np.diff(np.log(errs)) / np.diff(np.log([1e-2, 5e-3, 2.5e-3, 1.25e-3]))
+    assert np.all(slopes > 1.9), (errs, slopes)
