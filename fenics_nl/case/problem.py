@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import ufl
-from dolfinx import fem, geometry
+from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
@@ -19,6 +19,7 @@ from fenics_nl.case.mesh import load_mesh
 from fenics_nl.case.spec import Case, CaseError, Condition
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.domain import boundary
+from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.solvers.newton import NewtonSolver
@@ -55,7 +56,6 @@ class CaseProblem:
         self.bcs, self._prescribed = self._dirichlet()
         self.contact = self._contact()
         self.supports, self.held = self._supports()
-        self._probe_stress = {}  # σ_eq for the probes: its DG field and Expression
         self.solver = None  # make_solver(): compiling the forms is for a run, not a check
 
     # -- the pieces ---------------------------------------------------------------------
@@ -272,66 +272,20 @@ class CaseProblem:
         return self.material.von_mises(self.u, self.model)
 
     def _locate_probes(self):
-        """Where every probe is, and a line for every probe outside the mesh.
-
-        Each probe: (name, point, the lowest rank holding it, this rank's cells holding it,
-        the owned ones among them).
-        """
-        comm, msh = self.mesh.comm, self.mesh
-        tdim = msh.topology.dim
-        tree = geometry.bb_tree(msh, tdim)
-        n_owned = msh.topology.index_map(tdim).size_local
-        out, problems = [], []
-        for p in self.case.probes:
-            x = np.zeros((1, 3))
-            x[0, : len(p.point)] = p.point
-            cells = geometry.compute_colliding_cells(
-                msh, geometry.compute_collisions_points(tree, x), x).links(0)
-            # the lowest rank holding the point gives the displacement (continuous)
-            owner = comm.allreduce(comm.rank if len(cells) else comm.size, MPI.MIN)
-            if owner == comm.size:
-                problems.append(f"{p.key}: {p.point} is outside the mesh")
-            out.append((p.name, x, owner, np.asarray(cells, dtype=np.int32),
-                        [int(c) for c in cells if c < n_owned]))
-        return out, problems
+        """The probes located in the mesh, and a line for each one outside it."""
+        probes = Probes(self.mesh, [p.point for p in self.case.probes])
+        return probes, [f"{self.case.probes[i].key}: {self.case.probes[i].point} is outside "
+                        f"the mesh" for i in probes.outside]
 
     def probe_values(self) -> dict[str, dict]:
-        """Displacement and von Mises stress at every probe. Collective.
-
-        σ_eq is interpolated cell by cell into a discontinuous space of the displacement's
-        degree and evaluated at the point; on cell faces (a node, an edge) it is the mean
-        over the owned cells that hold the point: the same on any number of ranks.
-        """
-        comm, out = self.mesh.comm, {}
-        vm = self._stress_field()
-        for name, x, owner, cells, owned in self.probes:
-            value = None
-            if comm.rank == owner:
-                value = {"displacement": self.u.eval(x, cells[:1]).tolist()}
-            total = sum(float(vm.eval(x, np.array([c], dtype=np.int32))[0]) for c in owned)
-            value = comm.bcast(value, root=owner)
-            value["von_mises"] = comm.allreduce(total) / comm.allreduce(len(owned))
-            out[name] = value
-        return out
-
-    def _stress_field(self) -> fem.Function:
-        """σ_eq in DG(degree), interpolated now (its Expression compiled once, collectively).
-
-        Legendre variant: its interpolation points are inside the cells, so the hoop strain
-        u_r/r of the axisymmetric model is never evaluated on the axis (0/0 at r = 0).
-        """
-        if not self._probe_stress:
-            import basix.ufl
-
-            el = basix.ufl.element("DG", self.mesh.basix_cell(), self.case.degree,
-                                   lagrange_variant=basix.LagrangeVariant.legendre)
-            Q = fem.functionspace(self.mesh, el)
-            expr = self.material.von_mises_expression(self.u, self.model)
-            self._probe_stress = {"field": fem.Function(Q),
-                                  "expr": fem.Expression(expr, Q.element.interpolation_points)}
-        f = self._probe_stress["field"]
-        f.interpolate(self._probe_stress["expr"])
-        return f
+        """Displacement and von Mises stress at every probe (see `domain.probes`)."""
+        if not self.case.probes:
+            return {}
+        u = self.probes.continuous(self.u)
+        vm = self.probes.discontinuous(
+            "von_mises", self.material.von_mises_expression(self.u, self.model), self.case.degree)
+        return {p.name: {"displacement": d, "von_mises": s}
+                for p, d, s in zip(self.case.probes, u, vm, strict=True)}
 
 
 class ContactSteps:

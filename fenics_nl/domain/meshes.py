@@ -92,3 +92,35 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
         gmsh.model.remove()
     data.mesh.geometry.x[:] *= unit
     return data
+
+
+def quarter_annulus(comm: MPI.Comm, a: float, b: float, size: float, order: int = 2
+                    ) -> gmshio.MeshData:
+    """The quarter a < |x| < b, x, y ≥ 0, triangles of `size`, curved edges of `order`.
+
+    Physical groups: ``inner`` (|x| = a), ``outer`` (|x| = b), ``x0`` (x = 0), ``y0``
+    (y = 0), ``body``. For a sphere in the axisymmetric model (x = r, y = z) or a cylinder
+    in plane strain. Meshed in units of `a` (gmsh's tolerances are absolute), scaled back.
+    """
+    if comm.rank == 0:
+        start_model("annulus")
+        g = gmsh.model.geo
+        s, B = size / a, b / a
+        o = g.addPoint(0, 0, 0, s)
+        p = [g.addPoint(1, 0, 0, s), g.addPoint(B, 0, 0, s), g.addPoint(0, B, 0, s),
+             g.addPoint(0, 1, 0, s)]
+        curves = [g.addLine(p[0], p[1]), g.addCircleArc(p[1], o, p[2]), g.addLine(p[2], p[3]),
+                  g.addCircleArc(p[3], o, p[0])]
+        surface = g.addPlaneSurface([g.addCurveLoop(curves)])
+        g.synchronize()
+        for tag, (curve, name) in enumerate(zip(curves, ("y0", "outer", "x0", "inner"),
+                                                strict=True), start=1):
+            gmsh.model.addPhysicalGroup(1, [curve], tag, name=name)
+        gmsh.model.addPhysicalGroup(2, [surface], 1, name="body")
+        gmsh.option.setNumber("Mesh.ElementOrder", order)
+        gmsh.model.mesh.generate(2)
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    data.mesh.geometry.x[:] *= a
+    return data
