@@ -51,6 +51,7 @@ def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
 
 
 @pytest.mark.parametrize("name", ["newton_scalar.py", "punch.py", "buckling_beam.py",
+                                  "pressure_vessel.py",
                                   "bracket.py"])
 def test_help_describes_the_demo_and_states_defaults_once(demo, name):
     text = demo.run([name, "--help"]).stdout

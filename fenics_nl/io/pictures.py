@@ -136,8 +136,9 @@ def _contact_status_view(pl, pv, warped, status, size) -> None:
 def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                      marked: dict[str, np.ndarray] | None = None,
                      arrows: dict[str, np.ndarray] | None = None,
-                     focus: np.ndarray | None = None, obstacle: dict | None = None) -> None:
-    """The deformed body (2D or 3D) coloured by σ_eq over its undeformed outline.
+                     focus: np.ndarray | None = None, obstacle: dict | None = None,
+                     label: str = "von Mises stress") -> None:
+    """The deformed body (2D or 3D) coloured by σ_eq (or the `label`led cell field `vm`).
 
     `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
     `arrows`: name → (this rank's points of a loaded group, the load's direction);
@@ -193,7 +194,7 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
         pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.25)
     pl.add_mesh(warped, scalars="vm", cmap="turbo", show_edges=flat and mesh.n_cells < 3000,
                 edge_color="white", line_width=0.2, scalar_bar_args={
-                    "title": "von Mises stress", "vertical": False, "position_x": 0.2,
+                    "title": label, "vertical": False, "position_x": 0.2,
                     "position_y": 0.03, "width": 0.6, "fmt": "%.3g"})
     colours = ["black", "magenta", "blue", "orange", "green", "brown"]
     legend = []

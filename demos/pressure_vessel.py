@@ -1,0 +1,316 @@
+# # A thick pressure vessel in J2 plasticity: yield onset, plastic zone, limit load
+#
+# A hollow sphere (or a long cylinder) of radii $a < b$ is loaded by an internal pressure
+# $p$ past its yield onset, towards its limit load, and unloaded. The material is von Mises
+# plasticity (perfect by default), whose state at the quadrature points is committed when a
+# load step converges.
+#
+# ## Problem definition
+#
+# Sphere, perfect plasticity (exact for every $\nu$): the inner surface yields at
+# $p_e = \tfrac{2\sigma_0}{3}(1 - a^3/b^3)$; the plastic zone $a < r < c$ grows with
+#
+# $$ p = 2\sigma_0 \ln\frac{c}{a} + \frac{2\sigma_0}{3}\Big(1 - \frac{c^3}{b^3}\Big), $$
+#
+# until $c = b$ at the limit pressure $p_{lim} = 2\sigma_0 \ln(b/a)$; beyond it there is no
+# equilibrium. After unloading (elastic, if no reverse yielding) the residual stresses are
+# the loaded ones minus Lamé's elastic solution for the same pressure: at $r = a$,
+# $\sigma_\theta^{res} = \sigma_0 - p - p\,(b^3 + 2a^3)/(2(b^3 - a^3))$.
+# Cylinder in plane strain: $p_{lim} = \tfrac{2}{\sqrt3}\sigma_0 \ln(b/a)$ (exact); the yield
+# onset follows from Lamé with $\sigma_z = \nu(\sigma_r + \sigma_\theta)$; the closed-form
+# $c(p)$ assumes $\nu = 1/2$.
+#
+# ## Implementation
+
+# +
+import math
+import sys
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from fenics_nl.errors import SolveError
+from fenics_nl.io import cli, pictures
+from fenics_nl.io.cli import say
+from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.scenes.vessel import VesselBody
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.theory import vessels
+
+if __name__ == "__main__":  # `python demos/pressure_vessel.py [options]`: the cells below,
+    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
+
+comm = MPI.COMM_WORLD
+# -
+
+# ### Parameters
+#
+# From the command line (`python demos/pressure_vessel.py --help`); in a notebook, the
+# defaults. PETSc options take the prefix `-vessel_` (Newton's KSP).
+
+# +
+def parser():
+    """Every parameter of the scene, with its unit and default."""
+    p = cli.parser(
+        "Thick sphere or cylinder under internal pressure in J2 plasticity: yield onset, "
+        "plastic zone, limit load and residual stresses against the closed forms. Units are "
+        "the user's, consistent (e.g. N, mm, MPa).",
+        epilog="PETSc options take the prefix -vessel_ (e.g. -vessel_ksp_view).")
+    p.add_argument("--shape", choices=["sphere", "cylinder"], default="sphere",
+                   help="hollow sphere (axisymmetric) or long cylinder (plane strain)")
+    p.add_argument("--inner-radius", type=cli.positive, default=100.0, help="a [length]")
+    p.add_argument("--outer-radius", type=cli.positive, default=200.0, help="b [length]")
+    p.add_argument("--E", type=cli.positive, default=210e3, help="Young's modulus [stress]")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--sigma0", type=cli.positive, default=250.0, help="yield stress [stress]")
+    p.add_argument("--hardening", type=cli.finite, default=0.0,
+                   help="linear isotropic hardening modulus H [stress] (0: perfect)")
+    load = p.add_mutually_exclusive_group()
+    load.add_argument("--pressure-ratio", type=cli.positive, default=None,
+                      help="pressure control: final pressure / limit pressure (default 0.9)")
+    load.add_argument("--inner-displacement", type=cli.positive, default=None,
+                      help="displacement control: final radial displacement of the inner "
+                           "surface [length]; the pressure is read from its reaction")
+    p.add_argument("--unload", action="store_true", help="unload to zero afterwards")
+    p.add_argument("--steps", type=cli.at_least(1), default=10,
+                   help="load steps from the yield onset to the final load")
+    p.add_argument("--newton", choices=["full", "modified", "bfgs"], default="full",
+                   help="full: consistent tangent; modified: the elastic tangent, factorized "
+                        "once (the course's choice); bfgs: quasi-Newton")
+    p.add_argument("--size", type=cli.positive, default=None,
+                   help="element size [length] (default (b - a)/16)")
+    cli.add_outputs(p, png="the deformed quarter coloured by the cumulated plastic strain",
+                    plot="pressure against inner displacement, with the closed forms")
+    return p
+
+
+p = parser()
+args = cli.arguments(p, prefixes={"vessel_": "Newton's KSP"})
+a, b = args.inner_radius, args.outer_radius
+if not a < b:
+    p.error(f"--inner-radius must be below --outer-radius, got {a:g} and {b:g}")
+if args.hardening < 0:
+    p.error(f"--hardening must be >= 0, got {args.hardening:g}")
+if args.pressure_ratio is None and args.inner_displacement is None:
+    args.pressure_ratio = 0.9
+s0, shape = args.sigma0, args.shape
+p_lim = vessels.limit_pressure(shape, a, b, s0)
+p_e_exact = vessels.yield_onset_pressure(shape, a, b, s0, args.nu)
+# -
+
+# ### The body
+#
+# The quarter $a < |x| < b$ (P2 on curved edges), symmetric supports on its straight edges,
+# the inner surface loaded.
+
+body = VesselBody(shape, a, b, size=args.size)
+
+# ### The material
+#
+# J2 plasticity: the step's condensed energy around the closed-form radial return, in UFL
+# (`fenics_nl.materials.plasticity`); its state lives at the quadrature points of the
+# residual's rule.
+
+material = J2Plasticity(args.E, args.nu, sigma0=s0, H=args.hardening)
+material.bind(body.mesh, body.quadrature_degree)
+
+# ### The residual
+#
+# $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega
+# + \int_{r=a} p\,N \cdot v\,dS$ ($N$ the outward normal, into the cavity; $2\pi r$ in
+# both for the sphere).
+
+# +
+u, v = body.u, ufl.TestFunction(body.V)
+w = body.weight
+residual = (material.internal_work(u, v, body.model) * body.dx
+            + body.pressure * ufl.dot(body.normal, v) * w * body.ds_inner)
+# -
+
+# ### The solver
+#
+# Full Newton has the consistent tangent (UFL's derivative of the residual); modified
+# Newton keeps the elastic tangent of the first iteration, factorized once. The absolute
+# tolerance is relative to the limit load's force on the inner surface.
+
+# +
+control = "pressure" if args.inner_displacement is None else "displacement"
+bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
+force = p_lim * (math.pi * a * a if shape == "sphere" else a)
+solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
+                      force_scale=force, max_it=50 if args.newton == "full" else 500,
+                      prefix="vessel_")
+# -
+
+# ### Yield onset
+#
+# One elastic step at half the closed-form onset (any elastic load would do: σ_eq grows in
+# proportion) gives σ_eq at the inner surface per unit pressure, hence $p_e$.
+
+# +
+p1 = 0.5 * p_e_exact
+body.pressure.value = p1
+NewtonSolver(residual, u, body.supports, rtol=1e-10, atol=1e-10, force_scale=force,
+             prefix="vessel_onset_").solve()
+vm_a, _ = body.stresses_at_inner(material)
+if vm_a >= s0:
+    raise SolveError(f"the onset step yielded (σ_eq(a) = {vm_a:.4g} >= σ0): it must be elastic")
+p_e = p1 * s0 / vm_a
+u.x.array[:] = 0.0
+body.pressure.value = 0.0
+say(f"{shape}, a = {a:g}, b = {b:g}, {body.dofs} unknowns; yield onset p_e = {p_e:.6g} "
+    f"(closed form {p_e_exact:.6g}), limit {p_lim:.6g}")
+# -
+
+# ### Load steps
+#
+# Pressure control from 0 to the final pressure (or displacement control of the inner
+# surface); each converged step commits the plastic state. Past the limit load a pressure
+# has no equilibrium: the run stops there, saying so.
+
+# +
+path = [(0.0, 0.0)]
+
+
+def record(t, result):
+    pressure = (float(body.pressure.value) if control == "pressure"
+                else body.pressure_from(residual))
+    path.append((pressure, body.inner_displacement()))
+    say(f"  step {len(path) - 1}: p = {pressure:.6g} ({pressure / p_lim:.4f} p_lim), "
+        f"u(a) = {path[-1][1]:.6g}, {result.iterations} Newton iterations")
+
+
+def commit():
+    material.commit(u, body.model)
+
+
+if control == "pressure":
+    target = args.pressure_ratio * p_lim
+
+    def load(t):
+        body.pressure.value = t * target
+else:
+    target = args.inner_displacement
+
+    def load(t):
+        body.move_inner(t * target)
+
+try:
+    run = solve_incrementally(solver, load, args.steps, max_step=1.0 / args.steps,
+                              on_step=record, commit=commit)
+except LoadStepError as err:
+    last = path[-1][0]
+    raise SolveError(f"the limit load was reached: no equilibrium beyond p = {last:.6g} "
+                     f"({last / p_lim:.4f} of the limit pressure {p_lim:.6g}); asked "
+                     f"{target:.6g}" if control == "pressure" else str(err)) from err
+pressure, inner = path[-1]
+c_fe = body.plastic_radius(material)
+c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
+say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "
+    f"(closed form {c_exact:.5g}{', for ν = 1/2' if shape == 'cylinder' else ''}; "
+    f"h = {body.h:.3g})")
+# -
+
+# ### Unloading
+#
+# Back to zero pressure in the same number of steps (elastic when nothing yields in
+# reverse): the residual hoop stress at the inner surface, against the closed form.
+
+# +
+residual_hoop = None
+if args.unload:
+    loaded = pressure
+    if control == "displacement":
+        bcs.remove(body.inner_motion)
+        solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
+                              force_scale=force, max_it=500, prefix="vessel_")
+        control = "pressure"
+
+    def unload(t):
+        body.pressure.value = (1 - t) * loaded
+
+    body.pressure.value = loaded
+    back = solve_incrementally(solver, unload, args.steps, max_step=1.0 / args.steps,
+                               on_step=record, commit=commit)
+    run.work.add(back.work)
+    run.results.extend(back.results)
+    residual_hoop = body.stresses_at_inner(material)[1]
+    say(f"unloaded: permanent u(a) = {path[-1][1]:.6g}, residual hoop stress at r = a "
+        f"{residual_hoop:.6g}" + (f" (closed form "
+                                  f"{vessels.residual_hoop_stress_inner(a, b, s0, loaded):.6g}"
+                                  f", if nothing yields in reverse)"
+                                  if shape == "sphere" and args.hardening == 0 else ""))
+# -
+
+# ## Outputs
+
+
+def summary():
+    """The quantities of the run, for --json."""
+    out = {"shape": shape, "control": control, "newton": args.newton,
+           "yield_onset_pressure": p_e, "yield_onset_pressure_exact": p_e_exact,
+           "limit_pressure_exact": p_lim, "pressure": pressure,
+           "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": body.h,
+           "inner_displacement": inner,
+           "newton_iterations": run.iterations, "factorizations": run.work.factorizations,
+           "path": [{"pressure": q, "inner_displacement": d} for q, d in path],
+           "dofs": body.dofs, "ranks": comm.size, "warnings": []}
+    if shape == "cylinder":
+        out["warnings"].append("cylinder: the closed-form plastic radius assumes ν = 1/2")
+    if args.hardening > 0:
+        out["warnings"].append("hardening: the closed forms are for perfect plasticity")
+    if residual_hoop is not None:
+        out["residual_hoop_stress_inner"] = residual_hoop
+        out["permanent_inner_displacement"] = path[-1][1]
+        exact = vessels.residual_hoop_stress_inner(a, b, s0, loaded)
+        if shape == "sphere" and args.hardening == 0 and abs(exact) <= s0:
+            out["residual_hoop_stress_inner_exact"] = exact
+        elif shape == "sphere":
+            out["warnings"].append("the unloading yields in reverse (|σ_θ| would exceed σ0 at "
+                                   "r = a, p > 2 p_e): the elastic-unloading closed form "
+                                   "does not apply")
+    return out
+
+
+def plot():
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    q, d = np.array(path).T
+    ax.plot(d, q / p_lim, "o-", ms=3, label="FE (J2)")
+    ax.axhline(1.0, color="k", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
+    ax.axhline(p_e_exact / p_lim, color="gray", ls=":", lw=1, label="yield onset")
+    ax.set_xlabel("inner radial displacement u(a) [length]")
+    ax.set_ylabel("p / p_lim")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title(f"{shape}, b/a = {b / a:g}: p = {pressure / p_lim:.3f} p_lim, plastic radius "
+                 f"{c_fe:.4g} (closed form {c_exact:.4g})", fontsize=9)
+    pictures.save_figure(fig, args.plot)
+
+
+def picture():
+    """The deformed quarter coloured by the largest cumulated plastic strain of each cell."""
+    from dolfinx import fem
+
+    pq = material.cumulated_plastic_strain
+    n_cells = body.mesh.topology.index_map(2).size_local
+    per_cell = pq.x.array[: pq.function_space.dofmap.index_map.size_local]
+    Q0 = fem.functionspace(body.mesh, ("DG", 0))
+    cells = fem.Function(Q0, name="cumulated_plastic_strain")
+    cells.x.array[:n_cells] = per_cell.reshape(n_cells, -1).max(axis=1)
+    pictures.deformed_picture(
+        u, cells, args.png, f"{shape}: p = {pressure / p_lim:.3f} p_lim, plastic radius "
+        f"{c_fe:.4g} (closed form {c_exact:.4g})", label="cumulated plastic strain")
+    say(f"wrote {args.png}")
+
+
+writers = ([plot] if args.plot else []) + ([picture] if args.png else [])
+cli.results(summary(), writers)
