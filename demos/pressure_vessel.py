@@ -136,7 +136,8 @@ residual = (material.internal_work(u, v, body.model) * body.dx
 # ### The solver
 #
 # Full Newton has the consistent tangent (UFL's derivative of the residual); modified
-# Newton keeps the elastic tangent of the first iteration, factorized once. The absolute
+# Newton (and BFGS's base) is the course's choice, the elastic tangent K(0), factorized once
+# for the whole run. The absolute
 # tolerance is relative to the limit load's force on the inner surface.
 
 # +
@@ -145,7 +146,7 @@ bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
 solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
                       force_scale=force, max_it=50 if args.newton == "full" else 500,
-                      prefix="vessel_")
+                      constant_tangent="elastic", prefix="vessel_")
 # -
 
 # ### Yield onset
@@ -229,7 +230,8 @@ if args.unload:
     if control == "displacement":
         bcs.remove(body.inner_motion)
         solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
-                              force_scale=force, max_it=500, prefix="vessel_")
+                              force_scale=force, max_it=500, constant_tangent="elastic",
+                              prefix="vessel_")
         control = "pressure"
 
     def unload(t):

@@ -327,3 +327,20 @@ def test_the_console_script_is_installed(tmp_path):
     script = Path(sys.executable).parent / "fenics-nl"
     proc = subprocess.run([script, "--help"], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and "[[boundary]]" in proc.stdout
+
+
+def test_j2_bar_loaded_and_unloaded_keeps_its_permanent_strain(tmp_path, demo):
+    # traction 1.5 σ0 with hardening H, then 0: ε_p = (σ − σ0)(1/E_t − 1/E), E_t = EH/(E + H)
+    write(tmp_path, "bar.geo", BAR_GEO)
+    text = BAR.replace('law = "linear-elastic"\nE = 1000.0\nnu = 0.25',
+                       'law = "j2"\nE = 1000.0\nnu = 0.25\nsigma0 = 40.0\nH = 100.0\nC = 0.0')
+    text = text.replace("traction = [50.0, 0.0, 0.0]", "traction = [60.0, 0.0, 0.0]")
+    text = text.replace("steps = 2", "steps = [0.5, 1.0, 0.0]")
+    d = demo.case(write(tmp_path, "j2.toml", text))
+    E_t = 1000.0 * 100.0 / 1100.0
+    loaded = 40.0 / 1000.0 + 20.0 / E_t
+    permanent = 20.0 * (1 / E_t - 1 / 1000.0)
+    ux = [s["probes"]["corner"]["displacement"][0] for s in d["steps"]]
+    assert [s["load_factor"] for s in d["steps"]] == [0.5, 1.0, 0.0]
+    assert ux == pytest.approx([10 * 30.0 / 1000.0, 10 * loaded, 10 * permanent], rel=1e-9)
+    assert d["reactions"]["x0"][0] == pytest.approx(0.0, abs=1e-9 * 60)

@@ -51,6 +51,8 @@ class CaseProblem:
         self.dx = kinematics.quadrature_measure("dx", msh, q)
         self.ds = kinematics.quadrature_measure("ds", msh, q + 1, subdomain_data=tags)
         self.weight = kinematics.measure_weight(msh, self.model)
+        if getattr(self.material, "path_dependent", False):  # its state on dx's points
+            self.material.bind(msh, q)
         self.residual = self._residual(data)
         self.force_scale = self._load_magnitude(data)
         self.bcs, self._prescribed = self._dirichlet()

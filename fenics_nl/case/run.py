@@ -23,6 +23,11 @@ def solve_case(problem: CaseProblem) -> dict:
     case, steps, work = problem.case, [], WorkCounts()
     solver = problem.make_solver()
 
+    commit = None
+    if getattr(problem.material, "path_dependent", False):  # committed when a step converges
+        def commit():
+            problem.material.commit(problem.u, case.model)
+
     def show(message):  # step cuts; the converged steps are reported by step_record
         if not message.startswith("step "):
             say("  " + message)
@@ -30,7 +35,7 @@ def solve_case(problem: CaseProblem) -> dict:
     if case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
         path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
-                                   max_step=1.0 / n, progress=show,
+                                   max_step=1.0 / n, progress=show, commit=commit,
                                    on_step=lambda t, r: steps.append(step_record(problem, t, r)))
         work.add(path.work)
     else:  # from factor to factor, each segment one step (cut in half on failure)
@@ -43,7 +48,7 @@ def solve_case(problem: CaseProblem) -> dict:
                 steps.append(step_record(problem, b if s == 1 else a + s * (b - a), result))
 
             path = solve_incrementally(solver, load, 1, adaptive=case.adaptive,
-                                       on_step=record, progress=show)
+                                       on_step=record, progress=show, commit=commit)
             work.add(path.work)
             previous = target
     last = steps[-1]

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from fenics_nl.materials import laws
+from fenics_nl.materials.plasticity import J2Plasticity
 
 FORMAT = """\
 [mesh]
@@ -24,9 +25,9 @@ model = "plane_strain"   # 3d | plane_strain | plane_stress | axisymmetric (x = 
 degree = 2               # Lagrange degree of the displacement (default 1)
 
 [material]
-law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean
-E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n
-nu = 0.3
+law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
+E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
+nu = 0.3                 # Mises plasticity) also sigma0, H (isotropic), C (kinematic hardening)
 
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
@@ -70,6 +71,7 @@ LAWS: dict[str, type[laws.Material]] = {
     "power-law": laws.PowerLaw,
     "saint-venant-kirchhoff": laws.StVenantKirchhoff,
     "neo-hookean": laws.NeoHookean,
+    "j2": J2Plasticity,
 }
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "quasi-newton", "snes")
@@ -279,20 +281,21 @@ def _material(r: _Reader, data: dict, model: str | None):
     law = r.get(m, "law", "material", str, required=True, choices=tuple(LAWS))
     if law is None:
         return None, {}
-    accepted = tuple(f.name for f in fields(LAWS[law]))
+    params = [f for f in fields(LAWS[law]) if not f.name.startswith("_")]  # not the state
+    accepted = tuple(f.name for f in params)
     r.unknown(m, "material", ("law", *accepted))
     parameters = {}
-    for f in fields(LAWS[law]):  # every parameter, even one the class defaults: say it
+    for f in params:  # every parameter, even one the class defaults: say it
         value = r.get(m, f.name, "material", float, required=True)
         if value is not None:
             parameters[f.name] = value
-    if len(parameters) == len(fields(LAWS[law])):
+    if len(parameters) == len(params):
         try:
             LAWS[law](**parameters)
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5), ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"material.{name}" if name in parameters else "material", rest or name)
-    if law in ("neo-hookean", "power-law") and model == "plane_stress":
+    if law in ("neo-hookean", "power-law", "j2") and model == "plane_stress":
         r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters
