@@ -42,6 +42,7 @@ from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket, BracketPart
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
@@ -93,9 +94,9 @@ def parser():
                    help="a .msh file with groups bolts, load, base (in --units; not with --size)")
     p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
                    help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
-    p.add_argument("--material", choices=["power-law", "linear"], default="power-law",
-                   help="the power law below, or linear elasticity (E, nu): one Newton "
-                        "iteration per load step")
+    p.add_argument("--material", choices=["power-law", "j2", "linear"], default="power-law",
+                   help="the power law below; j2: von Mises plasticity (sigma0, --hardening), "
+                        "path-dependent; or linear elasticity (E, nu)")
     p.add_argument("--E", type=cli.positive, default=None,
                    help="Young's modulus (default 200 GPa, in N/unit²)")
     p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
@@ -103,6 +104,11 @@ def parser():
                    help="power law: reference stress (default 200 MPa, in N/unit²)")
     p.add_argument("--n", type=cli.positive, default=None,
                    help="power law exponent [-] (default 0.2)")
+    p.add_argument("--hardening", type=cli.finite, default=None,
+                   help="j2: linear isotropic hardening modulus H (default 13 GPa: the power "
+                        "law's secant at its peak strain, 14 ε0; in N/unit²)")
+    p.add_argument("--unload", action="store_true",
+                   help="unload in as many steps after loading: the permanent displacement")
     cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
                               "floor pressure and active set",
                     png="deformed bracket coloured by von Mises stress, load and supports drawn",
@@ -123,7 +129,19 @@ if args.mesh and args.size is not None:
     p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
 mm = MM[args.units]
 args.E = args.E if args.E is not None else 200e3 / mm**2
-cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
+if args.material == "j2":
+    if args.n is not None:
+        p.error("--n sets the power law, not --material j2")
+    args.sigma0 = args.sigma0 if args.sigma0 is not None else 200.0 / mm**2
+    args.hardening = args.hardening if args.hardening is not None else 13e3 / mm**2
+    if args.hardening < 0:
+        p.error(f"--hardening must be >= 0, got {args.hardening:g}")
+else:
+    if args.hardening is not None:
+        p.error("--hardening sets --material j2")
+    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
+if args.unload and args.compare:
+    p.error("--unload goes with one --newton, not --compare")
 if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
     p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
             f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
@@ -149,8 +167,13 @@ part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
 # The power law's energy $\varphi(\varepsilon)$ (or Hooke's); $\sigma$ and the tangent are
 # its derivatives, taken by UFL.
 
-material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
-            if args.material == "power-law" else LinearElastic(args.E, args.nu))
+if args.material == "j2":  # its state lives at the quadrature points of the residual's rule
+    material = J2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
+    material.bind(part.mesh, part.quadrature_degree)
+else:
+    material = (PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n)
+                if args.material == "power-law" else LinearElastic(args.E, args.nu))
+plastic = args.material == "j2"
 
 # ### The residual
 #
@@ -176,6 +199,8 @@ residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
 def solve(newton):
     """Load steps with one Newton variant; returns the bracket and a record per step."""
     u.x.array[:] = 0.0
+    if plastic:
+        material.reset()
     b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
                 tolerance=args.tolerance,
                 linear_solver="lu" if args.solver == "direct" else "gamg")
@@ -183,6 +208,8 @@ def solve(newton):
     steps = []
 
     def record(t, r):
+        if len(steps) >= args.steps:  # unloading: the force goes back down
+            t = 1.0 - t
         steps.append({"force": t * args.force,
                       "load_point_displacement": b.load_point_displacement(),
                       "newton_iterations": r.iterations,
@@ -193,14 +220,20 @@ def solve(newton):
                       "residual_norms": list(r.residual_norms)})
         sets = (f" in {r.active_set_iterations} active-set iterations"
                 if r.active_set_iterations else "")
-        say(f"  {newton}: step {len(steps)}/{args.steps}, F = {t * args.force:.4g} N, "
+        say(f"  {newton}: step {len(steps)}/{total}, F = {t * args.force:.4g} N, "
             f"{r.iterations} Newton iterations{sets}, |u_load| = "
             f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
 
+    total = 2 * args.steps if args.unload else args.steps
+    commit = (lambda: material.commit(u)) if plastic else None  # a converged step's state
     t0 = time.perf_counter()
     try:
         solve_incrementally(b.solver, lambda t: b.set_load(t * args.force), args.steps,
-                            adaptive=False, predictor=False, on_step=record)
+                            adaptive=False, predictor=False, on_step=record, commit=commit)
+        if args.unload:
+            solve_incrementally(b.solver, lambda t: b.set_load((1 - t) * args.force),
+                                args.steps, adaptive=False, predictor=False, on_step=record,
+                                commit=commit)
     except LoadStepError as err:
         # a stall at round-off needs a looser tolerance, not smaller steps
         norms = err.result.residual_norms if err.result is not None else []
@@ -229,8 +262,9 @@ runs = {n: solve(n) for n in (variants if args.compare else [args.newton])}
 b, steps, wall = runs[args.newton if not args.compare else "full"]
 reactions = b.reactions()
 held = [sum(r[i] for r in reactions.values()) for i in range(3)]
+final = 0.0 if args.unload else args.force  # the load at the end of the path
 say(f"supports hold ({', '.join(f'{x:.6g}' for x in held)}) N against the load "
-    f"({args.force:.6g}, 0, 0) N: imbalance {abs(held[0] + args.force) / args.force:.1e} F")
+    f"({final:.6g}, 0, 0) N: imbalance {abs(held[0] + final) / args.force:.1e} F")
 # -
 
 # ## Outputs
@@ -246,7 +280,7 @@ def summary(b, steps, wall, args):
     mat = b.material
     out = {
         "support": args.support, "force": args.force, "length_unit": args.units,
-        "load_point_displacement": steps[-1]["load_point_displacement"],
+        "load_point_displacement": steps[args.steps - 1]["load_point_displacement"],
         "max_von_mises": vm_max,
         "newton_iterations": sum(s["newton_iterations"] for s in steps),
         "factorizations": sum(s["factorizations"] for s in steps),
@@ -264,6 +298,12 @@ def summary(b, steps, wall, args):
     if isinstance(mat, PowerLaw):
         # σ_eq = σ0 x (1 + x²)^((n−1)/2), x = ε_eq/ε0: invert for the peak strain
         out["max_eps_eq_over_eps0"] = _strain_ratio(vm_max / mat.sigma0, mat.n)
+    if isinstance(mat, J2Plasticity):
+        out.update(plastic_zone(mat))
+    if args.unload:  # what the load leaves behind
+        out["permanent_load_point_displacement"] = steps[-1]["load_point_displacement"]
+        out["warnings"].append("unloaded: max_von_mises and the reactions are those of the "
+                               "residual state")
     if args.support == "contact":
         out["lifted_off_area"] = b.lifted_off_area()
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
@@ -285,6 +325,18 @@ def resolution_warnings(args):
     if args.degree == 1:
         notes.append("P1 tetrahedra lock in this bending problem (about half the displacement)")
     return notes
+
+
+def plastic_zone(mat):
+    """The largest cumulated plastic strain and the plastic fraction of the volume."""
+    from dolfinx import fem
+
+    pq = mat.cumulated_plastic_strain
+    n = pq.function_space.dofmap.index_map.size_local
+    volume, plastic_volume = (comm.allreduce(fem.assemble_scalar(fem.form(f * part.dx)))
+                              for f in (1.0, ufl.conditional(ufl.gt(pq, 0), 1.0, 0.0)))
+    return {"max_cumulated_plastic_strain": global_max(comm, pq.x.array[:n]),
+            "plastic_volume_fraction": plastic_volume / volume}
 
 
 def _strain_ratio(s, n):

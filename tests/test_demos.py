@@ -383,3 +383,11 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path, demo):
         proc = demo.run(["bracket.py", *args], check=False)
         assert proc.returncode != 0, args
         assert message in proc.stderr and "Traceback" not in proc.stderr, (args, proc.stderr)
+
+
+def test_bracket_j2_loaded_and_unloaded(demo):
+    # von Mises plasticity to 8 kN and back: a permanent set, no force left on the bolts
+    d = demo.bracket("--material", "j2", "--size", "20", "--steps", "2", "--unload")
+    assert 0 < d["permanent_load_point_displacement"] < d["load_point_displacement"]
+    assert max(abs(x) for x in d["reactions"]["bolts"]) < 1e-6 * d["force"]
+    assert d["max_cumulated_plastic_strain"] > 0 and 0 < d["plastic_volume_fraction"] < 1

@@ -28,6 +28,8 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, SmallStrain, check_range
 
+YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
+
 
 @dataclass(frozen=True, eq=False)
 class J2Plasticity(Isotropic, SmallStrain):
@@ -67,6 +69,12 @@ class J2Plasticity(Isotropic, SmallStrain):
                  "points": T.element.interpolation_points, "commit": None}
         object.__setattr__(self, "_state", state)  # the parameters stay frozen
 
+    def reset(self) -> None:
+        """Back to the virgin state (a new load path on the same forms)."""
+        st = self._bound()
+        st["eps_p"].x.array[:] = 0.0
+        st["p"].x.array[:] = 0.0
+
     @property
     def plastic_strain(self):
         """The committed plastic strain ε_p (quadrature Function, 3x3)."""
@@ -94,7 +102,10 @@ class J2Plasticity(Isotropic, SmallStrain):
             - 2.0 / 3.0 * self.C * eps_p_n
         q = ufl.sqrt(1.5 * ufl.inner(xi, xi))
         f = q - (self.sigma0 + self.H * p_n)
-        plastic = ufl.gt(f, 0)
+        # a point left on the yield surface by the last step has f = 0 up to round-off: it
+        # must start the next step elastic (an unloading step with the plastic tangent
+        # there overshoots by E/E_t and diverges)
+        plastic = ufl.gt(f, YIELD_TOLERANCE * self.sigma0)
         dp = ufl.conditional(plastic, f / (3 * mu + self.H + self.C), 0)
         # the direction only where it is defined (q > 0 there): no 0/0 in the elastic branch
         n = ufl.conditional(plastic, 1.5 * xi / q, ufl.zero(3, 3))
@@ -107,6 +118,27 @@ class J2Plasticity(Isotropic, SmallStrain):
         return (0.5 * self.lmbda * ufl.tr(eps_e) ** 2 + self.mu * ufl.inner(eps_e, eps_e)
                 + 0.5 * self.H * p**2 + self.C / 3.0 * ufl.inner(eps_p, eps_p)
                 + self.sigma0 * dp)
+
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq per cell (DG0): the mean of its quadrature points' values.
+
+        The state exists at the quadrature points only, so σ_eq is evaluated there.
+        """
+        from dolfinx import fem
+
+        st = self._bound()
+        Q = st["p"].function_space
+        at_points = fem.Function(Q)
+        at_points.interpolate(fem.Expression(self.von_mises_expression(u, model),
+                                             st["points"]))
+        msh = Q.mesh
+        n_cells = msh.topology.index_map(msh.topology.dim).size_local
+        D = fem.functionspace(msh, ("DG", 0))
+        f = fem.Function(D, name="von_mises")
+        per_cell = at_points.x.array[: Q.dofmap.index_map.size_local].reshape(n_cells, -1)
+        f.x.array[:n_cells] = per_cell.mean(axis=1)
+        f.x.scatter_forward()
+        return f
 
     def commit(self, u, model: str = "3d") -> None:
         """Store the return-mapped state of the displacement `u` (a converged step).

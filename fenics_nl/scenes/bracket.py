@@ -102,6 +102,7 @@ class BracketPart:
         self.load_area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * self.ds_load)))
         self.traction = fem.Constant(self.mesh, np.zeros(3))
         q = quadrature_degree if quadrature_degree is not None else 2 * degree
+        self.quadrature_degree = q
         self.dx = kinematics.quadrature_measure("dx", self.mesh, q)
         self.bcs = [boundary.fixed(self.V, facets("bolts"))]
         self._mean_u = [fem.form(self.u[i] * self.ds_load) for i in range(3)]
