@@ -43,10 +43,13 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from fenics_nl.domain.probes import Probes
 from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
+from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.parallel import global_max
 from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz
@@ -91,12 +94,18 @@ def parser():
                    help="active normal displacements as Dirichlet rows, or Lagrange multipliers")
     p.add_argument("--gap", choices=["parabola", "sphere"], default="parabola",
                    help="punch shape: Hertz's parabola or the exact sphere")
-    p.add_argument("--material", choices=["linear", "power-law"], default="linear",
-                   help="linear elastic (Hertz applies), or the power law (Newton inside)")
+    p.add_argument("--material", choices=["linear", "power-law", "j2"], default="linear",
+                   help="linear elastic (Hertz applies), the power law (Newton inside), or "
+                        "j2: von Mises plasticity (path-dependent; --unload for the imprint)")
     p.add_argument("--sigma0", type=cli.positive, default=None,
                    help="power law: stress where it turns non-linear [stress] (default 0.01)")
     p.add_argument("--n", type=cli.positive, default=None,
                    help="power law exponent [-] (default 0.3)")
+    p.add_argument("--hardening", type=cli.finite, default=None,
+                   help="j2: linear isotropic hardening modulus H [stress] (default 0.1 E)")
+    p.add_argument("--unload", action="store_true",
+                   help="take the punch back up in as many steps (displacement control): the "
+                        "residual imprint")
     p.add_argument("--refine", type=cli.at_least(0), default=1,
                    help=f"element size under the punch a/(20·2^refine) (3D: a/(6·2^refine)), "
                         f"at most {MAX_REFINE}")
@@ -113,7 +122,19 @@ p = parser()
 args = cli.arguments(p, prefixes=lambda a: {
     f"punch_{a.model.replace('-', '')}_{a.formulation[:4]}_":
         "KSP" if a.formulation == "elimination" else "SNES and KSP"})
-cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
+if args.material == "j2":  # σ0 = 0.3 p0 of the default indentation: a plastic zone
+    if args.n is not None:
+        p.error("--n sets the power law, not --material j2")
+    args.sigma0 = args.sigma0 if args.sigma0 is not None else 0.02 * args.E
+    args.hardening = args.hardening if args.hardening is not None else 0.1 * args.E
+    if args.hardening < 0:
+        p.error(f"--hardening must be >= 0, got {args.hardening:g}")
+else:
+    if args.hardening is not None:
+        p.error("--hardening sets --material j2")
+    cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
+if args.unload and args.force is not None:
+    p.error("--unload takes the punch back up under displacement control: drop --force")
 if args.refine > MAX_REFINE:
     p.error(f"--refine must be <= {MAX_REFINE}, got {args.refine}")
 if args.indentation is not None and args.indentation == 0:
@@ -150,8 +171,12 @@ block = PunchBlock(args.model, a, refine=args.refine, block=size)
 # \varepsilon$ and the tangent are derived from it by UFL. Hertz's theory is linear
 # elastic; the power law puts a Newton loop inside every active-set iteration.
 
-material = (LinearElastic(E, nu) if args.material == "linear"
-            else PowerLaw(E, nu, sigma0=args.sigma0, n=args.n))
+if args.material == "j2":  # its state lives at the quadrature points of the block's rule
+    material = J2Plasticity(E, nu, sigma0=args.sigma0, H=args.hardening)
+    material.bind(block.mesh, 2)
+else:
+    material = (LinearElastic(E, nu) if args.material == "linear"
+                else PowerLaw(E, nu, sigma0=args.sigma0, n=args.n))
 
 # ### The residual
 #
@@ -186,14 +211,26 @@ states = load.states
 
 def report(t, result):
     s = states[-1]
-    say(f"step {len(states)}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, "
+    say(f"step {len(states)}/{args.steps * (2 if args.unload else 1)}: δ = "
+        f"{s.indentation:.5g}, P = {s.force:.6g}, "
         f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
         f"{s.active_set_iterations} active-set iterations")
 
 
+plastic = args.material == "j2"
+commit = (lambda: material.commit(u, block.kinematics)) if plastic else None
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
-                    on_step=report)
-last = states[-1]
+                    on_step=report, commit=commit)
+last = states[-1]  # the loaded state: what is checked
+nodes = punch.nodes_in_contact()
+imprint = None
+if args.unload:  # back up in as many steps; the surface keeps an imprint
+    solve_incrementally(load, lambda t: load.set_load(1 - t), args.steps, adaptive=False,
+                        predictor=False, on_step=report, commit=commit)
+    axis = [0.0] * (3 if args.model == "3d" else 2)
+    imprint = -Probes(block.mesh, [axis]).continuous(u)[0][block.vertical]
+    say(f"unloaded: residual imprint depth {imprint:.5g} at the axis (δ_max = "
+        f"{last.indentation:.5g})")
 # -
 
 # ### Against Hertz
@@ -205,7 +242,6 @@ last = states[-1]
 # (fewer than 4 nodes) is refused.
 
 # +
-nodes = punch.nodes_in_contact()
 warnings = check_contact_resolution(nodes, block.h, last)
 ref = punch.hertz(last) if last.force > 0 else None
 errors = {}
@@ -220,9 +256,10 @@ else:
         checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
     say("; ".join(checked) + f"; h = {block.h:.2g}")
 exponent = None
-if len(states) >= 2 and all(s.force > 0 for s in states):
-    exponent = float(np.polyfit(np.log([s.indentation for s in states]),
-                                np.log([s.force for s in states]), 1)[0])
+loading = states[: args.steps]
+if len(loading) >= 2 and all(s.force > 0 for s in loading):
+    exponent = float(np.polyfit(np.log([s.indentation for s in loading]),
+                                np.log([s.force for s in loading]), 1)[0])
     say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if args.model == "plane-strain"
                                                    else " (Hertz: 1.5)"))
 # -
@@ -255,8 +292,16 @@ def summary():
     for k, e in errors.items():
         out[f"hertz_{k}"], out[f"{k}_rel_error"] = ref[k], e
     if args.material != "linear":
-        warnings.append("power-law material: Hertz's values are the linear reference, "
-                        "not a check")
+        warnings.append(f"{args.material} material: Hertz's values are the linear "
+                        f"reference, not a check")
+    if imprint is not None:
+        out["residual_imprint_depth"] = imprint
+        out["unloading"] = [{"indentation": s.indentation, "force": s.force}
+                            for s in states[args.steps:]]
+    if plastic:
+        pq = material.cumulated_plastic_strain
+        n_owned = pq.function_space.dofmap.index_map.size_local
+        out["max_cumulated_plastic_strain"] = global_max(comm, pq.x.array[:n_owned])
     if args.model == "plane-strain" and ref is not None:
         warnings.append("plane strain: the force is not checked (a cylinder's indentation "
                         "depends on the block, Hertz gives no P(δ)); half-width and p0 are "

@@ -391,3 +391,13 @@ def test_bracket_j2_loaded_and_unloaded(demo):
     assert 0 < d["permanent_load_point_displacement"] < d["load_point_displacement"]
     assert max(abs(x) for x in d["reactions"]["bolts"]) < 1e-6 * d["force"]
     assert d["max_cumulated_plastic_strain"] > 0 and 0 < d["plastic_volume_fraction"] < 1
+
+
+def test_punch_j2_load_unload_leaves_an_imprint(demo):
+    # von Mises plasticity under the punch: the force stays below elastic Hertz, the
+    # unloaded surface keeps a dent, the punch leaves it with no force
+    d = demo.punch("--material", "j2", "--refine", "0", "--steps", "2", "--unload")
+    assert d["force"] < d["hertz_force"]
+    assert 0 < d["residual_imprint_depth"] < d["indentation"]
+    assert abs(d["unloading"][-1]["force"]) < 1e-9 * d["force"]
+    assert d["max_cumulated_plastic_strain"] > 0
