@@ -129,17 +129,8 @@ if args.mesh and args.size is not None:
     p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
 mm = MM[args.units]
 args.E = args.E if args.E is not None else 200e3 / mm**2
-if args.material == "j2":
-    if args.n is not None:
-        p.error("--n sets the power law, not --material j2")
-    args.sigma0 = args.sigma0 if args.sigma0 is not None else 200.0 / mm**2
-    args.hardening = args.hardening if args.hardening is not None else 13e3 / mm**2
-    if args.hardening < 0:
-        p.error(f"--hardening must be >= 0, got {args.hardening:g}")
-else:
-    if args.hardening is not None:
-        p.error("--hardening sets --material j2")
-    cli.power_law_flags(p, args, sigma0=200.0 / mm**2, n=0.2)
+cli.material_flags(p, args, power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
+                   j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
 if args.unload and args.compare:
     p.error("--unload goes with one --newton, not --compare")
 if args.size is not None and args.size > 2 * THICKNESS_MM * mm:

@@ -122,17 +122,9 @@ p = parser()
 args = cli.arguments(p, prefixes=lambda a: {
     f"punch_{a.model.replace('-', '')}_{a.formulation[:4]}_":
         "KSP" if a.formulation == "elimination" else "SNES and KSP"})
-if args.material == "j2":  # σ0 = 0.3 p0 of the default indentation: a plastic zone
-    if args.n is not None:
-        p.error("--n sets the power law, not --material j2")
-    args.sigma0 = args.sigma0 if args.sigma0 is not None else 0.02 * args.E
-    args.hardening = args.hardening if args.hardening is not None else 0.1 * args.E
-    if args.hardening < 0:
-        p.error(f"--hardening must be >= 0, got {args.hardening:g}")
-else:
-    if args.hardening is not None:
-        p.error("--hardening sets --material j2")
-    cli.power_law_flags(p, args, sigma0=0.01, n=0.3)
+# j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
+cli.material_flags(p, args, power_law={"sigma0": 0.01, "n": 0.3},
+                   j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
 if args.unload and args.force is not None:
     p.error("--unload takes the punch back up under displacement control: drop --force")
 if args.refine > MAX_REFINE:

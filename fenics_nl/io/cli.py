@@ -104,14 +104,26 @@ def at_least(minimum: int):
     return parse
 
 
-def power_law_flags(parser: argparse.ArgumentParser, args, **defaults) -> None:
-    """Fill --sigma0/--n with their defaults; giving them with a linear material is an error."""
-    given = [f"--{k}" for k in defaults if getattr(args, k) is not None]
-    if args.material == "linear" and given:
-        parser.error(f"{', '.join(given)} set the power law, not --material linear")
-    for k, v in defaults.items():
+def material_flags(parser: argparse.ArgumentParser, args, *, power_law: dict,
+                   j2: dict | None = None) -> None:
+    """Fill the chosen --material's flags with their defaults.
+
+    Power law: --sigma0, --n; j2: --sigma0, --hardening. A flag that sets only another
+    material is an error.
+    """
+    own = {"power-law": power_law, "j2": j2 or {}}.get(args.material, {})
+    others = sorted({k for d in (power_law, j2 or {}) for k in d} - set(own))
+    given = [f"--{k}" for k in others if getattr(args, k, None) is not None]
+    if given:
+        owners = [m for m, d in (("the power law", power_law), ("j2", j2 or {}))
+                  if any(g[2:] in d for g in given)]
+        parser.error(f"{', '.join(given)} set {' and '.join(owners)}, not --material "
+                     f"{args.material}")
+    for k, v in own.items():
         if getattr(args, k) is None:
             setattr(args, k, v)
+    if args.material == "j2" and args.hardening < 0:
+        parser.error(f"--hardening must be >= 0, got {args.hardening:g}")
 
 
 def parse_with_petsc_options(parser: argparse.ArgumentParser, argv=None):
