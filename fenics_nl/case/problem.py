@@ -168,6 +168,9 @@ class CaseProblem:
         if c is None:
             return None
         axis, sign = self._flat_normal(c)
+        if c.value["obstacle"] == "plane" and c.value["normal"][axis] == 0:
+            raise CaseError([f"{c.key}.normal: the plane is parallel to the contact group's "
+                             f"normal (axis {axis}): the group can never meet it"])
         return c, self.facets[c.group], axis, sign
 
     def _flat_normal(self, c: Condition) -> tuple[int, int]:
@@ -190,21 +193,24 @@ class CaseProblem:
                              f"; the active set constrains one displacement component"])
         return axis, int(np.sign(mean[axis]))
 
+    def obstacle_at(self, t: float) -> dict:
+        """The contact obstacle at load factor t (moved by t × its displacement)."""
+        ob = dict(self.contact[0].value)
+        key = "center" if ob["obstacle"] == "sphere" else "point"
+        ob[key] = (np.asarray(ob[key]) + t * np.asarray(ob["displacement"])).tolist()
+        return ob
+
     def gap(self, t: float):
         """γ(x) at load factor t: distance from S_C to the obstacle along the outward normal."""
-        c, _, axis, sign = self.contact
-        ob = c.value
-        w = t * np.asarray(ob["displacement"])
+        _, _, axis, sign = self.contact
+        ob = self.obstacle_at(t)
 
         def plane(x):
-            p, m = np.asarray(ob["point"]) + w, np.asarray(ob["normal"])
-            dot_n = sign * m[axis]
-            if dot_n == 0:  # the plane is parallel to the normal: never met
-                return np.full(x.shape[1], np.inf)
-            return ((p[:, None] - x[: len(p)]) * m[:, None]).sum(axis=0) / dot_n
+            p, m = np.asarray(ob["point"]), np.asarray(ob["normal"])
+            return ((p[:, None] - x[: len(p)]) * m[:, None]).sum(axis=0) / (sign * m[axis])
 
         def sphere(x):
-            centre, R = np.asarray(ob["center"]) + w, ob["radius"]
+            centre, R = np.asarray(ob["center"]), ob["radius"]
             d = x[: len(centre)] - centre[:, None]
             a = sign * d[axis]  # along the outward normal, negative when facing the sphere
             r2 = np.maximum((d * d).sum(axis=0) - a * a, 0.0)
@@ -217,14 +223,6 @@ class CaseProblem:
         """The case's solver (compiles the forms; reads the PETSc options under case_)."""
         self.solver = self._solver()
         return self.solver
-
-    def obstacle_now(self) -> dict:
-        """The contact obstacle at the current load factor (moved by t × its displacement)."""
-        ob = dict(self.contact[0].value)
-        w = float(self.t.value) * np.asarray(ob["displacement"])
-        key = "center" if ob["obstacle"] == "sphere" else "point"
-        ob[key] = (np.asarray(ob[key]) + w).tolist()
-        return ob
 
     def _solver(self):
         case = self.case

@@ -128,7 +128,7 @@ def write_outputs(problem: CaseProblem, folder: str | None, png: str | None):
                 moved = c.x.copy()  # the nodes in contact where they are now
                 moved[:, axis] += S.sign * S.normal_displacement(problem.u)
                 focus = moved[c.owned & c.active][:, : problem.case.dim]
-                obstacle = problem.obstacle_now()
+                obstacle = problem.obstacle_at(float(problem.t.value))
                 title += f", {S.count(c.active)} nodes in contact"
             deformed_picture(problem.u, vm, png, title, marked, arrows, focus, obstacle)
             say(f"wrote {png}")
