@@ -17,6 +17,13 @@ $(VENV)/.installed: pyproject.toml
 	$(PY) -m pip install --quiet -e ".[test]"
 	@touch $@
 
+# the benchmarks' extra: numba and the J2 peer (see pyproject.toml's bench extra)
+PEER := dolfinx-external-operator==0.11.0
+$(VENV)/.bench-installed: $(VENV)/.installed
+	$(PY) -m pip install --quiet -e ".[test,bench]"
+	$(PY) -m pip install --quiet --no-deps $(PEER)
+	@touch $@
+
 # the three scenes at small sizes and the scalar demo, pictures and JSON in results/
 # (about 1 min on 2 cores; the bracket runs on 2 ranks)
 demo: $(VENV)/.installed
@@ -45,13 +52,13 @@ test-mpi: $(VENV)/.installed
 # README tables and the "which method when" reading regenerated from them;
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
-BENCHMARKS := newton contact buckling bracket plasticity
-bench: $(VENV)/.installed
+BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer
+bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done
 	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-readme)
 
-bench-large: $(VENV)/.installed
+bench-large: $(VENV)/.bench-installed
 	$(PY) benchmarks/bracket.py --large --update-readme
 	$(PY) benchmarks/reading.py --update-readme
 

@@ -111,7 +111,8 @@ def parser():
                    help="unload in as many steps after loading: the permanent displacement")
     cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
                               "floor pressure and active set",
-                    png="deformed bracket coloured by von Mises stress, load and supports drawn",
+                    png="deformed bracket coloured by von Mises stress (j2: by the cumulated "
+                        "plastic strain), load and supports drawn",
                     plot="load against load-point displacement")
     return p
 
@@ -386,8 +387,16 @@ def plot(steps, args):
 
 
 def picture(b, vm, args):
-    """Two views of the deformed bracket (σ_eq), the load arrow, the bolts, the floor."""
-    pictures.bracket_picture(b, vm, args.png, units=args.units, force=args.force)
+    """Two views of the deformed bracket (σ_eq; in J2 the cumulated plastic strain), the
+    load arrow, the bolts, the floor."""
+    if isinstance(b.material, J2Plasticity):  # where it yielded, and how much
+        pictures.bracket_picture(b, b.material.cumulated_plastic_strain_per_cell(), args.png,
+                                 units=args.units, force=args.force,
+                                 label="cumulated plastic strain p (largest of each cell)",
+                                 unloaded=args.unload)
+    else:
+        pictures.bracket_picture(b, vm, args.png, units=args.units, force=args.force,
+                                 unloaded=args.unload)
     say(f"wrote {args.png}")
 
 

@@ -25,6 +25,7 @@
 # +
 import math
 import sys
+import time
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -41,6 +42,7 @@ from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.snes import SnesSolver
 from fenics_nl.theory import vessels
 
 if __name__ == "__main__":  # `python demos/pressure_vessel.py [options]`: the cells below,
@@ -52,7 +54,8 @@ comm = MPI.COMM_WORLD
 # ### Parameters
 #
 # From the command line (`python demos/pressure_vessel.py --help`); in a notebook, the
-# defaults. PETSc options take the prefix `-vessel_` (Newton's KSP).
+# defaults. PETSc options take the prefix `-vessel_` (Newton's KSP) or `-vessel_snes_`
+# (`--newton snes`).
 
 # +
 def parser():
@@ -80,9 +83,10 @@ def parser():
     p.add_argument("--unload", action="store_true", help="unload to zero afterwards")
     p.add_argument("--steps", type=cli.at_least(1), default=10,
                    help="load steps from the yield onset to the final load")
-    p.add_argument("--newton", choices=["full", "modified", "bfgs"], default="full",
+    p.add_argument("--newton", choices=["full", "modified", "bfgs", "snes"], default="full",
                    help="full: consistent tangent; modified: the elastic tangent, factorized "
-                        "once (the course's choice); bfgs: quasi-Newton")
+                        "once (the course's choice); bfgs: quasi-Newton; snes: PETSc SNES "
+                        "newtonls on the same residual and consistent tangent")
     p.add_argument("--size", type=cli.positive, default=None,
                    help="element size [length] (default (b - a)/16)")
     cli.add_outputs(p, png="the deformed quarter coloured by the cumulated plastic strain",
@@ -91,7 +95,7 @@ def parser():
 
 
 p = parser()
-args = cli.arguments(p, prefixes={"vessel_": "Newton's KSP"})
+args = cli.arguments(p, prefixes={"vessel_": "Newton's KSP", "vessel_snes_": "SNES"})
 a, b = args.inner_radius, args.outer_radius
 if not a < b:
     p.error(f"--inner-radius must be below --outer-radius, got {a:g} and {b:g}")
@@ -137,16 +141,27 @@ residual = (material.internal_work(u, v, body.model) * body.dx
 #
 # Full Newton has the consistent tangent (UFL's derivative of the residual); modified
 # Newton (and BFGS's base) is the course's choice, the elastic tangent K(0), factorized once
-# for the whole run. The absolute
-# tolerance is relative to the limit load's force on the inner surface.
+# for the whole run; `--newton snes` is PETSc's newtonls on the same residual and consistent
+# tangent, a cross-check. The absolute tolerance is relative to the limit load's force on
+# the inner surface.
 
 # +
 control = "pressure" if args.inner_displacement is None else "displacement"
 bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
-solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
-                      force_scale=force, max_it=50 if args.newton == "full" else 500,
-                      constant_tangent="elastic", prefix="vessel_")
+
+
+def make_solver(bcs):
+    """The --newton variant on the residual, with `bcs`."""
+    if args.newton == "snes":
+        return SnesSolver(residual, u, bcs, rtol=1e-10, atol=1e-10, force_scale=force,
+                          prefix="vessel_snes_")
+    return NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
+                        force_scale=force, max_it=50 if args.newton == "full" else 500,
+                        constant_tangent="elastic", prefix="vessel_")
+
+
+solver = make_solver(bcs)
 # -
 
 # ### Yield onset
@@ -202,6 +217,7 @@ else:
     def load(t):
         body.move_inner(t * target)
 
+t_solve = time.perf_counter()  # the load steps' time, for the benchmarks
 try:
     run = solve_incrementally(solver, load, args.steps, max_step=1.0 / args.steps,
                               on_step=record, commit=commit)
@@ -211,6 +227,7 @@ except LoadStepError as err:
                      f"({last / p_lim:.4f} of the limit pressure {p_lim:.6g}); asked "
                      f"{target:.6g}" if control == "pressure" else str(err)) from err
 pressure, inner = path[-1]
+loaded = pressure
 c_fe = body.plastic_radius(material)
 c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
 say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "
@@ -225,13 +242,11 @@ say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5
 
 # +
 residual_hoop = None
+after_unloading = False
 if args.unload:
-    loaded = pressure
     if control == "displacement":
         bcs.remove(body.inner_motion)
-        solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
-                              force_scale=force, max_it=500, constant_tangent="elastic",
-                              prefix="vessel_")
+        solver = make_solver(bcs)
         control = "pressure"
 
     def unload(t):
@@ -241,6 +256,7 @@ if args.unload:
     back = solve_incrementally(solver, unload, args.steps, max_step=1.0 / args.steps,
                                on_step=record, commit=commit)
     run.work.add(back.work)
+    after_unloading = True
     run.results.extend(back.results)
     residual_hoop = body.stresses_at_inner(material)[1]
     say(f"unloaded: permanent u(a) = {path[-1][1]:.6g}, residual hoop stress at r = a "
@@ -248,6 +264,23 @@ if args.unload:
                                   f"{vessels.residual_hoop_stress_inner(a, b, s0, loaded):.6g}"
                                   f", if nothing yields in reverse)"
                                   if shape == "sphere" and args.hardening == 0 else ""))
+# -
+
+# ### Inner displacement against the closed form
+#
+# Sphere in perfect plasticity: u(a) of the monotonic loading is exact up to the limit
+# (`vessels.sphere_inner_displacement`: Lamé in the elastic zone, volume-preserving flow in
+# the plastic one); the unloading is elastic, Lamé's compliance. The cylinder has the elastic
+# line only.
+
+# +
+solve_time = comm.allreduce(time.perf_counter() - t_solve, op=MPI.MAX)
+compliance = vessels.elastic_inner_compliance(shape, a, b, args.E, args.nu)
+exact_curve = shape == "sphere" and args.hardening == 0 and loaded <= p_lim
+inner_exact = (vessels.sphere_inner_displacement(a, b, args.E, args.nu, s0, loaded)
+               if exact_curve else None)
+if inner_exact is not None:
+    say(f"u(a) at p = {loaded:.6g}: {inner:.6g} (closed form {inner_exact:.6g})")
 # -
 
 # ## Outputs
@@ -260,9 +293,12 @@ def summary():
            "limit_pressure_exact": p_lim, "pressure": pressure,
            "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": body.h,
            "inner_displacement": inner,
+           "peak_pressure": loaded,
            "newton_iterations": run.iterations, "factorizations": run.work.factorizations,
            "path": [{"pressure": q, "inner_displacement": d} for q, d in path],
-           "dofs": body.dofs, "ranks": comm.size, "warnings": []}
+           "dofs": body.dofs, "ranks": comm.size, "solve_time_s": solve_time, "warnings": []}
+    if inner_exact is not None:
+        out["inner_displacement_exact"] = inner_exact
     if shape == "cylinder":
         out["warnings"].append("cylinder: the closed-form plastic radius assumes ν = 1/2")
     if args.hardening > 0:
@@ -280,37 +316,52 @@ def summary():
     return out
 
 
+def state_title() -> str:
+    """What the run ends in: loaded, or unloaded from its peak."""
+    closed = "closed form" + (" for ν = 1/2" if shape == "cylinder" else "")
+    radius = f"plastic radius {c_fe:.4g} ({closed} {c_exact:.4g})"
+    if after_unloading:
+        return (f"{shape}: unloaded from {loaded / p_lim:.3f} p_lim, permanent u(a) = "
+                f"{path[-1][1]:.4g}, {radius}")
+    return f"{shape}: p = {loaded / p_lim:.3f} p_lim, {radius}"
+
+
 def plot():
+    """p(u(a)) of the run against the closed forms (loading and elastic unloading)."""
     if comm.rank != 0:
         return
     plt = pictures.pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
     q, d = np.array(path).T
-    ax.plot(d, q / p_lim, "o-", ms=3, label="FE (J2)")
-    ax.axhline(1.0, color="k", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
+    if exact_curve:  # the monotonic loading, exact up to the limit
+        ps = np.linspace(0.0, loaded, 200)
+        us = [vessels.sphere_inner_displacement(a, b, args.E, args.nu, s0, x) for x in ps]
+        ax.plot(us, ps / p_lim, "k-", lw=1, label="closed form (loading)")
+    else:  # Lamé up to the yield onset
+        ps = np.array([0.0, min(p_e_exact, loaded)])
+        ax.plot(ps * compliance, ps / p_lim, "k-", lw=1, label="Lamé (elastic)")
+    if after_unloading:  # elastic unloading from the computed peak: Lamé's compliance
+        top = (inner_exact if inner_exact is not None else inner, "closed form")
+        ax.plot([top[0], top[0] - loaded * compliance], [loaded / p_lim, 0.0], "k--", lw=1,
+                label="elastic unloading (Lamé)")
+    ax.plot(d, q / p_lim, "o", ms=4, mfc="none", color="C0", label="FE, J2 (each step)")
+    ax.axhline(1.0, color="C3", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
     ax.axhline(p_e_exact / p_lim, color="gray", ls=":", lw=1, label="yield onset")
     ax.set_xlabel("inner radial displacement u(a) [length]")
     ax.set_ylabel("p / p_lim")
+    ax.set_ylim(0, 1.08)
+    ax.set_xlim(left=0)
     ax.grid(alpha=0.3)
-    ax.legend()
-    ax.set_title(f"{shape}, b/a = {b / a:g}: p = {pressure / p_lim:.3f} p_lim, plastic radius "
-                 f"{c_fe:.4g} (closed form {c_exact:.4g})", fontsize=9)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.set_title(f"b/a = {b / a:g}, " + state_title().replace(", plastic", "\nplastic"),
+                 fontsize=9)
     pictures.save_figure(fig, args.plot)
 
 
 def picture():
     """The deformed quarter coloured by the largest cumulated plastic strain of each cell."""
-    from dolfinx import fem
-
-    pq = material.cumulated_plastic_strain
-    n_cells = body.mesh.topology.index_map(2).size_local
-    per_cell = pq.x.array[: pq.function_space.dofmap.index_map.size_local]
-    Q0 = fem.functionspace(body.mesh, ("DG", 0))
-    cells = fem.Function(Q0, name="cumulated_plastic_strain")
-    cells.x.array[:n_cells] = per_cell.reshape(n_cells, -1).max(axis=1)
-    pictures.deformed_picture(
-        u, cells, args.png, f"{shape}: p = {pressure / p_lim:.3f} p_lim, plastic radius "
-        f"{c_fe:.4g} (closed form {c_exact:.4g})", label="cumulated plastic strain")
+    pictures.deformed_picture(u, material.cumulated_plastic_strain_per_cell(), args.png,
+                              state_title(), label="cumulated plastic strain")
     say(f"wrote {args.png}")
 
 

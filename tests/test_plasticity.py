@@ -107,6 +107,15 @@ def test_uniaxial_load_unload_reverse_is_the_closed_form(H, C):
                                          rel=1e-9)
 
 
+@pytest.mark.mpi
+def test_uniaxial_closed_form_on_two_ranks():
+    # the state lives at each rank's quadrature points; commit and assembly are collective
+    assert MPI.COMM_WORLD.size > 1, "run under mpiexec -n 2"
+    strains = EPS_Y * np.array([1.5, 3.0, 1.0, -2.0])
+    sigma = Bar(J2Plasticity(E, NU, sigma0=S0, H=50.0, C=50.0), n=2).go(strains)
+    assert sigma == pytest.approx(uniaxial(strains, 50.0, 50.0), rel=1e-10, abs=1e-10 * S0)
+
+
 def test_consistent_tangent_taylor_slope_two_in_the_plastic_regime():
     law = J2Plasticity(E, NU, sigma0=S0, H=30.0, C=20.0)
     bar = Bar(law, n=2)

@@ -50,16 +50,19 @@ def facet_points(msh, facets: np.ndarray) -> np.ndarray:
     return msh.geometry.x[np.unique(nodes.ravel())]
 
 
-def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float) -> None:
-    """The deformed bracket in two views, σ_eq clipped at its 99th percentile (said so).
+def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: float,
+                    label: str | None = None, unloaded: bool = False) -> None:
+    """The deformed bracket in two views, coloured by a cell field (σ_eq by default).
 
-    The load arrow on the loaded hole, the clamped bolt holes, and with a floor support the
-    floor and a view from below with each base node's contact status. Collective; rank 0
-    writes `path`.
+    The field is clipped at its 99th percentile (said so); `label` names it. The load arrow
+    on the loaded hole (`unloaded`: the load was removed, the shape is the permanent one),
+    the clamped bolt holes, and with a floor support the floor and a view from below with
+    each base node's contact status. Collective; rank 0 writes `path`.
     """
+    bar_title = label or f"von Mises stress [N/{units}²]"
     comm = b.mesh.comm
     u1 = vertex_interpolant(b.u)
-    grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(vm)})
+    grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(field)})
     bolts = gather_rows(comm, facet_points(b.mesh, b.part.groups["bolts"]))
     load = gather_rows(comm, facet_points(b.mesh, b.part.load_facets))
     load_motion = b.load_point_motion()
@@ -91,17 +94,19 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
             pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.08)
             pl.add_mesh(warped, scalars="vm", cmap="turbo", clim=(0, top), show_edges=False,
                         show_scalar_bar=i == 1, scalar_bar_args={
-                            "title": f"von Mises stress [N/{units}²]\n(colours clipped at the "
+                            "title": f"{bar_title}\n(colours clipped at the "
                                      f"99th percentile; max {vm_cells.max():.4g})",
                             "vertical": False, "position_x": 0.15, "position_y": 0.04,
                             "width": 0.7, "height": 0.08, "title_font_size": 14,
-                            "label_font_size": 12, "fmt": "%.0f"})
+                            "label_font_size": 12, "fmt": "%.3g"})
             centre = load[0].mean(axis=0) + scale * load_motion  # on the deformed hole
             # the pull on the hole, drawn from the hole along +x (seen past the arm)
             pl.add_arrows(centre[None, :], np.array([[1.0, 0, 0]]), mag=0.3 * size,
-                          color="red")
+                          color="lightgray" if unloaded else "red")
             pl.add_point_labels([centre + np.array([0.15, 0.0, 0.05]) * size],
-                                [f"F = {force / 1e3:.3g} kN"], font_size=16, text_color="red",
+                                [f"F = {force / 1e3:.3g} kN" + (" (removed)" if unloaded
+                                                                 else "")], font_size=16,
+                                text_color="gray" if unloaded else "red",
                                 shape=None, show_points=False)
             pl.add_points(bolts[0], color="black", point_size=6, render_points_as_spheres=True)
             if status is not None:
@@ -111,8 +116,11 @@ def bracket_picture(b, vm: fem.Function, path: str, *, units: str, force: float)
                             color="tan", opacity=0.5)
         pl.view_vector(direction)
         if i == 0:
-            label = (f"bracket, {b.support} support, F = {force / 1e3:.3g} kN: load-point "
-                     f"displacement {np.linalg.norm(load_motion):.3g} {units}\n{label}")
+            state = (f"unloaded from F = {force / 1e3:.3g} kN: permanent load-point "
+                     f"displacement" if unloaded else
+                     f"F = {force / 1e3:.3g} kN: load-point displacement")
+            label = (f"bracket, {b.support} support, {state} "
+                     f"{np.linalg.norm(load_motion):.3g} {units}\n{label}")
         pl.add_text(label, font_size=12 if i == 0 else 10, position="upper_left")
     pl.subplot(0, 0)
     legend = (f"deformed x{scale:.3g} (grey: undeformed); black: clamped bolt holes"

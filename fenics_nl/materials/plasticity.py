@@ -45,6 +45,8 @@ class J2Plasticity(Isotropic, SmallStrain):
     _state: dict | None = field(default=None, repr=False, compare=False)
 
     path_dependent = True
+    # the course's modified Newton for plasticity: the elastic tangent, factorized once
+    modified_tangent = "elastic"
 
     def __post_init__(self):
         super().__post_init__()
@@ -84,6 +86,20 @@ class J2Plasticity(Isotropic, SmallStrain):
     def cumulated_plastic_strain(self):
         """The committed cumulated plastic strain p (quadrature Function)."""
         return self._bound()["p"]
+
+    def cumulated_plastic_strain_per_cell(self):
+        """The largest committed p of each cell's quadrature points (DG0 Function)."""
+        from dolfinx import fem
+
+        p = self.cumulated_plastic_strain
+        msh = p.function_space.mesh
+        n_cells = msh.topology.index_map(msh.topology.dim).size_local
+        per_point = p.x.array[: p.function_space.dofmap.index_map.size_local]
+        cells = fem.Function(fem.functionspace(msh, ("DG", 0)),
+                             name="cumulated_plastic_strain")
+        cells.x.array[:n_cells] = per_point.reshape(n_cells, -1).max(axis=1)
+        cells.x.scatter_forward()
+        return cells
 
     def _bound(self) -> dict:
         if self._state is None:

@@ -180,6 +180,8 @@ class Bracket:
         opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}
+        if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
+            opts["constant_tangent"] = material.modified_tangent
         if part.support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
             self.solver = ActiveSetContact(

@@ -63,3 +63,32 @@ def residual_hoop_stress_inner(a: float, b: float, sigma0: float, p: float) -> f
     """Sphere, after loading to p (a < c ≤ b) and unloading elastically: σ_θ(a)."""
     loaded = -p + sigma0  # plastic zone: σ_θ = σ_r + σ0, σ_r(a) = −p
     return loaded - elastic_stresses("sphere", a, b, p, a)[1]
+
+
+def elastic_inner_compliance(shape: str, a: float, b: float, E: float, nu: float) -> float:
+    """u(a)/p of Lamé's elastic solution (cylinder: plane strain)."""
+    if shape == "sphere":
+        return a**3 / (b**3 - a**3) * ((1 - 2 * nu) * a + (1 + nu) * b**3 / (2 * a * a)) / E
+    return a * (1 + nu) * ((1 - 2 * nu) * a * a + b * b) / (E * (b * b - a * a))
+
+
+def sphere_inner_displacement(a: float, b: float, E: float, nu: float, sigma0: float,
+                              p: float) -> float:
+    """u(a) of the sphere loaded monotonically to p ≤ p_lim (exact for every ν).
+
+    Elastic zone c < r < b: Lamé's shell under p_c = (2σ0/3)(1 − c³/b³) at r = c. Plastic
+    zone: σ_r = 2σ0 ln(r/c) − p_c, σ_θ = σ_r + σ0, and the plastic flow keeps the volume, so
+    (r² u)' = r² tr ε = r² (1 − 2ν)/E (3σ_r + 2σ0) integrates from u(c) down to r = a.
+    """
+    if p > limit_pressure("sphere", a, b, sigma0) * (1 + 1e-12):
+        raise ValueError(f"p = {p:g} is beyond the limit pressure: no equilibrium")
+    c = plastic_radius("sphere", a, b, sigma0, p)
+    if c == a:
+        return p * elastic_inner_compliance("sphere", a, b, E, nu)
+    p_c = 2 * sigma0 / 3 * (1 - c**3 / b**3)
+    # Lamé's u(c) = p_c c³/(b³ − c³) (...), with p_c c³/(b³ − c³) = (2σ0/3) c³/b³: finite at c = b
+    u_c = 2 * sigma0 / 3 * c**3 / b**3 * ((1 - 2 * nu) * c + (1 + nu) * b**3 / (2 * c * c)) / E
+    # ∫_a^c ρ² (6σ0 ln(ρ/c) + 2σ0 − 3p_c) dρ
+    integral = (6 * sigma0 * (-c**3 / 9 - a**3 / 3 * math.log(a / c) + a**3 / 9)
+                + (2 * sigma0 - 3 * p_c) * (c**3 - a**3) / 3)
+    return (c * c * u_c - (1 - 2 * nu) / E * integral) / (a * a)

@@ -1,0 +1,310 @@
+"""J2 plasticity against a peer: dolfinx-external-operator, same problem, same meshes.
+
+The thick cylinder of dolfinx-external-operator's von Mises demo, in plane strain: a = 1,
+b = 1.3, E = 70e3, ν = 0.3, σ0 = 250, linear isotropic hardening with tangent modulus
+E_t = E/100 (H = E E_t/(E − E_t)), internal pressure in 19 increments
+p_i = q_lim √(1.1 i/19) up to 1.1 q_lim, q_lim = (2/√3) σ0 ln(b/a).
+
+* **ours**: `fenics_nl` as a user writes it: `J2Plasticity`'s condensed energy in UFL, the
+  consistent tangent by UFL's derivative, the hand-written full Newton (MUMPS LU).
+* **peer**: the same problem through dolfinx-external-operator's public API
+  (`FEMExternalOperator`, `replace_external_operators`, `evaluate_operands`,
+  `evaluate_external_operators`, `petsc.assemble_residual_with_callback`): the radial
+  return and its tangent in Numba at the quadrature points, SNES `vinewtonrsls` with a basic
+  line search (the package's choice), MUMPS LU as ours. Written here from the package's API
+  documentation, not from its demo.
+
+Both on the very same mesh (P2 displacement, degree-2 quadrature: three points per
+triangle, the peer's choice), the same increments, each started from the last converged
+state, and the same stopping test ‖R‖ ≤ max(1e-8 ‖R₀‖, 1e-8). Times are of the load loop only,
+after a warm-up run that compiles the forms and the Numba kernel. There is no closed form
+with hardening (the limit pressure and c(p) are for perfect plasticity, c(p) for ν = 1/2
+only), so the error is that of the inner displacement u(a) at the final load against a
+reference: ours on a mesh twice finer than the finest compared (and the peer's agreement
+with ours on each mesh is shown). The first increment is elastic: its u(a) is checked
+against Lamé's closed form.
+
+Needs the optional benchmark dependencies (`make bench` installs them):
+`pip install -e ".[bench]"` and `pip install --no-deps dolfinx-external-operator==0.11.0`
+(its declared dependency `fenics-dolfinx` is the same DOLFINx as our wheel under another
+name).
+
+    python benchmarks/plasticity_peer.py [--quick] [--update-readme]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from functools import partial
+from pathlib import Path
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+# Before any UFL algorithm runs: UFL's transformers size their tables by the expression
+# classes defined when they are first used, and the package defines a new one.
+try:
+    import dolfinx_external_operator as peer_package
+except ImportError as err:
+    raise SystemExit("benchmarks/plasticity_peer.py needs the bench extra: pip install -e "
+                     "'.[bench]' && pip install --no-deps dolfinx-external-operator==0.11.0"
+                     ) from err
+
+# isort: split
+
+import numpy as np
+import ufl
+from common import elapsed, machine, update_readme
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.scenes.vessel import VesselBody
+from fenics_nl.solvers.linear_solver import create_ksp
+from fenics_nl.solvers.newton import NewtonSolver
+
+HERE = Path(__file__).resolve().parent
+A, B, E, NU, SIGMA0 = 1.0, 1.3, 70e3, 0.3, 250.0
+E_T = E / 100
+H = E * E_T / (E - E_T)
+Q_LIM = 2 / math.sqrt(3) * SIGMA0 * math.log(B / A)
+LOADS = Q_LIM * np.sqrt(np.linspace(0.0, 1.1, 20))[1:]  # the zero load is skipped: u = 0
+QUADRATURE = 2
+TOL = 1e-8
+MU, LMBDA = E / (2 * (1 + NU)), E * NU / ((1 + NU) * (1 - 2 * NU))
+
+
+def lame_inner_displacement(p: float) -> float:
+    """u(a) of the elastic thick cylinder in plane strain (Lamé)."""
+    return p * A * (1 + NU) / E * ((1 - 2 * NU) * A**2 + B**2) / (B**2 - A**2)
+
+
+def body(h: float) -> VesselBody:
+    return VesselBody("cylinder", A, B, size=h)
+
+
+def linear_solve_time(vb: VesselBody) -> float:
+    """One elastic solve of the mesh: assemble K and the load, factorize, solve (MUMPS LU)."""
+    from dolfinx import fem
+    from dolfinx.fem import petsc
+
+    from fenics_nl.materials.laws import LinearElastic
+
+    u, v = ufl.TrialFunction(vb.V), ufl.TestFunction(vb.V)
+    K = fem.form(ufl.derivative(LinearElastic(E, NU).internal_work(vb.u, v, vb.model),
+                                vb.u, u) * ufl.dx)
+    L = fem.form(-LOADS[0] * ufl.dot(vb.normal, v) * vb.ds_inner)
+    x = fem.Function(vb.V)
+
+    def solve() -> float:
+        t0 = time.perf_counter()
+        A = petsc.assemble_matrix(K, bcs=vb.supports)
+        A.assemble()
+        b = petsc.assemble_vector(L)
+        petsc.apply_lifting(b, [K], [vb.supports])
+        b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        petsc.set_bc(b, vb.supports)
+        ksp = create_ksp(A, "lu", prefix="peer_linear_")
+        ksp.solve(b, x.x.petsc_vec)
+        elapsed = time.perf_counter() - t0
+        for obj in (ksp, A, b):
+            obj.destroy()
+        return elapsed
+
+    solve()  # warm
+    return solve()
+
+
+def ours(vb: VesselBody) -> dict:
+    """fenics_nl: the condensed energy in UFL, its UFL tangent, full Newton."""
+    material = J2Plasticity(E, NU, sigma0=SIGMA0, H=H)
+    material.bind(vb.mesh, QUADRATURE)
+    dx = kinematics.quadrature_measure("dx", vb.mesh, QUADRATURE)
+    u, v = vb.u, ufl.TestFunction(vb.V)
+    u.x.array[:] = 0.0
+    residual = (material.internal_work(u, v, vb.model) * dx
+                + vb.pressure * ufl.dot(vb.normal, v) * vb.ds_inner)
+    solver = NewtonSolver(residual, u, vb.supports, rtol=TOL, atol=TOL, force_scale=1.0,
+                          prefix="peer_ours_")
+    iterations, path, phases = [], [], {}
+    t0 = time.perf_counter()
+    for q in LOADS:
+        vb.pressure.value = q
+        result = solver.solve()
+        iterations.append(result.iterations)
+        for k, t in result.work.time.items():
+            phases[k] = phases.get(k, 0.0) + t
+        material.commit(u, vb.model)
+        path.append(vb.inner_displacement())
+    return {"time_s": time.perf_counter() - t0, "iterations": iterations, "path": path,
+            "phase_time_s": phases}
+
+
+@partial(__import__("numba").njit, cache=False)
+def radial_return(deps, sigma_n, p_n, stiffness, mu, sigma0, hardening):
+    """Stress, tangent and Δp at every point, Mandel vectors (xx, yy, zz, √2 xy)."""
+    n = deps.shape[0]
+    sigma = np.empty((n, 4))
+    tangent = np.empty((n, 4, 4))
+    dp = np.zeros(n)
+    dev = np.eye(4)
+    dev[:3, :3] -= 1.0 / 3.0
+    for i in range(n):
+        trial = sigma_n[i] + stiffness @ deps[i]
+        s = dev @ trial
+        q = math.sqrt(1.5 * (s @ s))
+        f = q - sigma0 - hardening * p_n[i]
+        if f <= 0.0:
+            sigma[i] = trial
+            tangent[i] = stiffness
+            continue
+        dp[i] = f / (3 * mu + hardening)
+        beta = 3 * mu * dp[i] / q
+        sigma[i] = trial - beta * s
+        unit = s / math.sqrt(s @ s)
+        tangent[i] = (stiffness - 2 * mu * beta * dev
+                      - 2 * mu * (3 * mu / (3 * mu + hardening) - beta) * np.outer(unit, unit))
+    return sigma, tangent, dp
+
+
+def peer(vb: VesselBody, snes_type: str = "vinewtonrsls") -> dict:
+    """dolfinx-external-operator: the return map in Numba behind a FEMExternalOperator."""
+    import basix.ufl
+    from dolfinx import fem
+    from dolfinx.fem.petsc import NonlinearProblem
+    from dolfinx_external_operator.petsc import assemble_residual_with_callback
+
+    msh, V = vb.mesh, vb.V
+    cell = msh.topology.cell_name()
+    S = fem.functionspace(msh, basix.ufl.quadrature_element(cell, degree=QUADRATURE,
+                                                            value_shape=(4,)))
+    P = fem.functionspace(msh, basix.ufl.quadrature_element(cell, degree=QUADRATURE))
+    du, u = fem.Function(V), fem.Function(V)
+    sigma_n, p_n, dp = fem.Function(S), fem.Function(P), fem.Function(P)
+
+    def mandel(w):
+        g = ufl.grad(w)
+        return ufl.as_vector([g[0, 0], g[1, 1], 0.0, (g[0, 1] + g[1, 0]) / math.sqrt(2)])
+
+    stiffness = LMBDA * np.outer([1, 1, 1, 0], [1, 1, 1, 0]) + 2 * MU * np.eye(4)
+    sigma = peer_package.FEMExternalOperator(mandel(du), function_space=S)
+
+    def evaluate(derivatives):
+        if derivatives != (1,):
+            raise NotImplementedError(derivatives)
+
+        def tangent_and_state(deps):
+            s, c, d = radial_return(deps.reshape(-1, 4), sigma_n.x.array.reshape(-1, 4),
+                                    p_n.x.array, stiffness, MU, SIGMA0, H)
+            return c.reshape(-1), s.reshape(-1), d
+
+        return tangent_and_state
+
+    sigma.external_function = evaluate
+    v = ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, metadata={"quadrature_degree": QUADRATURE})
+    F = ufl.inner(sigma, mandel(v)) * dx + vb.pressure * ufl.dot(vb.normal, v) * vb.ds_inner
+    J = ufl.derivative(F, du, ufl.TrialFunction(V))
+    F_hat, F_ops = peer_package.replace_external_operators(F)
+    J_hat, J_ops = peer_package.replace_external_operators(J)
+
+    def update():
+        (_, s_new, dp_new), = peer_package.evaluate_external_operators(
+            J_ops, peer_package.evaluate_operands(F_ops))
+        F_ops[0].ref_coefficient.x.array[:] = s_new
+        dp.x.array[:] = dp_new
+
+    options = {"snes_type": snes_type, "snes_linesearch_type": "basic",
+               "snes_rtol": TOL, "snes_atol": TOL, "snes_stol": 0.0, "snes_max_it": 50,
+               "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    problem = NonlinearProblem(F_hat, du, J=J_hat, bcs=vb.supports,
+                               petsc_options_prefix="peer_eo_", petsc_options=options)
+    problem.solver.setFunction(partial(assemble_residual_with_callback, problem.u, problem.F,
+                                       problem.J, vb.supports, update, []), problem.b)
+    iterations, path = [], []
+    t0 = time.perf_counter()
+    for q in LOADS:
+        vb.pressure.value = q
+        du.x.array[:] = np.finfo(float).eps  # σ_eq ≠ 0 at the first evaluation
+        problem.solve()
+        if problem.solver.getConvergedReason() <= 0:
+            raise SystemExit(f"peer: SNES diverged at p = {q:.4g}")
+        iterations.append(problem.solver.getIterationNumber())
+        u.x.array[:] += du.x.array
+        p_n.x.array[:] += dp.x.array
+        sigma_n.x.array[:] = F_ops[0].ref_coefficient.x.array
+        path.append(vb.probes.continuous(u)[0][0])
+    return {"time_s": time.perf_counter() - t0, "iterations": iterations, "path": path}
+
+
+def compare(h: float) -> dict:
+    vb = body(h)
+    row = {"h": h, "dofs": vb.dofs, "linear_solve_s": linear_solve_time(vb)}
+    for name, run in (("ours", ours), ("peer", peer),
+                      ("peer, newtonls", partial(peer, snes_type="newtonls"))):
+        r = run(vb)
+        row[name] = {"time_s": r["time_s"], "newton_iterations": sum(r["iterations"]),
+                     "iterations_per_increment": r["iterations"],
+                     "inner_displacement": r["path"][-1],
+                     "elastic_error": r["path"][0] / lame_inner_displacement(LOADS[0]) - 1,
+                     **({"phase_time_s": r["phase_time_s"]} if "phase_time_s" in r else {})}
+    return row
+
+
+def table(rows: list[dict], reference: dict) -> str:
+    lines = [f"Thick cylinder a = 1, b = 1.3, plane strain, E_t = E/100, 19 increments to "
+             f"1.1 q_lim, P2, 3 quadrature points per triangle; u_ref(a) = "
+             f"{reference['inner_displacement']:.7g} (ours, h = {reference['h']:g}, "
+             f"{reference['dofs']} unknowns); `python benchmarks/plasticity_peer.py`.", "",
+             "| h | unknowns | code | Newton iterations | time (s) | / one linear solve | "
+             "time ours / peer | u(a) error vs reference | elastic step vs Lamé |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    ref = reference["inner_displacement"]
+    for r in rows:
+        for name in ("ours", "peer", "peer, newtonls"):
+            c = r[name]
+            ratio = f"{r['ours']['time_s'] / r['peer']['time_s']:.2f}" if name == "ours" else ""
+            lines.append(
+                f"| {r['h']:g} | {r['dofs']} | {name} | {c['newton_iterations']} | "
+                f"{c['time_s']:.2f} | {c['time_s'] / r['linear_solve_s']:.0f} | {ratio} | "
+                f"{abs(c['inner_displacement'] / ref - 1):.1e} | {c['elastic_error']:+.1e} |")
+    finest = rows[-1]["ours"]["phase_time_s"]
+    total = sum(finest.values())
+    lines += ["", f"Where ours spends its Newton time at {rows[-1]['dofs']} unknowns: " + ", ".join(
+        f"{k} {100 * t / total:.0f} %" for k, t in sorted(finest.items(), key=lambda kv: -kv[1])
+        if t > 0) + " (MUMPS LU of the consistent tangent, and assembling it)."]
+    return "\n".join(lines)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="two coarse meshes, nothing written")
+    ap.add_argument("--update-readme", action="store_true")
+    args = ap.parse_args()
+    sizes = [0.04, 0.02] if args.quick else [0.02, 0.01, 0.007]
+    compare(0.05)  # warm-up: forms and the Numba kernel compiled
+    rows = [compare(h) for h in sizes]
+    h_ref = sizes[-1] / 2
+    vb = body(h_ref)
+    reference = {"h": h_ref, "dofs": vb.dofs, **ours(vb)}
+    reference["inner_displacement"] = reference["path"][-1]
+    text = table(rows, reference)
+    if MPI.COMM_WORLD.rank == 0:
+        print(text)
+    if not args.quick and MPI.COMM_WORLD.rank == 0:
+        (HERE / "results" / "plasticity_peer.json").write_text(json.dumps(
+            {"machine": machine(MPI.COMM_WORLD.size), "rows": rows,
+             "reference": {k: reference[k] for k in ("h", "dofs", "inner_displacement",
+                                                     "time_s")},
+             "benchmark_time_s": elapsed()}, indent=2))
+        if args.update_readme:
+            update_readme("plasticity_peer", text)
+
+
+if __name__ == "__main__":
+    main()
