@@ -58,7 +58,7 @@ bench: $(VENV)/.bench-installed
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done
 	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-readme)
 
-bench-large: $(VENV)/.bench-installed
+bench-large: $(VENV)/.installed
 	$(PY) benchmarks/bracket.py --large --update-readme
 	$(PY) benchmarks/reading.py --update-readme
 

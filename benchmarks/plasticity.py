@@ -4,8 +4,11 @@ Every number comes from the demos' `--json`, each Newton variant on the same mes
 
 * **sphere** (`demos/pressure_vessel.py`, run in this process through `cli.run_file`, after a
   warm-up run that compiles the forms): a = 100, b = 200, perfect plasticity, loaded to
-  0.9 p_lim in 10 steps. Errors against the closed forms: u(a) (exact for the monotonic
-  loading, `vessels.sphere_inner_displacement`) and the plastic radius, in element sizes;
+  0.9 p_lim in 10 steps on four meshes (1.7k to 91k unknowns). Errors against the closed
+  forms: u(a) (exact for the monotonic loading, `vessels.sphere_inner_displacement`) and
+  the plastic radius, in element sizes;
+* **near the limit**: the sphere to 0.99 p_lim on the second mesh, where the material's
+  tangent stiffness tends to zero and the elastic one does not: where the variants part;
 * **bracket** (`demos/bracket.py --material j2`, a process per run as in
   `benchmarks/bracket.py`): 8 kN in 4 steps; no closed form, the variants must agree;
 * **one linear solve** of each mesh (assemble, factorize, solve: MUMPS LU) is the time unit
@@ -22,6 +25,8 @@ the same residual and consistent tangent.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import json
 import subprocess
 import sys
@@ -64,7 +69,7 @@ def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float) ->
 
     du, v = ufl.TrialFunction(body.V), ufl.TestFunction(body.V)
     K = fem.form(ufl.derivative(LinearElastic(E, nu).internal_work(body.u, v, body.model)
-                                * ufl.dx, body.u, du))
+                                * body.dx, body.u, du))  # the non-linear forms' rule
     L = fem.form(-pressure * ufl.dot(body.normal, v) * body.weight * body.ds_inner)
     x = fem.Function(body.V)
 
@@ -87,21 +92,36 @@ def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float) ->
     return solve()
 
 
-def vessel(size: float, newton: str, ranks: int = 1) -> dict:
-    """One sphere run to 0.9 p_lim: in this process (1 rank) or through mpiexec."""
+def vessel(size: float, newton: str, ranks: int = 1, ratio: float = 0.9,
+           may_fail: bool = False, separate: bool = False) -> dict:
+    """One sphere run to `ratio` p_lim: in this process, or a process per run (`separate`,
+    always on 2 ranks and more).
+
+    `may_fail`: a failed run is a result ({"failed": the demo's error line}), not an error.
+    """
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out.json"
-        argv = ["--size", str(size), "--newton", newton, "--pressure-ratio", "0.9",
+        argv = ["--size", str(size), "--newton", newton, "--pressure-ratio", str(ratio),
                 "--steps", str(SPHERE_STEPS), "--json", str(out)]
-        if ranks == 1:
-            failed = cli.run_file(VESSEL, argv)
+        if ranks == 1 and not separate:
+            errors = io.StringIO()
+            with contextlib.redirect_stderr(errors):
+                failed = cli.run_file(VESSEL, argv)
+            message = errors.getvalue().strip()
         else:
-            cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, str(VESSEL), *argv]
-            failed = subprocess.run(cmd, capture_output=True, text=True).returncode
+            cmd = [sys.executable, str(VESSEL), *argv]
+            cmd = [str(MPIEXEC), "-n", str(ranks), *cmd] if ranks > 1 else cmd
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+            failed, message = proc.returncode, proc.stderr.strip()
+        if failed and may_fail:
+            return {"size": size, "newton": newton, "failed": message.splitlines()[-1]}
         if failed:
-            raise SystemExit(f"pressure_vessel.py {' '.join(argv)} on {ranks} rank(s) failed")
+            raise SystemExit(f"pressure_vessel.py {' '.join(argv)} on {ranks} rank(s) "
+                             f"failed:\n{message}")
         d = json.loads(out.read_text())
     return {"size": size, "newton": newton, "dofs": d["dofs"], "ranks": d["ranks"],
+            "failed": False, "iterations_per_step": d["iterations_per_step"],
+            "step_cuts": d["step_cuts"], "phase_time_s": d["phase_time_s"],
             "solve_time_s": d["solve_time_s"], "newton_iterations": d["newton_iterations"],
             "factorizations": d["factorizations"],
             "inner_displacement_rel_error": d["inner_displacement"]
@@ -125,6 +145,20 @@ def sphere(sizes) -> list[dict]:
     return rows
 
 
+def near_limit(size: float, ratio: float) -> list[dict]:
+    """The sphere to `ratio` p_lim (close to 1), where the variants part: the material's
+    tangent stiffness tends to zero, the elastic one does not."""
+    rows = []
+    for newton in SPHERE_VARIANTS:
+        r = vessel(size, newton, ratio=ratio, may_fail=True)
+        r["ratio"] = ratio
+        rows.append(r)
+        say(f"sphere to {ratio} p_lim, h = {size:g}, {newton}: " + (
+            f"failed: {r['failed']}" if r["failed"] else
+            f"{r['solve_time_s']:.2f} s, iterations per step {r['iterations_per_step']}"))
+    return rows
+
+
 def bracket(sizes) -> list[dict]:
     rows = []
     for size in sizes:
@@ -145,7 +179,7 @@ def bracket(sizes) -> list[dict]:
 def parallel(sphere_size: float, bracket_size: float) -> list[dict]:
     rows = []
     for newton in ("full", "bfgs"):
-        one, two = (vessel(sphere_size, newton, ranks=n) for n in (1, 2))
+        one, two = (vessel(sphere_size, newton, ranks=n, separate=True) for n in (1, 2))
         rows.append({"scene": "sphere", "newton": newton, "dofs": one["dofs"],
                      "time_1_s": one["solve_time_s"], "time_2_s": two["solve_time_s"],
                      "agree": abs(two["inner_displacement_rel_error"]
@@ -164,8 +198,9 @@ def parallel(sphere_size: float, bracket_size: float) -> list[dict]:
     return rows
 
 
-def per_step(r: dict, steps: int) -> str:
-    return f"{r['solve_time_s'] / steps / r['linear_solve_s']:.1f}"
+def per_step(r: dict) -> str:
+    """Time per converged load step, in linear solves of the same mesh."""
+    return f"{r['solve_time_s'] / len(r['iterations_per_step']) / r['linear_solve_s']:.1f}"
 
 
 def table(s: dict) -> str:
@@ -179,7 +214,7 @@ def table(s: dict) -> str:
         lines.append(f"| {r['size']:g} | {r['dofs']} | {r['newton']} | "
                      f"{r['newton_iterations']} | {r['factorizations']} | "
                      f"{r['solve_time_s']:.2f} | {r['solve_time_s'] / full[r['size']]:.2f} | "
-                     f"{per_step(r, SPHERE_STEPS)} | "
+                     f"{per_step(r)} | "
                      f"{100 * r['inner_displacement_rel_error']:+.3f} % | "
                      f"{r['plastic_radius_error_over_h']:+.3f} |")
     lines += ["", f"**Bracket** (`--material j2`, σ0 = 200 MPa, H = 13 GPa), P2, 8 kN in "
@@ -192,7 +227,21 @@ def table(s: dict) -> str:
         lines.append(f"| {r['size']:g} | {r['dofs']} | {r['newton']} | "
                      f"{r['newton_iterations']} | {r['factorizations']} | "
                      f"{r['solve_time_s']:.2f} | {r['solve_time_s'] / full[r['size']]:.2f} | "
-                     f"{per_step(r, BRACKET_STEPS)} | {r['load_point_displacement']:.6f} |")
+                     f"{per_step(r)} | {r['load_point_displacement']:.6f} |")
+    if s.get("near_limit"):
+        rows = s["near_limit"]
+        lines += ["", f"Near the limit load: the sphere to {rows[0]['ratio']:g} p_lim, "
+                  f"h = {rows[0]['size']:g}, {SPHERE_STEPS} steps (a step that fails is "
+                  "halved):", "", "| Newton | iterations per converged step | step cuts | "
+                  "factorizations | time (s) | u(a) error |", "|---|---|---|---|---|---|"]
+        for r in rows:
+            if r["failed"]:
+                lines.append(f"| {r['newton']} | failed: {r['failed']} | | | | |")
+            else:
+                lines.append(f"| {r['newton']} | {', '.join(map(str, r['iterations_per_step']))}"
+                             f" | {r['step_cuts']} | {r['factorizations']} | "
+                             f"{r['solve_time_s']:.2f} | "
+                             f"{100 * r['inner_displacement_rel_error']:+.3f} % |")
     if s.get("parallel"):
         lines += ["", "1 vs 2 ranks (MUMPS):", "",
                   "| scene | unknowns | Newton | 1 rank (s) | 2 ranks (s) | speed-up | "
@@ -210,13 +259,15 @@ def main():
     ap.add_argument("--quick", action="store_true", help="coarse meshes, nothing written")
     ap.add_argument("--update-readme", action="store_true")
     args = ap.parse_args()
-    sphere_sizes = [12.5] if args.quick else [12.5, 6.25, 3.125]
+    sphere_sizes = [12.5] if args.quick else [12.5, 6.25, 3.125, 1.5625]
     bracket_sizes = [14.0] if args.quick else [9.0, 6.0]
     with tempfile.TemporaryDirectory() as d:
         cli.run_file(VESSEL, ["--size", "12.5", "--json", str(Path(d) / "warm.json")])
-    out = {"machine": machine(), "sphere": sphere(sphere_sizes),
+    out = {"machine": machine(), "sphere_steps": SPHERE_STEPS, "bracket_steps": BRACKET_STEPS,
+           "sphere": sphere(sphere_sizes),
            "bracket": bracket(bracket_sizes)}
     if not args.quick:
+        out["near_limit"] = near_limit(sphere_sizes[1], 0.99)
         out["parallel"] = parallel(sphere_sizes[-1], bracket_sizes[-1])
     out["benchmark_time_s"] = elapsed()
     text = table(out)

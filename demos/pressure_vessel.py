@@ -82,7 +82,8 @@ def parser():
                            "surface [length]; the pressure is read from its reaction")
     p.add_argument("--unload", action="store_true", help="unload to zero afterwards")
     p.add_argument("--steps", type=cli.at_least(1), default=10,
-                   help="load steps from the yield onset to the final load")
+                   help="equal load steps from zero to the final load (as many to unload); "
+                        "a step that fails is cut in half")
     p.add_argument("--newton", choices=["full", "modified", "bfgs", "snes"], default="full",
                    help="full: consistent tangent; modified: the elastic tangent, factorized "
                         "once (the course's choice); bfgs: quasi-Newton; snes: PETSc SNES "
@@ -140,7 +141,7 @@ residual = (material.internal_work(u, v, body.model) * body.dx
 # ### The solver
 #
 # Full Newton has the consistent tangent (UFL's derivative of the residual); modified
-# Newton (and BFGS's base) is the course's choice, the elastic tangent K(0), factorized once
+# Newton (and BFGS's base) is the course's choice, Hooke's elastic tangent, factorized once
 # for the whole run; `--newton snes` is PETSc's newtonls on the same residual and consistent
 # tangent, a cross-check. The absolute tolerance is relative to the limit load's force on
 # the inner surface.
@@ -149,6 +150,7 @@ residual = (material.internal_work(u, v, body.model) * body.dx
 control = "pressure" if args.inner_displacement is None else "displacement"
 bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
+elastic_tangent = material.modified_newton_tangent(u, body.model, body.dx)
 
 
 def make_solver(bcs):
@@ -158,7 +160,7 @@ def make_solver(bcs):
                           prefix="vessel_snes_")
     return NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
                         force_scale=force, max_it=50 if args.newton == "full" else 500,
-                        constant_tangent="elastic", prefix="vessel_")
+                        constant_tangent=elastic_tangent, prefix="vessel_")
 
 
 solver = make_solver(bcs)
@@ -191,14 +193,17 @@ say(f"{shape}, a = {a:g}, b = {b:g}, {body.dofs} unknowns; yield onset p_e = {p_
 # has no equilibrium: the run stops there, saying so.
 
 # +
-path = [(0.0, 0.0)]
+path = [(0.0, 0.0)]  # (pressure, u(a)) after each converged step
+step_iterations = []
+pressure_from_reaction = control == "displacement"
 
 
 def record(t, result):
-    pressure = (float(body.pressure.value) if control == "pressure"
-                else body.pressure_from(residual))
-    path.append((pressure, body.inner_displacement()))
-    say(f"  step {len(path) - 1}: p = {pressure:.6g} ({pressure / p_lim:.4f} p_lim), "
+    p_now = (body.pressure_from(residual) if pressure_from_reaction
+             else float(body.pressure.value))
+    path.append((p_now, body.inner_displacement()))
+    step_iterations.append(result.iterations)
+    say(f"  step {len(path) - 1}: p = {p_now:.6g} ({p_now / p_lim:.4f} p_lim), "
         f"u(a) = {path[-1][1]:.6g}, {result.iterations} Newton iterations")
 
 
@@ -217,17 +222,21 @@ else:
     def load(t):
         body.move_inner(t * target)
 
-t_solve = time.perf_counter()  # the load steps' time, for the benchmarks
+t0 = time.perf_counter()
 try:
     run = solve_incrementally(solver, load, args.steps, max_step=1.0 / args.steps,
                               on_step=record, commit=commit)
 except LoadStepError as err:
     last = path[-1][0]
-    raise SolveError(f"the limit load was reached: no equilibrium beyond p = {last:.6g} "
-                     f"({last / p_lim:.4f} of the limit pressure {p_lim:.6g}); asked "
-                     f"{target:.6g}" if control == "pressure" else str(err)) from err
+    if control == "pressure" and target >= p_lim:
+        raise SolveError(f"the limit load was reached: no equilibrium beyond p = {last:.6g} "
+                         f"({last / p_lim:.4f} of the limit pressure {p_lim:.6g}); asked "
+                         f"{target:.6g}") from err
+    raise SolveError(f"{args.newton} Newton failed at {last / p_lim:.4f} p_lim, below the "
+                     f"limit load: {err}") from err
+solve_time = time.perf_counter() - t0  # the load steps only, for the benchmarks
 pressure, inner = path[-1]
-loaded = pressure
+loaded = pressure  # the peak, also after unloading
 c_fe = body.plastic_radius(material)
 c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
 say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "
@@ -242,21 +251,22 @@ say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5
 
 # +
 residual_hoop = None
-after_unloading = False
 if args.unload:
-    if control == "displacement":
+    if control == "displacement":  # the same state, now held by its pressure
         bcs.remove(body.inner_motion)
         solver = make_solver(bcs)
-        control = "pressure"
+        pressure_from_reaction = False
 
     def unload(t):
         body.pressure.value = (1 - t) * loaded
 
     body.pressure.value = loaded
+    t0 = time.perf_counter()
     back = solve_incrementally(solver, unload, args.steps, max_step=1.0 / args.steps,
                                on_step=record, commit=commit)
+    solve_time += time.perf_counter() - t0
     run.work.add(back.work)
-    after_unloading = True
+    run.failures += back.failures
     run.results.extend(back.results)
     residual_hoop = body.stresses_at_inner(material)[1]
     say(f"unloaded: permanent u(a) = {path[-1][1]:.6g}, residual hoop stress at r = a "
@@ -274,7 +284,7 @@ if args.unload:
 # line only.
 
 # +
-solve_time = comm.allreduce(time.perf_counter() - t_solve, op=MPI.MAX)
+solve_time = comm.allreduce(solve_time, op=MPI.MAX)
 compliance = vessels.elastic_inner_compliance(shape, a, b, args.E, args.nu)
 exact_curve = shape == "sphere" and args.hardening == 0 and loaded <= p_lim
 inner_exact = (vessels.sphere_inner_displacement(a, b, args.E, args.nu, s0, loaded)
@@ -293,8 +303,9 @@ def summary():
            "limit_pressure_exact": p_lim, "pressure": pressure,
            "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": body.h,
            "inner_displacement": inner,
-           "peak_pressure": loaded,
            "newton_iterations": run.iterations, "factorizations": run.work.factorizations,
+           "iterations_per_step": step_iterations, "step_cuts": run.failures,
+           "phase_time_s": run.work.time,
            "path": [{"pressure": q, "inner_displacement": d} for q, d in path],
            "dofs": body.dofs, "ranks": comm.size, "solve_time_s": solve_time, "warnings": []}
     if inner_exact is not None:
@@ -316,14 +327,14 @@ def summary():
     return out
 
 
-def state_title() -> str:
-    """What the run ends in: loaded, or unloaded from its peak."""
+def state_title(sep: str = ", ") -> str:
+    """What the run ends in, loaded or unloaded from its peak; `sep` before the radius."""
     closed = "closed form" + (" for ν = 1/2" if shape == "cylinder" else "")
     radius = f"plastic radius {c_fe:.4g} ({closed} {c_exact:.4g})"
-    if after_unloading:
+    if args.unload:
         return (f"{shape}: unloaded from {loaded / p_lim:.3f} p_lim, permanent u(a) = "
-                f"{path[-1][1]:.4g}, {radius}")
-    return f"{shape}: p = {loaded / p_lim:.3f} p_lim, {radius}"
+                f"{path[-1][1]:.4g}{sep}{radius}")
+    return f"{shape}: p = {loaded / p_lim:.3f} p_lim{sep}{radius}"
 
 
 def plot():
@@ -340,10 +351,14 @@ def plot():
     else:  # Lamé up to the yield onset
         ps = np.array([0.0, min(p_e_exact, loaded)])
         ax.plot(ps * compliance, ps / p_lim, "k-", lw=1, label="Lamé (elastic)")
-    if after_unloading:  # elastic unloading from the computed peak: Lamé's compliance
-        top = (inner_exact if inner_exact is not None else inner, "closed form")
-        ax.plot([top[0], top[0] - loaded * compliance], [loaded / p_lim, 0.0], "k--", lw=1,
-                label="elastic unloading (Lamé)")
+    if args.unload:  # from the closed-form peak (else the computed one), Lamé's compliance
+        peak = inner_exact if inner_exact is not None else inner
+        # the sphere unloads elastically up to 2 p_e (σ_eq(a) goes from σ0 to −σ0); the
+        # cylinder's bound is close to it (exact for ν = 1/2)
+        reverse = loaded > 2 * p_e_exact
+        ax.plot([peak, peak - loaded * compliance], [loaded / p_lim, 0.0], "k--", lw=1,
+                label="elastic unloading (Lamé" + (", reverse yield ignored)" if reverse
+                                                   else ")"))
     ax.plot(d, q / p_lim, "o", ms=4, mfc="none", color="C0", label="FE, J2 (each step)")
     ax.axhline(1.0, color="C3", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
     ax.axhline(p_e_exact / p_lim, color="gray", ls=":", lw=1, label="yield onset")
@@ -353,8 +368,7 @@ def plot():
     ax.set_xlim(left=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    ax.set_title(f"b/a = {b / a:g}, " + state_title().replace(", plastic", "\nplastic"),
-                 fontsize=9)
+    ax.set_title(f"b/a = {b / a:g}, " + state_title("\n"), fontsize=9)
     pictures.save_figure(fig, args.plot)
 
 

@@ -1,5 +1,8 @@
 """The thick sphere and cylinder in perfect J2 plasticity against the closed forms."""
 
+import math
+
+import numpy as np
 import pytest
 
 from fenics_nl.theory import vessels
@@ -7,22 +10,24 @@ from fenics_nl.theory import vessels
 A, B, E, NU, SIGMA0 = 100.0, 200.0, 210e3, 0.3, 250.0
 
 
-def test_sphere_displacement_closed_form_is_continuous_and_right_when_incompressible():
-    # at the yield onset the elastic-plastic branch meets Lamé's line
+def test_sphere_displacement_closed_form_against_hill():
+    # written independently (Hill 1950, The Mathematical Theory of Plasticity, the
+    # expanding spherical shell): u(a) = σ0 a/E [(1 − ν) c³/a³ − ⅔(1 − 2ν)(1 − c³/b³
+    # + 3 ln(c/a))], from the yield onset up to the limit (c = b) included
     p_e = vessels.yield_onset_pressure("sphere", A, B, SIGMA0)
+    p_lim = vessels.limit_pressure("sphere", A, B, SIGMA0)
+    for p in np.linspace(p_e, p_lim, 7):
+        c = vessels.plastic_radius("sphere", A, B, SIGMA0, p)
+        hill = SIGMA0 * A / E * ((1 - NU) * c**3 / A**3 - 2 / 3 * (1 - 2 * NU)
+                                 * (1 - c**3 / B**3 + 3 * math.log(c / A)))
+        assert vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, p) == pytest.approx(
+            hill, rel=1e-12)
+    # below the onset, Lamé's line, which the plastic branch meets at p_e
     lame = p_e * vessels.elastic_inner_compliance("sphere", A, B, E, NU)
-    above = vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, p_e * (1 + 1e-12))
-    assert above == pytest.approx(lame, rel=1e-9)
-    # ν = 1/2: no volume change anywhere, r² u is constant, u(a) = u(c) c²/a² with u(c)
-    # that of the elastic shell c < r < b under the pressure p_c at r = c
-    p = 0.9 * vessels.limit_pressure("sphere", A, B, SIGMA0)
-    c = vessels.plastic_radius("sphere", A, B, SIGMA0, p)
-    p_c = 2 * SIGMA0 / 3 * (1 - c**3 / B**3)
-    u_c = p_c * vessels.elastic_inner_compliance("sphere", c, B, E, 0.5)
-    assert vessels.sphere_inner_displacement(A, B, E, 0.5, SIGMA0, p) == pytest.approx(
-        u_c * c * c / A**2, rel=1e-12)
+    assert vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, p_e * (1 + 1e-12)) == \
+        pytest.approx(lame, rel=1e-9)
     with pytest.raises(ValueError, match="beyond the limit"):
-        vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, 1.01 * p / 0.9)
+        vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, 1.01 * p_lim)
 
 
 def test_sphere_onset_plastic_radius_and_residual_stress(demo):

@@ -231,7 +231,8 @@ class CaseProblem:
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": not self.material.is_linear, "force_scale": self.force_scale}
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = self.material.modified_tangent
+            opts["constant_tangent"] = self.material.modified_newton_tangent(
+                self.u, self.model, self.dx)
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(

@@ -79,7 +79,7 @@ def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: flo
     scale = max(1.0, 0.05 * size / max(u_max, 1e-300))  # the largest motion ≥ 5 % of the part
     warped = mesh.warp_by_vector("u", factor=scale)
     vm_cells = grid.cell_data["vm"]
-    top = float(np.percentile(vm_cells, 99))
+    top = float(np.percentile(vm_cells, 99)) or 1.0  # a zero field (nothing yielded) too
     views = [((1.0, -1.6, 0.9), "view from the front"), ((0.0, -1.0, 0.0), "side view (along y)")]
     if status is not None:
         views.append(((0.0, 0.0, -1.0),

@@ -66,13 +66,17 @@ class Material(ABC):
 
     `is_linear`: the residual is linear in u (Newton converges in one step, no line
     search needed). `finite_strain`: the energy is written in the Green–Lagrange strain.
-    `modified_tangent`: the constant tangent that modified Newton and BFGS keep
-    (`NewtonSolver`'s `constant_tangent`): the tangent at the start of each solve.
     """
 
     finite_strain: bool = False
     is_linear: bool = False
-    modified_tangent: str = "initial"
+
+    def modified_newton_tangent(self, u, model: str, dx):
+        """The tangent modified Newton and BFGS keep: for an elastic law, "initial".
+
+        `NewtonSolver`'s `constant_tangent`: the tangent at the start of each solve.
+        """
+        return "initial"
 
     @abstractmethod
     def energy(self, strain):

@@ -23,10 +23,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
 import ufl
 
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.laws import Isotropic, SmallStrain, check_range
+from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
 
@@ -45,8 +46,6 @@ class J2Plasticity(Isotropic, SmallStrain):
     _state: dict | None = field(default=None, repr=False, compare=False)
 
     path_dependent = True
-    # the course's modified Newton for plasticity: the elastic tangent, factorized once
-    modified_tangent = "elastic"
 
     def __post_init__(self):
         super().__post_init__()
@@ -71,6 +70,16 @@ class J2Plasticity(Isotropic, SmallStrain):
                  "points": T.element.interpolation_points, "commit": None}
         object.__setattr__(self, "_state", state)  # the parameters stay frozen
 
+    def modified_newton_tangent(self, u, model: str, dx):
+        """The course's choice for plasticity: Hooke's tangent (E, ν), factorized once.
+
+        Not K(0) of this energy: that form reads the committed state, and at u = 0 after
+        plastic steps the trial stress −C:ε_p is beyond yield (a plastic tangent).
+        """
+        v = ufl.TestFunction(u.function_space)
+        work = LinearElastic(self.E, self.nu).internal_work(u, v, model)
+        return ufl.derivative(work * dx, u)
+
     def reset(self) -> None:
         """Back to the virgin state (a new load path on the same forms)."""
         st = self._bound()
@@ -92,13 +101,9 @@ class J2Plasticity(Isotropic, SmallStrain):
         from dolfinx import fem
 
         p = self.cumulated_plastic_strain
-        msh = p.function_space.mesh
-        n_cells = msh.topology.index_map(msh.topology.dim).size_local
-        per_point = p.x.array[: p.function_space.dofmap.index_map.size_local]
-        cells = fem.Function(fem.functionspace(msh, ("DG", 0)),
+        cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
                              name="cumulated_plastic_strain")
-        cells.x.array[:n_cells] = per_point.reshape(n_cells, -1).max(axis=1)
-        cells.x.scatter_forward()
+        _per_cell(p, cells, np.max)
         return cells
 
     def _bound(self) -> dict:
@@ -147,13 +152,8 @@ class J2Plasticity(Isotropic, SmallStrain):
         at_points = fem.Function(Q)
         at_points.interpolate(fem.Expression(self.von_mises_expression(u, model),
                                              st["points"]))
-        msh = Q.mesh
-        n_cells = msh.topology.index_map(msh.topology.dim).size_local
-        D = fem.functionspace(msh, ("DG", 0))
-        f = fem.Function(D, name="von_mises")
-        per_cell = at_points.x.array[: Q.dofmap.index_map.size_local].reshape(n_cells, -1)
-        f.x.array[:n_cells] = per_cell.mean(axis=1)
-        f.x.scatter_forward()
+        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name="von_mises")
+        _per_cell(at_points, f, np.mean)
         return f
 
     def commit(self, u, model: str = "3d") -> None:
@@ -175,3 +175,15 @@ class J2Plasticity(Isotropic, SmallStrain):
         b.interpolate(new_p)
         st["eps_p"].x.array[:] = a.x.array
         st["p"].x.array[:] = b.x.array
+
+
+def _per_cell(at_points, cells, reduce) -> None:
+    """DG0 `cells` = `reduce` of each owned cell's quadrature values of `at_points`.
+
+    Read and written through both dofmaps (no assumption on dof numbering); ghosts updated.
+    """
+    msh = cells.function_space.mesh
+    n = msh.topology.index_map(msh.topology.dim).size_local
+    values = at_points.x.array[at_points.function_space.dofmap.list[:n]]  # (cells, points)
+    cells.x.array[cells.function_space.dofmap.list[:n, 0]] = reduce(values, axis=1)
+    cells.x.scatter_forward()

@@ -181,7 +181,7 @@ class Bracket:
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = material.modified_tangent
+            opts["constant_tangent"] = material.modified_newton_tangent(self.u, "3d", part.dx)
         if part.support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
             self.solver = ActiveSetContact(

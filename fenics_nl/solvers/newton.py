@@ -219,7 +219,10 @@ class NewtonSolver:
         method: ``full``, ``modified``, ``periodic`` or ``bfgs`` (see the module).
         tangent: the tangent form; by default ∂R/∂u by UFL.
         constant_tangent: for ``modified`` and ``bfgs``: ``initial`` (the tangent at the
-            start of each solve) or ``elastic`` (K(0), factorized once for the solver's life).
+            start of each solve), ``elastic`` (K(0), factorized once for the solver's life),
+            or a bilinear form, assembled and factorized once for the solver's life (a
+            material with internal variables gives its elastic tangent this way: K(0) would
+            read its current state).
         period: iterations between tangent rebuilds of ``periodic``.
         linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
         prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...).
@@ -247,7 +250,7 @@ class NewtonSolver:
         *,
         method: str = "full",
         tangent: ufl.Form | None = None,
-        constant_tangent: str = "initial",
+        constant_tangent: str | ufl.Form = "initial",
         period: int = 3,
         linear_solver: str = "lu",
         prefix: str = "newton_",
@@ -262,8 +265,9 @@ class NewtonSolver:
     ):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-        if constant_tangent not in ("initial", "elastic"):
-            raise ValueError("constant_tangent must be 'initial' or 'elastic', "
+        given = isinstance(constant_tangent, ufl.Form)
+        if not given and constant_tangent not in ("initial", "elastic"):
+            raise ValueError("constant_tangent must be 'initial', 'elastic' or a form, "
                              f"got {constant_tangent!r}")
         if period < 1:
             raise ValueError(f"period must be >= 1, got {period}")
@@ -284,9 +288,15 @@ class NewtonSolver:
         J_expanded = expand_derivatives(J)
         fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
         self._K_fixed = None  # K without Dirichlet rows, kept after its first assembly
-        for_life = constant_tangent == "elastic" and method in ("modified", "bfgs")
-        # the tangent that is assembled: K(u), or K(0) (the same form at a zero displacement)
-        self._K_used = fem.form(ufl.replace(J, {u: fem.Function(V)})) if for_life else self._K
+        for_life = (given or constant_tangent == "elastic") and method in ("modified", "bfgs")
+        # the tangent that is assembled: K(u), K(0) (the same form at a zero displacement),
+        # or the given one
+        if for_life and given:
+            self._K_used = fem.form(constant_tangent)
+        elif for_life:
+            self._K_used = fem.form(ufl.replace(J, {u: fem.Function(V)}))
+        else:
+            self._K_used = self._K
         self._constant = method in ("modified", "bfgs")
         self.A = petsc.create_matrix(self._K)
         # reuse: the factorized matrix P lags behind A and preconditions CG on A

@@ -56,6 +56,8 @@ def plastic_radius(shape: str, a: float, b: float, sigma0: float, p: float) -> f
             return Y * math.log(c / a) + Y / 2 * (1 - c * c / (b * b)) - p
     if gap(a) >= 0:
         return a
+    if gap(b) <= 0:  # at (or, by round-off, past) the limit: the whole wall
+        return b
     return brentq(gap, a, b, xtol=1e-14 * b)
 
 
@@ -80,8 +82,10 @@ def sphere_inner_displacement(a: float, b: float, E: float, nu: float, sigma0: f
     zone: σ_r = 2σ0 ln(r/c) − p_c, σ_θ = σ_r + σ0, and the plastic flow keeps the volume, so
     (r² u)' = r² tr ε = r² (1 − 2ν)/E (3σ_r + 2σ0) integrates from u(c) down to r = a.
     """
-    if p > limit_pressure("sphere", a, b, sigma0) * (1 + 1e-12):
+    p_lim = limit_pressure("sphere", a, b, sigma0)
+    if p > p_lim * (1 + 1e-12):
         raise ValueError(f"p = {p:g} is beyond the limit pressure: no equilibrium")
+    p = min(p, p_lim)
     c = plastic_radius("sphere", a, b, sigma0, p)
     if c == a:
         return p * elastic_inner_compliance("sphere", a, b, E, nu)
