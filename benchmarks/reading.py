@@ -200,7 +200,8 @@ def plasticity(p: dict) -> list[str]:
             if r["failed"]:
                 items.append(f"{k} failed ({r['failed']})")
             else:
-                ratio = f", {r['solve_time_s'] / full['solve_time_s']:.1f}x full" if full else ""
+                ratio = (f", {r['solve_time_s'] / full['solve_time_s']:.1f}x full"
+                         if full and k != "full" else "")
                 items.append(f"{k} {r['solve_time_s']:.2f} s ({r['newton_iterations']} "
                              f"iterations, {r['step_cuts']} step cuts{ratio})")
         out.append(
