@@ -46,7 +46,7 @@ from mpi4py import MPI
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -92,6 +92,9 @@ def parser():
                    help="load steps from 0 to the load")
     p.add_argument("--formulation", choices=["elimination", "multiplier"], default="elimination",
                    help="active normal displacements as Dirichlet rows, or Lagrange multipliers")
+    p.add_argument("--mixed", action="store_true",
+                   help="Taylor–Hood P2–P1 displacement–pressure elements: no locking as ν → "
+                        "1/2, and ν = 0.5 exactly (with the elimination)")
     p.add_argument("--gap", choices=["parabola", "sphere"], default="parabola",
                    help="punch shape: Hertz's parabola or the exact sphere")
     p.add_argument("--material", choices=["linear", "power-law", "j2"], default="linear",
@@ -125,6 +128,9 @@ args = cli.arguments(p, prefixes=lambda a: {
 # j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
 cli.material_flags(p, args, power_law={"sigma0": 0.01, "n": 0.3},
                    j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
+if args.mixed and args.formulation == "multiplier":
+    p.error("--mixed works with --formulation elimination (the multiplier formulation is "
+            "written for P1 displacements)")
 if args.unload and args.force is not None:
     p.error("--unload takes the punch back up under displacement control: drop --force")
 if args.refine > MAX_REFINE:
@@ -154,7 +160,7 @@ else:
     a = hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
 size = args.block or (100.0 if args.model == "3d" else 1000.0)
 say(f"meshing the {args.model} block ({size:g} contact radii) ...")
-block = PunchBlock(args.model, a, refine=args.refine, block=size)
+block = PunchBlock(args.model, a, refine=args.refine, block=size, mixed=args.mixed)
 # -
 
 # ### The material
@@ -165,7 +171,7 @@ block = PunchBlock(args.model, a, refine=args.refine, block=size)
 
 if args.material == "j2":  # its state lives at the quadrature points of the block's rule
     material = J2Plasticity(E, nu, sigma0=args.sigma0, H=args.hardening)
-    material.bind(block.mesh, 2)
+    material.bind(block.mesh, block.quadrature_degree)
 else:
     material = (LinearElastic(E, nu) if args.material == "linear"
                 else PowerLaw(E, nu, sigma0=args.sigma0, n=args.n))
@@ -175,13 +181,20 @@ else:
 # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega$, and no
 # external load: the punch acts only through the contact conditions. In the axisymmetric
 # model $\varepsilon$ has the hoop strain $u_r/r$ and the weight is $2\pi r$, so that $R$
-# is the whole body's.
+# is the whole body's. With `--mixed` the pressure p is an unknown too and the residual is
+# the variation of $\Pi(u, p) = \int \tilde\varphi(\varepsilon) + p\,\mathrm{tr}\,
+# \varepsilon - p^2/(2\kappa)$ (`fenics_nl.materials.mixed`), which holds at κ = ∞.
 
 # +
-u, v = block.u, ufl.TestFunction(block.V)
-eps = kinematics.small_strain
-residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
-            * block.weight * block.dx)
+u = block.u
+if args.mixed:
+    m = block.mixed
+    residual = mixed.internal_work(material, m.u, m.p, m.v, m.q, block.kinematics) * block.dx
+else:
+    v = ufl.TestFunction(block.V)
+    eps = kinematics.small_strain
+    residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
+                * block.weight * block.dx)
 # -
 
 # ### The active-set loop, in load steps
@@ -220,7 +233,7 @@ if args.unload:  # back up in as many steps; the surface keeps an imprint
     solve_incrementally(load, lambda t: load.set_load(1 - t), args.steps, adaptive=False,
                         predictor=False, on_step=report, commit=commit)
     axis = [0.0] * (3 if args.model == "3d" else 2)
-    imprint = -Probes(block.mesh, [axis]).continuous(u)[0][block.vertical]
+    imprint = -Probes(block.mesh, [axis]).continuous(block.displacement())[0][block.vertical]
     say(f"unloaded: residual imprint depth {imprint:.5g} at the axis (δ_max = "
         f"{last.indentation:.5g})")
 # -
@@ -265,6 +278,7 @@ if len(loading) >= 2 and all(s.force > 0 for s in loading):
 def summary():
     """The quantities of the run, for --json."""
     out = {"model": args.model, "formulation": args.formulation, "material": args.material,
+           "mixed": args.mixed, "elements": "P2-P1 (Taylor-Hood)" if args.mixed else "P1",
            "force": last.force, "indentation": last.indentation,
            "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
            "element_size": block.h, "nodes_in_contact": nodes,
@@ -302,7 +316,8 @@ def summary():
 
 
 def write_fields(vm):
-    paths = output.write_fields(args.output, [punch.u, *punch.contact_fields(), vm])
+    fields = [block.displacement(), *([m.pressure()] if args.mixed else [])]
+    paths = output.write_fields(args.output, [*fields, *punch.contact_fields(), vm])
     say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
 
 
@@ -370,7 +385,7 @@ def pressure_panel(ax, profile, state, ref):
 
 def picture(punch, vm, state, ref, args):
     """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
-    section = output.section(punch.u, vm, normal_axis=1 if punch.block.vertical == 2
+    section = output.section(block.displacement(), vm, normal_axis=1 if punch.block.vertical == 2
                              else None)
     profile = punch.surface_profile()
     if comm.rank != 0:

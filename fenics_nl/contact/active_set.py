@@ -117,18 +117,23 @@ class ActiveSetContact:
         max_iterations: int = 50,
         newton_options: dict | None = None,
         prefix: str = "contact_",
+        displacement_space: fem.FunctionSpace | None = None,
     ):
         if formulation not in FORMULATIONS:
             raise ValueError(f"formulation must be one of {', '.join(FORMULATIONS)}, "
                              f"got {formulation!r}")
         if initial not in ("all", "none", "penetrating"):
             raise ValueError(f"initial must be all, none or penetrating, got {initial!r}")
-        V = u.function_space
-        if V.element.basix_element.degree != 1 and formulation == "multiplier":
+        V = displacement_space or u.function_space
+        if formulation == "multiplier" and displacement_space is not None:
+            raise ValueError("the multiplier contact formulation does not take a mixed "
+                             "displacement-pressure unknown: use the elimination")
+        if formulation == "multiplier" and V.element.basix_element.degree != 1:
             raise ValueError("the multiplier formulation needs a P1 displacement space")
         self.u, self.formulation, self.max_iterations = u, formulation, max_iterations
         self.surface = ContactSurface(V, facets, gap, normal_axis=normal_axis,
-                                      normal_sign=normal_sign)
+                                      normal_sign=normal_sign,
+                                      unknown_space=u.function_space)
         self.comm = self.surface.comm
         self.active = self._initial_set(initial)
         self.force = 0.0  # total normal contact force of the last solve (compression > 0)
@@ -228,7 +233,7 @@ class ActiveSetContact:
             # obstacle's gap or the motion itself
             scale_T = global_max(self.comm, np.abs(T_n))
             scale_u = max(global_max(self.comm, np.abs(S.gamma)),
-                          global_max(self.comm, np.abs(self.u.x.array)))
+                          S.displacement_scale(self.u))
             leave = self.active & (T_n > 1e-10 * scale_T)
             join = ~self.active & (d > 1e-10 * scale_u)
             new = S.sync((self.active & ~leave) | join)

@@ -21,19 +21,27 @@ from petsc4py import PETSc
 
 
 class ContactSurface:
-    """Nodes of S_C for the displacement space V, and the obstacle's gap at them."""
+    """Nodes of S_C for the displacement space V, and the obstacle's gap at them.
+
+    `V` is the unknown's space, or its displacement part (`W.sub(0)` of the mixed
+    formulation), and then `unknown_space` is W: node dofs (`dofs_V`) are in W's numbering.
+    """
 
     def __init__(self, V: fem.FunctionSpace, facets: np.ndarray,
                  gap: Callable[[np.ndarray], np.ndarray], *, normal_axis: int,
-                 normal_sign: int = 1):
+                 normal_sign: int = 1, unknown_space: fem.FunctionSpace | None = None):
         self.V, self.mesh = V, V.mesh
+        self.W = unknown_space or V
+        # every displacement dof in the unknown's numbering (all of them without a pressure)
+        self.displacement_dofs = (slice(None) if self.W is V
+                                  else np.asarray(V.collapse()[1], dtype=np.int32))
         self.comm = self.mesh.comm
         self.axis, self.sign = normal_axis, int(np.sign(normal_sign))
         self.facets = np.asarray(facets, dtype=np.int32)
         if self.comm.allreduce(len(self.facets)) == 0:
             raise ValueError("the contact surface has no facets (missing or wrong tag?)")
         fdim = self.mesh.topology.dim - 1
-        if V.dofmap.index_map_bs == 1:  # one component (a bar): no sub-space to extract
+        if V.num_sub_spaces == 0:  # one component (a bar): no sub-space to extract
             self.Vn, self.component = V, V
             self.dofs_V = self.dofs_n = fem.locate_dofs_topological(V, fdim, self.facets)
         else:
@@ -105,22 +113,32 @@ class ContactSurface:
             tags = mesh.meshtags(self.mesh, fdim, np.sort(self.facets),
                                  np.ones(len(self.facets), dtype=np.int32))
             ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)(1)
-            v = ufl.TestFunction(self.V)
-            v_n = v[self.axis] if ufl.shape(v) else v
+            v_n = self._normal_part(ufl.TestFunction(self.W))
             m = self._at_nodes(petsc.assemble_vector(fem.form(v_n * weight * ds)))
             if self.comm.allreduce(bool(np.any(m[self.owned] <= 1e-12 * np.abs(m).max(initial=0))),
                                    op=MPI.LOR):
-                w = ufl.TrialFunction(self.V)
-                w_n = w[self.axis] if ufl.shape(w) else w
+                w_n = self._normal_part(ufl.TrialFunction(self.W))
                 M = petsc.assemble_matrix(fem.form(w_n * v_n * weight * ds))
                 M.assemble()
-                diagonal = petsc.create_vector(self.V)  # ghosted, like the row sums
+                diagonal = petsc.create_vector(self.W)  # ghosted, like the row sums
                 M.getDiagonal(diagonal)
                 d = self._at_nodes(diagonal)
                 M.destroy()
                 m = d * self.total(m) / self.total(d)
             self._areas[key] = m
         return self._areas[key]
+
+    def _normal_part(self, argument):
+        """n-component of the displacement part of a test or trial function of W."""
+        if self.W is not self.V:
+            argument = ufl.split(argument)[0]
+        return argument[self.axis] if ufl.shape(argument) else argument
+
+    def displacement_scale(self, u: fem.Function) -> float:
+        """The largest displacement component of `u` (the pressure of a mixed unknown left
+        out): a length scale of the current state."""
+        values = u.x.array[self.displacement_dofs]
+        return self.comm.allreduce(float(np.abs(values).max(initial=0.0)), op=MPI.MAX)
 
     def _at_nodes(self, b: PETSc.Vec) -> np.ndarray:
         """An assembled vector's values at the nodes (owned and ghosts); destroys b."""

@@ -30,38 +30,43 @@ def component(V: fem.FunctionSpace, i: int, facets: np.ndarray, value: float = 0
 
 
 def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np.ndarray],
-              components: dict[str, list[int]] | None = None) -> dict[str, list[float]]:
+              components: dict[str, list[int]] | None = None,
+              space: fem.FunctionSpace | None = None) -> dict[str, list[float]]:
     """Resultant force on each facet group: Σ R(u) over its nodes, per component.
 
     R = f_int − f_ext assembled without any Dirichlet row, at the current u: on a supported
     group it is the force the support exerts on the body (an axisymmetric residual carries
-    2πr, so this is the force on the whole revolution). `components`: the components each
-    group holds (default: all); the others are reported as 0. A node component held by
-    several groups (the edge of a clamped bolt hole on a floor) counts in the first of them
-    only: list the groups that hold a node fully (clamped) first. Collective.
+    2πr, so this is the force on the whole revolution). `u` is the residual's unknown and
+    `space` the displacement space, if it is a part of `u`'s (the mixed formulation's
+    `W.sub(0)`). `components`: the components each group holds (default: all); the others
+    are reported as 0. A node component held by several groups (the edge of a clamped bolt
+    hole on a floor) counts in the first of them only: list the groups that hold a node
+    fully (clamped) first. Collective.
     """
     from dolfinx.fem import petsc
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    V = u.function_space
+    W = u.function_space
+    V = space or W
     form = residual if isinstance(residual, fem.Form) else fem.form(residual)
     b = petsc.assemble_vector(form)
     b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-    bs = V.dofmap.index_map_bs
-    n_owned = V.dofmap.index_map.size_local
-    R = b.array_r[: n_owned * bs].reshape(-1, bs).copy()
+    R = b.array_r.copy()
     b.destroy()
+    n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
+    parts = [V.sub(i) for i in range(V.num_sub_spaces)] or [V]  # a scalar space: itself
+    n_comp = len(parts)
     fdim = V.mesh.topology.dim - 1
-    counted = np.zeros((n_owned, bs), dtype=bool)
+    counted = np.zeros(R.size, dtype=bool)
     out = {}
     for name, facets in groups.items():
-        nodes = fem.locate_dofs_topological(V, fdim, facets)
-        nodes = nodes[nodes < n_owned]
-        total = np.zeros(bs)
-        for i in (components or {}).get(name, range(bs)):
-            mine = nodes[~counted[nodes, i]]
-            counted[mine, i] = True
-            total[i] = R[mine, i].sum()
+        total = np.zeros(n_comp)
+        for i in (components or {}).get(name, range(n_comp)):
+            # a component's dofs, in the numbering of u's space (unrolled)
+            dofs = fem.locate_dofs_topological(parts[i], fdim, facets)
+            mine = dofs[(dofs < n_owned) & ~counted[dofs]]
+            counted[mine] = True
+            total[i] = R[mine].sum()
         out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]
     return out

@@ -20,6 +20,12 @@ def check_model(model: str) -> str:
     return model
 
 
+def domain(u):
+    """The mesh (UFL domain) of `u`: a Function, or a part of one (`ufl.split` of a mixed
+    unknown)."""
+    return ufl.domain.extract_unique_domain(u)
+
+
 def displacement_gradient(u, model: str = "3d"):
     """Return the (embedded) displacement gradient H = ∇u of `u` for `model`."""
     check_model(model)
@@ -28,7 +34,7 @@ def displacement_gradient(u, model: str = "3d"):
         return g
     hoop = 0
     if model == "axisymmetric":
-        r = ufl.SpatialCoordinate(u.ufl_function_space().mesh)[0]
+        r = ufl.SpatialCoordinate(domain(u))[0]
         hoop = u[0] / r
     return ufl.as_tensor([[g[0, 0], g[0, 1], 0], [g[1, 0], g[1, 1], 0], [0, 0, hoop]])
 

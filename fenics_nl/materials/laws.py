@@ -9,6 +9,7 @@ the materials that support it use the plane-stress Lamé constant `λ* = 2λμ/(
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
@@ -25,14 +26,24 @@ def check_range(name: str, value: float, low: float, high: float) -> None:
 
 @dataclass(frozen=True)
 class Isotropic:
-    """Young's modulus E > 0 and Poisson's ratio -1 < ν < 0.5."""
+    """Young's modulus E > 0 and Poisson's ratio -1 < ν ≤ 0.5.
+
+    ν = 1/2 (incompressible: λ = κ = ∞) only in the mixed formulation
+    (`fenics_nl.materials.mixed`); `energy` refuses it.
+    """
 
     E: float
     nu: float
 
     def __post_init__(self):
         check_range("E", self.E, 0.0, float("inf"))
-        check_range("nu", self.nu, -1.0, 0.5)
+        if not -1.0 < float(self.nu) <= 0.5:
+            raise ValueError(f"nu must be in (-1, 0.5], got {self.nu!r}")
+
+    @property
+    def incompressible(self) -> bool:
+        """ν = 1/2: λ and κ are infinite."""
+        return self.nu == 0.5
 
     @property
     def mu(self) -> float:
@@ -41,17 +52,30 @@ class Isotropic:
 
     @property
     def lmbda(self) -> float:
-        """First Lamé constant λ."""
+        """First Lamé constant λ (∞ at ν = 1/2)."""
+        if self.incompressible:
+            return math.inf
         return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
 
     @property
     def kappa(self) -> float:
-        """Bulk modulus κ."""
+        """Bulk modulus κ (∞ at ν = 1/2)."""
+        if self.incompressible:
+            return math.inf
         return self.E / (3 * (1 - 2 * self.nu))
 
+    def require_compressible(self) -> None:
+        """Raise ValueError at ν = 1/2: a displacement formulation cannot hold it."""
+        if self.incompressible:
+            raise ValueError("nu = 0.5 (incompressible) needs the mixed displacement-pressure "
+                             "formulation (--mixed): the displacement formulation locks, its "
+                             "bulk modulus is infinite")
+
     def lmbda_for(self, strain) -> float:
-        """λ for a 3x3 strain, the plane-stress λ* for a 2x2 one."""
+        """λ for a 3x3 strain, the plane-stress λ* = 2λμ/(λ + 2μ) for a 2x2 one."""
         if strain.ufl_shape[0] == 2:
+            if self.incompressible:
+                return 2 * self.mu  # the limit λ → ∞
             return 2 * self.lmbda * self.mu / (self.lmbda + 2 * self.mu)
         return self.lmbda
 
@@ -81,6 +105,13 @@ class Material(ABC):
     @abstractmethod
     def energy(self, strain):
         """Free-energy density of the strain (ε in small strain, e in finite strain)."""
+
+    def volumetric_split(self, strain):
+        """(φ̃, g, k) with φ = φ̃ + k/2 g²: g the volumetric measure (tr ε, tr e or ln J) and
+        k the modulus that tends to ∞ as ν → 1/2 (κ or λ). The mixed formulation
+        (`fenics_nl.materials.mixed`) needs it."""
+        raise ValueError(f"{type(self).__name__} has no volumetric split: no mixed "
+                         "displacement-pressure formulation")
 
     @abstractmethod
     def internal_work(self, u, v, model: str = "3d"):
@@ -130,7 +161,7 @@ class SmallStrain(Material):
 
     def internal_work(self, u, v, model: str = "3d"):
         """Integrand of the internal virtual work σ(ε(u)) : ε(v) (times 2πr if axisymmetric)."""
-        mesh = u.ufl_function_space().mesh
+        mesh = kinematics.domain(u)
         eps_u = kinematics.small_strain(u, model)
         eps_v = kinematics.small_strain(v, model)
         return ufl.inner(self.stress(eps_u), eps_v) * kinematics.measure_weight(mesh, model)
@@ -162,7 +193,7 @@ class FiniteStrain(Material):
 
     def internal_work(self, u, v, model: str = "3d"):
         """Integrand of P(u) : ∇v over the reference configuration (times 2πR if axisymmetric)."""
-        mesh = u.ufl_function_space().mesh
+        mesh = kinematics.domain(u)
         H_v = kinematics.displacement_gradient(v, model)
         return ufl.inner(self.first_piola(u, model), H_v) * kinematics.measure_weight(mesh, model)
 
@@ -175,7 +206,15 @@ class LinearElastic(Isotropic, SmallStrain):
 
     def energy(self, eps):
         """φ(ε)."""
+        if eps.ufl_shape[0] == 3:  # plane stress keeps a finite λ* at ν = 1/2
+            self.require_compressible()
         return 0.5 * self.lmbda_for(eps) * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
+
+    def volumetric_split(self, eps):
+        """φ = μ dev ε : dev ε + κ/2 (tr ε)²."""
+        self.require_3x3(eps)
+        d = ufl.dev(eps)
+        return self.mu * ufl.inner(d, d), ufl.tr(eps), self.kappa
 
 
 @dataclass(frozen=True)
@@ -204,13 +243,18 @@ class PowerLaw(Isotropic, SmallStrain):
 
     def energy(self, eps):
         """φ(ε)."""
+        self.require_compressible()
+        rest, g, k = self.volumetric_split(eps)
+        return 0.5 * k * g**2 + rest
+
+    def volumetric_split(self, eps):
+        """φ = σ0 ε0/(n+1) [...] + κ/2 (tr ε)²: the deviatoric part is the power law."""
         self.require_3x3(eps)
         d = ufl.dev(eps)
         x2 = (2.0 / 3.0) * ufl.inner(d, d) / self.eps0**2
         n = self.n
-        return 0.5 * self.kappa * ufl.tr(eps) ** 2 + self.sigma0 * self.eps0 / (n + 1) * (
-            (1 + x2) ** ((n + 1) / 2) - 1
-        )
+        return (self.sigma0 * self.eps0 / (n + 1) * ((1 + x2) ** ((n + 1) / 2) - 1),
+                ufl.tr(eps), self.kappa)
 
 
 @dataclass(frozen=True)
@@ -219,7 +263,15 @@ class StVenantKirchhoff(Isotropic, FiniteStrain):
 
     def energy(self, e):
         """φ(e)."""
+        if e.ufl_shape[0] == 3:
+            self.require_compressible()
         return 0.5 * self.lmbda_for(e) * ufl.tr(e) ** 2 + self.mu * ufl.inner(e, e)
+
+    def volumetric_split(self, e):
+        """φ = μ dev e : dev e + κ/2 (tr e)² (at κ = ∞: tr e = 0, not J = 1)."""
+        self.require_3x3(e)
+        d = ufl.dev(e)
+        return self.mu * ufl.inner(d, d), ufl.tr(e), self.kappa
 
 
 @dataclass(frozen=True)
@@ -228,7 +280,14 @@ class NeoHookean(Isotropic, FiniteStrain):
 
     def energy(self, e):
         """φ(e)."""
+        self.require_compressible()
+        rest, lnJ, lmbda = self.volumetric_split(e)
+        return rest + 0.5 * lmbda * lnJ**2
+
+    def volumetric_split(self, e):
+        """φ = [μ/2 (tr C − 3) − μ ln J] + λ/2 (ln J)²: at λ = ∞, J = 1 and the first term
+        is the incompressible neo-Hookean energy μ/2 (tr C − 3)."""
         self.require_3x3(e)
         C = ufl.Identity(3) + 2 * e
         lnJ = 0.5 * ufl.ln(ufl.det(C))
-        return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
+        return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ, lnJ, self.lmbda

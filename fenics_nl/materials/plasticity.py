@@ -117,10 +117,10 @@ class J2Plasticity(Isotropic, SmallStrain):
         self.require_3x3(eps)
         st = self._bound()
         eps_p_n, p_n = st["eps_p"], st["p"]
-        mu, lmbda = self.mu, self.lmbda
+        mu = self.mu
         eps_e = eps - eps_p_n
-        xi = ufl.dev(lmbda * ufl.tr(eps_e) * ufl.Identity(3) + 2 * mu * eps_e) \
-            - 2.0 / 3.0 * self.C * eps_p_n
+        # dev σ_tr = 2μ dev ε_e: the bulk modulus (∞ at ν = 1/2) does not enter the return
+        xi = 2 * mu * ufl.dev(eps_e) - 2.0 / 3.0 * self.C * eps_p_n
         q = ufl.sqrt(1.5 * ufl.inner(xi, xi))
         f = q - (self.sigma0 + self.H * p_n)
         # a point left on the yield surface by the last step has f = 0 up to round-off: it
@@ -134,11 +134,21 @@ class J2Plasticity(Isotropic, SmallStrain):
 
     def energy(self, eps):
         """ψ(ε): the step's condensed energy at the return-mapped state."""
+        self.require_compressible()
         eps_p, p, dp = self.return_map(eps)
         eps_e = eps - eps_p
         return (0.5 * self.lmbda * ufl.tr(eps_e) ** 2 + self.mu * ufl.inner(eps_e, eps_e)
                 + 0.5 * self.H * p**2 + self.C / 3.0 * ufl.inner(eps_p, eps_p)
                 + self.sigma0 * dp)
+
+    def volumetric_split(self, eps):
+        """ψ = [μ |dev ε_e|² + hardening + σ0 Δp] + κ/2 (tr ε)²: the plastic flow is
+        isochoric (tr ε_p = 0), so the bulk term holds the total strain."""
+        eps_p, p, dp = self.return_map(eps)
+        d = ufl.dev(eps - eps_p)
+        rest = (self.mu * ufl.inner(d, d) + 0.5 * self.H * p**2
+                + self.C / 3.0 * ufl.inner(eps_p, eps_p) + self.sigma0 * dp)
+        return rest, ufl.tr(eps), self.kappa
 
     def von_mises(self, u, model: str = "3d"):
         """σ_eq per cell (DG0): the mean of its quadrature points' values.

@@ -32,6 +32,8 @@ from fenics_nl.domain.meshes import graded_block
 from fenics_nl.errors import SolveError
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.materials import mixed as mixed_form
+from fenics_nl.materials.mixed import MixedUnknown
 from fenics_nl.parallel import gather_rows, global_max
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
@@ -77,10 +79,15 @@ class PunchBlock:
     `a` is the expected contact radius. Everything a residual is written with is public:
     `u`, `V`, `kinematics` (the strain model), `dx` (degree-2 quadrature, exact for P1) and
     `weight` (2πr in the axisymmetric model, else 1).
+
+    `mixed=True`: the Taylor–Hood pair (u, p) of `materials.mixed` (P2–P1) on the same
+    mesh; `unknown` is the Function a solver updates (u itself otherwise), `u` and `p` the
+    parts for forms, `displacement()` a Function of u to probe and draw, `dx` of degree 4.
     """
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
-                 growth: float | None = None, comm: MPI.Comm = MPI.COMM_WORLD):
+                 growth: float | None = None, mixed: bool = False,
+                 comm: MPI.Comm = MPI.COMM_WORLD):
         if model not in MODELS:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         if refine < 0 or block < 10:
@@ -94,12 +101,19 @@ class PunchBlock:
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth)
         self.mesh = data.mesh
-        self.V = fem.functionspace(self.mesh, ("Lagrange", 1, (dim,)))
-        self.u = fem.Function(self.V, name="displacement")
+        self.mixed = MixedUnknown(self.mesh) if mixed else None
+        if mixed:
+            self.V, self.unknown = self.mixed.V, self.mixed.w
+            self.u, self.p = self.mixed.u, self.mixed.p
+        else:
+            self.V = fem.functionspace(self.mesh, ("Lagrange", 1, (dim,)))
+            self.u = self.unknown = fem.Function(self.V, name="displacement")
+            self.p = None
         self.kinematics = ("axisymmetric" if model == "axisymmetric"
                            else "3d" if dim == 3 else "plane_strain")
         self.weight = kinematics.measure_weight(self.mesh, self.kinematics)
-        self.dx = kinematics.quadrature_measure("dx", self.mesh, 2)
+        self.quadrature_degree = 4 if mixed else 2
+        self.dx = kinematics.quadrature_measure("dx", self.mesh, self.quadrature_degree)
 
         def facets(name):
             return data.facet_tags.find(data.physical_groups[name].tag)
@@ -115,23 +129,33 @@ class PunchBlock:
         # force of the whole body from the modelled part (2πr is in the weight)
         self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
 
+    def displacement(self) -> fem.Function:
+        """The displacement as a Function (a copy of the mixed unknown's part)."""
+        return self.mixed.displacement() if self.mixed else self.u
+
     def radius_of(self, x):
         """Distance from the punch axis (the x coordinate in plane strain)."""
         return np.sqrt(x[0] ** 2 + x[1] ** 2) if self.model == "3d" else np.abs(x[0])
 
 
 def build_punch(model: str, material, radius: float, a: float, *, refine: int = 1,
-                block: float = 1000.0, growth: float | None = None,
+                block: float = 1000.0, growth: float | None = None, mixed: bool = False,
                 comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Punch:
     """The punch scene in one call (as `demos/punch.py` composes it), for tests and benchmarks.
 
     `options` go to `Punch` (formulation, gap, newton_options).
     """
-    body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm)
-    eps = kinematics.small_strain
-    v = ufl.TestFunction(body.V)
-    residual = (ufl.inner(material.stress(eps(body.u, body.kinematics)),
-                          eps(v, body.kinematics)) * body.weight * body.dx)
+    body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm,
+                      mixed=mixed)
+    if mixed:
+        m = body.mixed
+        residual = mixed_form.internal_work(material, m.u, m.p, m.v, m.q,
+                                            body.kinematics) * body.dx
+    else:
+        eps = kinematics.small_strain
+        v = ufl.TestFunction(body.V)
+        residual = (ufl.inner(material.stress(eps(body.u, body.kinematics)),
+                              eps(v, body.kinematics)) * body.weight * body.dx)
     return Punch(body, material, residual, radius, **options)
 
 
@@ -160,7 +184,8 @@ class Punch:
             raise ValueError(f"gap must be parabola or sphere, got {gap!r}")
         self.block, self.material, self.residual = block, material, residual
         self.R, self.gap_shape = radius, gap
-        self.model, self.mesh, self.u, self.bcs = block.model, block.mesh, block.u, block.bcs
+        self.model, self.mesh, self.bcs = block.model, block.mesh, block.bcs
+        self.u = block.unknown  # the Function the active-set loop updates
         # the force scale of Newton's absolute tolerance: Hertz's force for the expected a
         # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length)
         a, model = block.a, block.model
@@ -175,11 +200,12 @@ class Punch:
             residual, self.u, self.bcs, self.block.contact_facets, self.gap(0.0),
             normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
             initial="penetrating", newton_options=opts,
-            prefix=f"punch_{model.replace('-', '')}_")
+            prefix=f"punch_{model.replace('-', '')}_",
+            displacement_space=block.V if block.mixed else None)
 
     @property
     def dofs(self) -> int:
-        """Global number of displacement unknowns."""
+        """Global number of unknowns (displacement, and pressure if mixed)."""
         return output.dofs(self.u.function_space)
 
     def gap_at(self, r, delta: float):
@@ -252,7 +278,10 @@ class Punch:
 
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (DG0), with the hoop strain in the axisymmetric model."""
-        return self.material.von_mises(self.u, self.block.kinematics)
+        b = self.block
+        if b.mixed:
+            return mixed_form.von_mises(self.material, b.u, b.p, b.kinematics, b.mesh)
+        return self.material.von_mises(self.u, b.kinematics)
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal contact pressure and active set (1/0) on S_C, to write out."""
@@ -263,7 +292,7 @@ class Punch:
 
         A node shared by two groups (a corner) counts in the first: contact, bottom, symmetry.
         """
-        return boundary.reactions(self.residual, self.u, self.block.groups)
+        return boundary.reactions(self.residual, self.u, self.block.groups, space=self.block.V)
 
     def hertz(self, state: Indentation) -> dict[str, float]:
         """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""

@@ -15,8 +15,12 @@ The variants differ only by *when the tangent K is rebuilt*:
 * ``bfgs``: the constant tangent of ``modified`` corrected by inverse BFGS updates
   (Matthies–Strang), superlinear convergence for one factorization.
 
-Boundary values are imposed on U before the first residual, so every correction δU is
-homogeneous on the Dirichlet dofs and no lifting is needed. A tangent is only reassembled
+New boundary values (a prescribed motion, a contact node made active) enter through the
+first correction, not by moving the boundary nodes alone: δU = g − U on the Dirichlet dofs
+and the interior answers through the tangent's columns (lifting), so the first iterate is
+the linearised response of the whole body. Moving the nodes first would crush (or plastify)
+the elements along the boundary, and Newton could diverge from there. Every later
+correction is homogeneous on the Dirichlet dofs. A tangent is only reassembled
 when the method asks for it; the matrix keeps its sparsity pattern, so PETSc/MUMPS redo the
 numeric factorization only and reuse the symbolic analysis.
 """
@@ -342,13 +346,11 @@ class NewtonSolver:
         """Run the loop from the current `u`; raise ConvergenceError on failure."""
         t_start = time.perf_counter()
         work = WorkCounts()
-        x = self.u.x.petsc_vec
-        petsc.set_bc(x, self.bcs)  # U[bc] = g, so every correction is zero there
-        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         self.policy.start_solve()
         if self.bfgs:
             self.bfgs.clear()
-        norms = [self._residual(work)]
+        lift = self._boundary_moved()  # the first correction carries g − U (see the module)
+        norms = [self._residual(work, lift=lift)]
         elapsed = [time.perf_counter() - t_start]
         k = 0
 
@@ -363,7 +365,7 @@ class NewtonSolver:
             if not math.isfinite(rnorm):
                 raise ConvergenceError(f"residual is not finite at iteration {k}",
                                        result(False, "nan"))
-            if rnorm <= self._threshold(norms[0]):
+            if rnorm <= self._threshold(norms[0]) and not lift:
                 return result(True, "converged")
             if k >= self.max_it:
                 raise ConvergenceError(f"no convergence in {self.max_it} iterations "
@@ -385,12 +387,14 @@ class NewtonSolver:
                     self._linear_solve(self.b, work)
             except _LinearSolveFailed as err:
                 raise ConvergenceError(f"{err} at iteration {k}", result(False, "ksp")) from None
-            alpha, rnorm_new = self._step(rnorm, work)
+            alpha, rnorm_new = self._step(rnorm, work, full_step=lift)
             norms.append(rnorm_new)
             elapsed.append(time.perf_counter() - t_start)
             if self.bfgs:
-                self.bfgs.store(self.du, alpha, b_old, self.b)
+                if not lift:  # the lifted step's rhs is not a residual difference
+                    self.bfgs.store(self.du, alpha, b_old, self.b)
                 b_old.destroy()
+            lift = False
             k += 1
 
     # -- pieces ----------------------------------------------------------------------
@@ -400,16 +404,43 @@ class NewtonSolver:
         self._largest_r0 = max(self._largest_r0, r0)
         return max(self.rtol * r0, self.atol * (self.force_scale or self._largest_r0))
 
-    def _residual(self, work: WorkCounts) -> float:
-        """b = R(u) with b[bc] = u − g (zero once imposed); returns ‖b‖."""
+    def _boundary_moved(self) -> bool:
+        """Whether U differs from g on a Dirichlet dof (on any rank)."""
+        x = self.u.x.petsc_vec
+        gap = x.duplicate()
+        gap.set(0.0)
+        petsc.set_bc(gap, self.bcs, x0=x, alpha=-1.0)  # u − g on the Dirichlet dofs
+        moved = gap.norm(PETSc.NormType.NORM_INFINITY)
+        gap.destroy()
+        scale = x.norm(PETSc.NormType.NORM_INFINITY)
+        return moved > 1e-14 * scale if scale > 0 else moved > 0
+
+    def _residual(self, work: WorkCounts, lift: bool = False) -> float:
+        """b = R(u) with b[bc] = u − g; returns ‖b‖ off the Dirichlet rows (a force).
+
+        `lift`: also b −= K (u − g) on the Dirichlet columns, so that the correction δU = −K⁻¹b
+        moves the boundary to g and the interior with it.
+        """
         with _Timer(work, "residual"):
             with self.b.localForm() as loc:
                 loc.set(0.0)
             petsc.assemble_vector(self.b, self._R)
+            x = self.u.x.petsc_vec
+            if lift:
+                petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
             self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            petsc.set_bc(self.b, self.bcs, x0=self.u.x.petsc_vec, alpha=-1.0)
+            petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
             work.residual_assemblies += 1
-            return self.b.norm()
+            return self._force_norm()
+
+    def _force_norm(self) -> float:
+        """‖b‖ without the Dirichlet rows: the equilibrium imbalance, in force units."""
+        n = self.b.getLocalSize()
+        values = self.b.array_r[:n].copy()
+        for bc in self.bcs:
+            owned, count = bc.dof_indices()
+            values[owned[:count]] = 0.0
+        return math.sqrt(self.b.comm.tompi4py().allreduce(float(values @ values)))
 
     def _assemble_tangent(self, work: WorkCounts) -> None:
         with _Timer(work, "tangent"):
@@ -467,9 +498,11 @@ class NewtonSolver:
         if self.policy.reuse:  # many iterations: cheaper to refactorize next time
             self.policy.krylov_iterations(its)
 
-    def _step(self, rnorm: float, work: WorkCounts) -> tuple[float, float]:
+    def _step(self, rnorm: float, work: WorkCounts, full_step: bool = False
+              ) -> tuple[float, float]:
         """u ← u − α du with α = 1, or backtracking on ‖R‖ if line search is on.
 
+        `full_step`: α = 1 whatever (the lifted step must reach the boundary values).
         Returns α and the new ‖R‖.
         """
         x = self.u.x.petsc_vec
@@ -477,7 +510,7 @@ class NewtonSolver:
         x.axpy(-alpha, self.du)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         norm = self._residual(work)
-        if self.line_search:
+        if self.line_search and not full_step:
             for _ in range(10):
                 if math.isfinite(norm) and norm <= (1 - 1e-4 * alpha) * rnorm:
                     break

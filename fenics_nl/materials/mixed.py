@@ -1,0 +1,123 @@
+"""The displacement–pressure (u, p) formulation of every energy of the library.
+
+Each energy splits as φ = φ̃ + k/2 g² (`Material.volumetric_split`): g the volumetric
+measure (tr ε in small strain, tr e or ln J in finite strain) and k the modulus that tends
+to ∞ as ν → 1/2 (κ, or λ for the neo-Hookean law). With p an unknown field, the perturbed
+Lagrangian
+
+    Π(u, p) = ∫ φ̃(u) + p g(u) − p²/(2k) dΩ
+
+is stationary in p where p = k g: for a finite k the solution is the displacement
+formulation's, and at k = ∞ (ν = 1/2 exactly) the term p²/(2k) vanishes, g = 0 is a
+constraint and p its multiplier. The residual δΠ is written as the laws write their
+stresses (`ufl.variable` + `ufl.diff` of φ̃ + p g), and the tangent is its UFL derivative:
+nothing is typed. For the small-strain laws p = κ tr ε is the mean stress.
+
+The spaces are Taylor–Hood, P2 displacement and P1 pressure on the same mesh: inf-sup
+stable, so neither locking nor a checkerboard pressure, in 2D, 3D and the axisymmetric
+model. A J2 material keeps its state at the quadrature points of the residual's rule, as
+in the displacement formulation (its plastic flow is isochoric: tr ε_p = 0).
+"""
+
+from __future__ import annotations
+
+import math
+
+import basix.ufl
+import ufl
+from dolfinx import fem
+
+from fenics_nl.materials import kinematics
+
+
+def taylor_hood(mesh, degree: int = 2) -> fem.FunctionSpace:
+    """The mixed space (P`degree` vector displacement, P`degree − 1` pressure)."""
+    if degree < 2:
+        raise ValueError(f"Taylor–Hood needs a displacement degree >= 2, got {degree}")
+    cell, gdim = mesh.basix_cell(), mesh.geometry.dim
+    dtype = mesh.geometry.x.dtype
+    Pu = basix.ufl.element("Lagrange", cell, degree, shape=(gdim,), dtype=dtype)
+    Pp = basix.ufl.element("Lagrange", cell, degree - 1, dtype=dtype)
+    return fem.functionspace(mesh, basix.ufl.mixed_element([Pu, Pp]))
+
+
+def internal_work(material, u, p, v, q, model: str = "3d"):
+    """Integrand of δΠ(u, p; v, q): the virtual work of φ̃ + p g, and q (g − p/k).
+
+    `u`, `p` are the parts of the mixed unknown (`ufl.split`), `v`, `q` those of the test
+    function. Times 2πr in the axisymmetric model.
+    """
+    if model == "plane_stress":
+        raise ValueError("the mixed formulation is for 3D, plane-strain and axisymmetric "
+                         "models (plane stress has no volumetric constraint)")
+    weight = kinematics.measure_weight(kinematics.domain(u), model)
+    if material.finite_strain:
+        strain = ufl.variable(kinematics.green_lagrange(u, model))
+    else:
+        strain = ufl.variable(kinematics.small_strain(u, model))
+    rest, g, k = material.volumetric_split(strain)
+    stress = ufl.diff(rest + p * g, strain)  # σ̃ (small strain) or S̃ (finite strain)
+    if material.finite_strain:
+        F = kinematics.deformation_gradient(u, model)
+        work = ufl.inner(F * stress, kinematics.displacement_gradient(v, model))
+    else:
+        work = ufl.inner(stress, kinematics.small_strain(v, model))
+    constraint = g if math.isinf(k) else g - p / k
+    return (work + q * constraint) * weight
+
+
+def cauchy_stress(material, u, p, model: str = "3d"):
+    """σ of the mixed state: ∂(φ̃ + p g)/∂ε in small strain, F S̃ Fᵀ / J in finite strain."""
+    if material.finite_strain:
+        e = ufl.variable(kinematics.green_lagrange(u, model))
+        rest, g, _ = material.volumetric_split(e)
+        F = kinematics.deformation_gradient(u, model)
+        return F * ufl.diff(rest + p * g, e) * F.T / ufl.det(F)
+    eps = ufl.variable(kinematics.small_strain(u, model))
+    rest, g, _ = material.volumetric_split(eps)
+    return ufl.diff(rest + p * g, eps)
+
+
+def von_mises_expression(material, u, p, model: str = "3d"):
+    """σ_eq = √(3/2) ‖dev σ‖ of the mixed state (UFL)."""
+    s = ufl.dev(cauchy_stress(material, u, p, model))
+    return ufl.sqrt(1.5 * ufl.inner(s, s))
+
+
+def von_mises(material, u, p, model: str, mesh) -> fem.Function:
+    """σ_eq per cell (DG0, at the centroid) of the mixed state on `mesh`."""
+    Q = fem.functionspace(mesh, ("DG", 0))
+    f = fem.Function(Q, name="von_mises")
+    f.interpolate(fem.Expression(von_mises_expression(material, u, p, model),
+                                 Q.element.interpolation_points))
+    return f
+
+
+class MixedUnknown:
+    """w = (u, p) in Taylor–Hood, and what scenes read of it.
+
+    `w` is the Function a solver updates; `u`, `p` its parts for forms; `V` the displacement
+    sub-space (Dirichlet conditions, contact nodes: dofs in `w`'s numbering); and
+    `displacement()`, `pressure()` collapsed copies to probe, draw and write.
+    """
+
+    def __init__(self, mesh, degree: int = 2):
+        self.W = taylor_hood(mesh, degree)
+        self.w = fem.Function(self.W, name="displacement_pressure")
+        self.V, self.Q = self.W.sub(0), self.W.sub(1)
+        self.u, self.p = ufl.split(self.w)
+        self.v, self.q = ufl.TestFunctions(self.W)
+        Vc, self._u_dofs = self.V.collapse()
+        Qc, self._p_dofs = self.Q.collapse()
+        self._u = fem.Function(Vc, name="displacement")
+        self._p = fem.Function(Qc, name="pressure")
+
+    def displacement(self) -> fem.Function:
+        """The current displacement (a copy in the collapsed P2 space)."""
+        self._u.x.array[:] = self.w.x.array[self._u_dofs]
+        return self._u
+
+    def pressure(self) -> fem.Function:
+        """The current pressure field p (a copy in the collapsed P1 space)."""
+        self._p.x.array[:] = self.w.x.array[self._p_dofs]
+        return self._p
