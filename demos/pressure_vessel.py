@@ -237,6 +237,12 @@ except LoadStepError as err:
 solve_time = time.perf_counter() - t0  # the load steps only, for the benchmarks
 pressure, inner = path[-1]
 loaded = pressure  # the peak, also after unloading
+if args.hardening == 0 and pressure > p_lim * (1 + 1e-3):
+    # perfect plasticity has no equilibrium there: a discrete one means the elements lock
+    # in the isochoric plastic flow (P2 with a few elements through the wall)
+    raise SolveError(f"p = {pressure / p_lim:.4f} p_lim found an equilibrium beyond the limit "
+                     f"pressure, which has none: the mesh locks (h = {body.h:.3g}, "
+                     f"{(b - a) / body.h:.0f} elements through the wall); refine --size")
 c_fe = body.plastic_radius(material)
 c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
 say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "

@@ -233,7 +233,7 @@ def test_every_mistake_of_a_file_at_once(tmp_path, demo):
                                                          'law = "linear-elastic"\nsigma0 = 1.0')
     write(tmp_path, "bar.geo", BAR_GEO)
     lines = check(demo, tmp_path, text)
-    expected = ["mesh.sise: unknown key", "material.nu: must be in (-1, 0.5), got 0.7",
+    expected = ["mesh.sise: unknown key", "material.nu: must be in (-1, 0.5], got 0.7",
                 "material.sigma0: unknown key", "boundary[4].traction: must be a list of 3",
                 "loading.step: unknown key", "loading.steps: missing"]
     for e in expected:

@@ -202,7 +202,8 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path, demo):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["--nu", "0.5"], "nu must be in"), (["--radius", "-1"], "--radius: must be > 0"),
+    (["--nu", "0.6"], "nu must be in"), (["--nu", "0.5"], "needs the mixed"),
+    (["--radius", "-1"], "--radius: must be > 0"),
     (["--E", "-3"], "--E: must be > 0"), (["--steps", "0"], "--steps"),
     (["--bogus", "1"], "unrecognized"), (["--force", "-1"], "--force"),
     (["--indentation", "nan"], "--indentation: must be a finite number"),
@@ -273,7 +274,7 @@ def test_beam_two_ranks_match_serial(demo):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["--thickness", "0.5"], "slender"), (["--nu", "0.5"], "nu must be in"),
+    (["--thickness", "0.5"], "slender"), (["--nu", "0.6"], "nu must be in"),
     (["--load-ratio", "-1"], "--load-ratio"), (["--steps", "0"], "--steps"),
     (["--material", "neo-hookean"], "plane strain only"), (["--oops"], "unrecognized"),
     (["--E", "nan"], "--E: must be a finite number"), (["-ksp_view"], "-beam_"),

@@ -45,7 +45,7 @@ def test_sphere_onset_plastic_radius_and_residual_stress(demo):
 
 def test_sphere_displacement_control_reaches_the_limit_pressure(demo):
     d = demo.json("pressure_vessel.py", "--inner-displacement", "1.0", "--steps", "5")
-    assert d["pressure"] == pytest.approx(d["limit_pressure_exact"], rel=0.01)  # +0.6 %
+    assert d["pressure"] == pytest.approx(d["limit_pressure_exact"], rel=2e-3)  # -0.01 %
     assert abs(d["plastic_radius"] - 200.0) < d["element_size"]
 
 
@@ -54,7 +54,7 @@ def test_cylinder_onset_and_limit(demo):
                   "--steps", "5")
     assert d["yield_onset_pressure"] == pytest.approx(d["yield_onset_pressure_exact"],
                                                       rel=5e-3)
-    assert d["pressure"] == pytest.approx(d["limit_pressure_exact"], rel=0.01)
+    assert d["pressure"] == pytest.approx(d["limit_pressure_exact"], rel=2e-3)  # measured -0.001 %
 
 
 def test_beyond_the_limit_load_is_one_line(demo):
@@ -76,3 +76,11 @@ def test_two_ranks_give_the_serial_answer(demo, ranks):
     assert p["ranks"] == ranks
     for k in ("yield_onset_pressure", "plastic_radius", "inner_displacement"):
         assert p[k] == pytest.approx(s[k], rel=1e-8), k
+
+
+def test_a_locking_mesh_past_the_limit_is_refused_in_one_line(demo):
+    # h = 25, 4 elements through the wall: 1.2 p_lim "converges" to u(a) = 27 a
+    proc = demo.run(["pressure_vessel.py", "--pressure-ratio", "1.2", "--size", "25"],
+                    check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and "the mesh locks" in lines[0]

@@ -292,7 +292,7 @@ def _material(r: _Reader, data: dict, model: str | None):
     if len(parameters) == len(params):
         try:
             LAWS[law](**parameters)
-        except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5), ..."
+        except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"material.{name}" if name in parameters else "material", rest or name)
     if law in ("neo-hookean", "power-law", "j2") and model == "plane_stress":

@@ -135,8 +135,10 @@ class ContactSurface:
         return argument[self.axis] if ufl.shape(argument) else argument
 
     def displacement_scale(self, u: fem.Function) -> float:
-        """The largest displacement component of `u` (the pressure of a mixed unknown left
-        out): a length scale of the current state."""
+        """The largest displacement component of `u`: a length scale of the current state.
+
+        The pressure of a mixed unknown is left out.
+        """
         values = u.x.array[self.displacement_dofs]
         return self.comm.allreduce(float(np.abs(values).max(initial=0.0)), op=MPI.MAX)
 

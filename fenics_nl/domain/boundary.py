@@ -65,7 +65,8 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
         for i in (components or {}).get(name, range(n_comp)):
             # a component's dofs, in the numbering of u's space (unrolled)
             dofs = fem.locate_dofs_topological(parts[i], fdim, facets)
-            mine = dofs[(dofs < n_owned) & ~counted[dofs]]
+            dofs = dofs[dofs < n_owned]  # owned only: R and `counted` hold no ghosts
+            mine = dofs[~counted[dofs]]
             counted[mine] = True
             total[i] = R[mine].sum()
         out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]

@@ -21,8 +21,7 @@ def check_model(model: str) -> str:
 
 
 def domain(u):
-    """The mesh (UFL domain) of `u`: a Function, or a part of one (`ufl.split` of a mixed
-    unknown)."""
+    """The mesh (UFL domain) of `u`: a Function, or a part of one (`ufl.split`)."""
     return ufl.domain.extract_unique_domain(u)
 
 

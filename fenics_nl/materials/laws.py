@@ -107,9 +107,11 @@ class Material(ABC):
         """Free-energy density of the strain (ε in small strain, e in finite strain)."""
 
     def volumetric_split(self, strain):
-        """(φ̃, g, k) with φ = φ̃ + k/2 g²: g the volumetric measure (tr ε, tr e or ln J) and
-        k the modulus that tends to ∞ as ν → 1/2 (κ or λ). The mixed formulation
-        (`fenics_nl.materials.mixed`) needs it."""
+        """(φ̃, g, k) with φ = φ̃ + k/2 g², for the mixed formulation (`materials.mixed`).
+
+        g is the volumetric measure (tr ε, tr e or ln J), k the modulus that tends to ∞ as
+        ν → 1/2 (κ or λ).
+        """
         raise ValueError(f"{type(self).__name__} has no volumetric split: no mixed "
                          "displacement-pressure formulation")
 
@@ -285,8 +287,10 @@ class NeoHookean(Isotropic, FiniteStrain):
         return rest + 0.5 * lmbda * lnJ**2
 
     def volumetric_split(self, e):
-        """φ = [μ/2 (tr C − 3) − μ ln J] + λ/2 (ln J)²: at λ = ∞, J = 1 and the first term
-        is the incompressible neo-Hookean energy μ/2 (tr C − 3)."""
+        """φ = [μ/2 (tr C − 3) − μ ln J] + λ/2 (ln J)².
+
+        At λ = ∞, J = 1 and the first term is the incompressible neo-Hookean μ/2 (tr C − 3).
+        """
         self.require_3x3(e)
         C = ufl.Identity(3) + 2 * e
         lnJ = 0.5 * ufl.ln(ufl.det(C))

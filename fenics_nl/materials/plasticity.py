@@ -142,8 +142,10 @@ class J2Plasticity(Isotropic, SmallStrain):
                 + self.sigma0 * dp)
 
     def volumetric_split(self, eps):
-        """ψ = [μ |dev ε_e|² + hardening + σ0 Δp] + κ/2 (tr ε)²: the plastic flow is
-        isochoric (tr ε_p = 0), so the bulk term holds the total strain."""
+        """ψ = [μ |dev ε_e|² + hardening + σ0 Δp] + κ/2 (tr ε)².
+
+        The plastic flow is isochoric (tr ε_p = 0), so the bulk term holds the total strain.
+        """
         eps_p, p, dp = self.return_map(eps)
         d = ufl.dev(eps - eps_p)
         rest = (self.mu * ufl.inner(d, d) + 0.5 * self.H * p**2

@@ -89,14 +89,14 @@ class VesselBody:
         self._motion.interpolate(lambda x: delta * x[:2] / np.hypot(x[0], x[1]))
 
     def pressure_from(self, residual, inner_radius: float | None = None) -> float:
-        """The pressure the inner support exerts (displacement control), small strain; for
-        finite strain give the deformed `inner_radius`.
+        """The pressure the inner support exerts (displacement control).
 
-        Read where the wall carries it: the symmetry plane across the wall holds the
-        pressure's resultant (sphere: the plane z = 0 the axial p π a²; cylinder: the plane
-        x = 0 the x resultant p a per unit length of the quarter). The inner support's own
-        reaction would also hold the corner node it shares with that plane: an O(h) error
-        (−2.4 % at h = a/10, measured on the neo-Hookean cylinder).
+        Small strain; in finite strain give the deformed `inner_radius`. Read where the wall
+        carries it: the symmetry plane across the wall holds the pressure's resultant
+        (sphere: the plane z = 0 the axial p π a²; cylinder: the plane x = 0 the x resultant
+        p a per unit length of the quarter). The inner support's own reaction would also
+        hold the corner node it shares with that plane: an O(h) error (−2.4 % at h = a/10,
+        measured on the neo-Hookean cylinder).
         """
         a = inner_radius or self.a
         plane, axis = ("y0", 1) if self.shape == "sphere" else ("x0", 0)
