@@ -38,6 +38,7 @@ from mpi4py import MPI
 from fenics_nl.errors import SolveError
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.materials import mixed
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
@@ -90,6 +91,9 @@ def parser():
                         "newtonls on the same residual and consistent tangent")
     p.add_argument("--size", type=cli.positive, default=None,
                    help="element size [length] (default (b - a)/16)")
+    p.add_argument("--mixed", action="store_true",
+                   help="Taylor–Hood P2–P1 displacement–pressure elements: no locking in the "
+                        "isochoric plastic flow on coarse meshes; ν = 0.5 allowed")
     cli.add_outputs(p, png="the deformed quarter coloured by the cumulated plastic strain",
                     plot="pressure against inner displacement, with the closed forms")
     return p
@@ -114,7 +118,7 @@ p_e_exact = vessels.yield_onset_pressure(shape, a, b, s0, args.nu)
 # The quarter $a < |x| < b$ (P2 on curved edges), symmetric supports on its straight edges,
 # the inner surface loaded.
 
-body = VesselBody(shape, a, b, size=args.size)
+body = VesselBody(shape, a, b, size=args.size, mixed=args.mixed)
 
 # ### The material
 #
@@ -129,13 +133,19 @@ material.bind(body.mesh, body.quadrature_degree)
 #
 # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega
 # + \int_{r=a} p\,N \cdot v\,dS$ ($N$ the outward normal, into the cavity; $2\pi r$ in
-# both for the sphere).
+# both for the sphere). With `--mixed`, the mean stress is an unknown too: the first term
+# is the variation of $\Pi(u, p)$ (`fenics_nl.materials.mixed`).
 
 # +
-u, v = body.u, ufl.TestFunction(body.V)
-w = body.weight
-residual = (material.internal_work(u, v, body.model) * body.dx
-            + body.pressure * ufl.dot(body.normal, v) * w * body.ds_inner)
+u, w = body.unknown, body.weight  # u: what the solver updates
+if args.mixed:
+    m = body.mixed
+    v = m.v
+    internal = mixed.internal_work(material, m.u, m.p, m.v, m.q, body.model)
+else:
+    v = ufl.TestFunction(body.V)
+    internal = material.internal_work(u, v, body.model)
+residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * body.ds_inner
 # -
 
 # ### The solver
@@ -150,7 +160,8 @@ residual = (material.internal_work(u, v, body.model) * body.dx
 control = "pressure" if args.inner_displacement is None else "displacement"
 bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
-elastic_tangent = material.modified_newton_tangent(u, body.model, body.dx)
+elastic_tangent = (mixed.modified_newton_tangent(material, body.mixed, body.model, body.dx)
+                   if args.mixed else material.modified_newton_tangent(u, body.model, body.dx))
 
 
 def make_solver(bcs):
@@ -208,7 +219,7 @@ def record(t, result):
 
 
 def commit():
-    material.commit(u, body.model)
+    material.commit(body.u, body.model)
 
 
 if control == "pressure":
@@ -304,7 +315,7 @@ if inner_exact is not None:
 
 def summary():
     """The quantities of the run, for --json."""
-    out = {"shape": shape, "control": control, "newton": args.newton,
+    out = {"shape": shape, "control": control, "newton": args.newton, "mixed": args.mixed,
            "yield_onset_pressure": p_e, "yield_onset_pressure_exact": p_e_exact,
            "limit_pressure_exact": p_lim, "pressure": pressure,
            "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": body.h,
@@ -380,8 +391,8 @@ def plot():
 
 def picture():
     """The deformed quarter coloured by the largest cumulated plastic strain of each cell."""
-    pictures.deformed_picture(u, material.cumulated_plastic_strain_per_cell(), args.png,
-                              state_title(), label="cumulated plastic strain")
+    pictures.deformed_picture(body.displacement(), material.cumulated_plastic_strain_per_cell(),
+                              args.png, state_title(), label="cumulated plastic strain")
     say(f"wrote {args.png}")
 
 

@@ -93,6 +93,20 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
     return f
 
 
+def modified_newton_tangent(material, unknown: MixedUnknown, model: str, dx):
+    """The mixed counterpart of `Material.modified_newton_tangent`.
+
+    For a path-dependent law: the tangent of the same mixed form with Hooke's law (E, ν).
+    """
+    if not getattr(material, "path_dependent", False):
+        return "initial"
+    from fenics_nl.materials.laws import LinearElastic
+
+    m = unknown
+    elastic = LinearElastic(material.E, material.nu)
+    return ufl.derivative(internal_work(elastic, m.u, m.p, m.v, m.q, model) * dx, m.w)
+
+
 class MixedUnknown:
     """w = (u, p) in Taylor–Hood, and what scenes read of it.
 

@@ -22,7 +22,7 @@ from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import quarter_annulus
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.mixed import MixedUnknown
 from fenics_nl.parallel import global_max
 
@@ -110,9 +110,12 @@ class VesselBody:
 
     def stresses_at_inner(self, material) -> tuple[float, float]:
         """(σ_eq, hoop σ_θ) at the inner surface (the point on y = 0)."""
-        sigma = material.cauchy_stress(self.u, self.model)
-        vm = self.probes.discontinuous("vm", material.von_mises_expression(self.u, self.model),
-                                       self.degree)
+        if self.mixed:
+            sigma = mixed.cauchy_stress(material, self.u, self.mixed.p, self.model)
+        else:
+            sigma = material.cauchy_stress(self.u, self.model)
+        s = ufl.dev(sigma)
+        vm = self.probes.discontinuous("vm", ufl.sqrt(1.5 * ufl.inner(s, s)), self.degree)
         hoop = self.probes.discontinuous("hoop", sigma[1, 1], self.degree)
         return vm[0], hoop[0]
 
