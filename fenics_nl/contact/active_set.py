@@ -140,6 +140,8 @@ class ActiveSetContact:
         opts = {"method": "full", "rtol": 1e-10, "max_it": 50, **(newton_options or {})}
         prefix += formulation[:4] + "_"  # each formulation reads its own PETSc options
         if formulation == "elimination":
+            if displacement_space is not None:  # a saddle point: CG on it would break down
+                opts.setdefault("reuse_factorization", False)
             self.system = EliminationSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         else:
             from fenics_nl.contact.multiplier import MultiplierSystem

@@ -7,8 +7,12 @@ from dolfinx import fem
 
 
 def fixed(V: fem.FunctionSpace, facets: np.ndarray) -> fem.DirichletBC:
-    """u = 0 on `facets`."""
+    """u = 0 on `facets` (V may be the displacement part of a mixed space)."""
     fdim = V.mesh.topology.dim - 1
+    if V.component():  # a sub-space: located through its collapsed space, as `component`
+        Vc, _ = V.collapse()
+        dofs = fem.locate_dofs_topological((V, Vc), fdim, facets)
+        return fem.dirichletbc(fem.Function(Vc), dofs, V)
     dofs = fem.locate_dofs_topological(V, fdim, facets)
     return fem.dirichletbc(fem.Function(V), dofs)  # a zero Function: works for any shape
 
@@ -48,6 +52,8 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
     from petsc4py import PETSc
 
     W = u.function_space
+    if space is None and W.ufl_element().is_mixed:
+        raise ValueError("reactions on a mixed unknown: give its displacement part as `space`")
     V = space or W
     form = residual if isinstance(residual, fem.Form) else fem.form(residual)
     b = petsc.assemble_vector(form)

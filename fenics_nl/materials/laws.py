@@ -68,8 +68,8 @@ class Isotropic:
         """Raise ValueError at ν = 1/2: a displacement formulation cannot hold it."""
         if self.incompressible:
             raise ValueError("nu = 0.5 (incompressible) needs the mixed displacement-pressure "
-                             "formulation (--mixed): the displacement formulation locks, its "
-                             "bulk modulus is infinite")
+                             "formulation (--mixed where a scene has it, "
+                             "fenics_nl.materials.mixed): the bulk modulus is infinite")
 
     def lmbda_for(self, strain) -> float:
         """λ for a 3x3 strain, the plane-stress λ* = 2λμ/(λ + 2μ) for a 2x2 one."""
@@ -282,16 +282,20 @@ class NeoHookean(Isotropic, FiniteStrain):
 
     def energy(self, e):
         """φ(e)."""
+        self.require_3x3(e)
         self.require_compressible()
-        rest, lnJ, lmbda = self.volumetric_split(e)
-        return rest + 0.5 * lmbda * lnJ**2
+        C = ufl.Identity(3) + 2 * e
+        lnJ = 0.5 * ufl.ln(ufl.det(C))
+        return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
 
     def volumetric_split(self, e):
-        """φ = [μ/2 (tr C − 3) − μ ln J] + λ/2 (ln J)².
+        """φ = [μ/2 (tr C − 3) − μ ln J − μ/3 (ln J)²] + κ/2 (ln J)²  (λ/2 = κ/2 − μ/3).
 
-        At λ = ∞, J = 1 and the first term is the incompressible neo-Hookean μ/2 (tr C − 3).
+        κ > 0 for every ν > −1 (λ vanishes at ν = 0); at κ = ∞, J = 1 and the first term is
+        the incompressible neo-Hookean energy μ/2 (tr C − 3).
         """
         self.require_3x3(e)
         C = ufl.Identity(3) + 2 * e
         lnJ = 0.5 * ufl.ln(ufl.det(C))
-        return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ, lnJ, self.lmbda
+        rest = 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ - self.mu / 3 * lnJ**2
+        return rest, lnJ, self.kappa

@@ -14,9 +14,10 @@ stresses (`ufl.variable` + `ufl.diff` of φ̃ + p g), and the tangent is its UFL
 nothing is typed. For the small-strain laws p = κ tr ε is the mean stress.
 
 The spaces are Taylor–Hood, P2 displacement and P1 pressure on the same mesh: inf-sup
-stable, so neither locking nor a checkerboard pressure, in 2D, 3D and the axisymmetric
-model. A J2 material keeps its state at the quadrature points of the residual's rule, as
-in the displacement formulation (its plastic flow is isochoric: tr ε_p = 0).
+stable on meshes where no cell has all its vertices on the boundary (gmsh's meshes here), so
+neither locking nor a checkerboard pressure, in 2D, 3D and the axisymmetric model. A J2
+material keeps its state at the quadrature points of the residual's rule, as in the
+displacement formulation (its plastic flow is isochoric: tr ε_p = 0).
 """
 
 from __future__ import annotations
@@ -85,7 +86,13 @@ def von_mises_expression(material, u, p, model: str = "3d"):
 
 
 def von_mises(material, u, p, model: str, mesh) -> fem.Function:
-    """σ_eq per cell (DG0, at the centroid) of the mixed state on `mesh`."""
+    """σ_eq per cell (DG0) of the mixed state on `mesh`.
+
+    At the centroid, or the mean over the quadrature points for a law whose state lives
+    there (J2).
+    """
+    if hasattr(material, "cell_mean"):
+        return material.cell_mean(von_mises_expression(material, u, p, model), "von_mises")
     Q = fem.functionspace(mesh, ("DG", 0))
     f = fem.Function(Q, name="von_mises")
     f.interpolate(fem.Expression(von_mises_expression(material, u, p, model),

@@ -153,18 +153,22 @@ class J2Plasticity(Isotropic, SmallStrain):
         return rest, ufl.tr(eps), self.kappa
 
     def von_mises(self, u, model: str = "3d"):
-        """σ_eq per cell (DG0): the mean of its quadrature points' values.
+        """σ_eq per cell (DG0): the mean of its quadrature points' values."""
+        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
 
-        The state exists at the quadrature points only, so σ_eq is evaluated there.
+    def cell_mean(self, expression, name: str):
+        """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
+
+        The state exists at the quadrature points only, so anything that reads it (σ_eq,
+        the mixed formulation's stress) is evaluated there.
         """
         from dolfinx import fem
 
         st = self._bound()
         Q = st["p"].function_space
         at_points = fem.Function(Q)
-        at_points.interpolate(fem.Expression(self.von_mises_expression(u, model),
-                                             st["points"]))
-        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name="von_mises")
+        at_points.interpolate(fem.Expression(expression, st["points"]))
+        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
         _per_cell(at_points, f, np.mean)
         return f
 

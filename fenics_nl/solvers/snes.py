@@ -152,7 +152,10 @@ class SnesSolver:
         self.counter = EventCounter(all_event_names())
 
     def solve(self) -> SolveResult:
-        """Solve from the current `u` (boundary values imposed first, as NewtonSolver does)."""
+        """Solve from the current `u`, the boundary values imposed first.
+
+        That is SNES's own way; NewtonSolver lifts them into its first correction instead.
+        """
         t0 = time.perf_counter()
         x = self.u.x.petsc_vec
         petsc.set_bc(x, self.bcs)
