@@ -243,6 +243,32 @@ def plasticity_peer(q: dict) -> str:
             f"of tangent assembly against the peer's {plain['phase_time_s']['tangent']:.1f} s.")
 
 
+def near_incompressible(x: dict) -> str:
+    """Displacement against mixed at each ν, on the punch and the neo-Hookean cylinder."""
+    def row(name, nu, form):
+        return next((r for r in x[name] if r["nu"] == nu and r["formulation"] == form
+                     and not r.get("failed")), None)
+
+    parts = []
+    # the cylinder's closed form is the incompressible one: below ν = 0.5 its gap is also the
+    # material's compressibility, so only 0.499 and 0.5 are read there
+    for name, what in (("punch", "the punch's force"),
+                       ("cylinder", "the neo-Hookean cylinder's p(a)")):
+        d, m = row(name, 0.499, "displacement"), row(name, 0.499, "mixed")
+        m5 = row(name, 0.5, "mixed")
+        if not (d and m and m5):
+            continue
+        d3, m3 = row(name, 0.3, "displacement"), row(name, 0.3, "mixed")
+        parts.append(f"{what} at ν = 0.499 is {100 * d['error']:+.2f} % off with displacements "
+                     f"({d['dofs']} unknowns, {d['time_s']:.2f} s) and {100 * m['error']:+.3f} % "
+                     f"with Taylor–Hood ({m['dofs']}, {m['time_s']:.2f} s), "
+                     f"{100 * m5['error']:+.3f} % at ν = 0.5"
+                     + (f"; at ν = 0.3: {100 * d3['error']:+.3f} % in {d3['time_s']:.2f} s "
+                        f"against {100 * m3['error']:+.3f} % in {m3['time_s']:.2f} s"
+                        if d3 and m3 and name == "punch" else ""))
+    return ("* **Near-incompressible** (`--mixed`): " + "; ".join(parts) + ".") if parts else ""
+
+
 def run_times(names) -> str:
     parts = [(n, d["benchmark_time_s"]) for n in names
              if (d := load(n)) and "benchmark_time_s" in d]
@@ -267,8 +293,10 @@ def reading() -> str:
     if q := load("plasticity_peer"):
         if "peer, newtonls" in q["rows"][-1]:
             lines.append(plasticity_peer(q))
+    if x := load("mixed"):
+        lines.append(near_incompressible(x))
     lines += ["", run_times(["newton", "contact", "buckling", "bracket", "plasticity",
-                             "plasticity_peer"])]
+                             "plasticity_peer", "mixed"])]
     return "\n".join(lines)
 
 

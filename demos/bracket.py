@@ -40,7 +40,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -90,6 +90,9 @@ def parser():
                         f"twice the {THICKNESS_MM:g} mm plate thickness")
     p.add_argument("--degree", type=int, choices=[1, 2], default=2,
                    help="Lagrange degree (P1 is far too stiff here: see the README)")
+    p.add_argument("--mixed", action="store_true",
+                   help="Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
+                        "direct solver)")
     p.add_argument("--mesh", metavar="MSH",
                    help="a .msh file with groups bolts, load, base (in --units; not with --size)")
     p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
@@ -151,7 +154,7 @@ mm = MM[args.units]
 size_mm = args.size / mm if args.size is not None else DEFAULT_SIZE_MM
 say("reading " + args.mesh if args.mesh else f"meshing the bracket (size {size_mm:g} mm) ...")
 part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
-                   degree=args.degree, length_scale=1.0 if args.mesh else mm)
+                   degree=args.degree, length_scale=1.0 if args.mesh else mm, mixed=args.mixed)
 # -
 
 # ### The material
@@ -170,13 +173,20 @@ plastic = args.material == "j2"
 # ### The residual
 #
 # $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,dx -
-# \int_{S_{load}} t \cdot v\,ds$, the traction $t$ scaled by the load factor.
+# \int_{S_{load}} t \cdot v\,ds$, the traction $t$ scaled by the load factor. With
+# `--mixed` the first term is the variation of $\Pi(u, p)$ (`fenics_nl.materials.mixed`).
 
 # +
-u, v = part.u, ufl.TestFunction(part.V)
-eps = kinematics.small_strain
-residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
-            - ufl.dot(part.traction, v) * part.ds_load)
+u = part.u
+if args.mixed:
+    m = part.mixed
+    v = m.v
+    internal = mixed.internal_work(material, m.u, m.p, m.v, m.q, "3d")
+else:
+    v = ufl.TestFunction(part.V)
+    eps = kinematics.small_strain
+    internal = ufl.inner(material.stress(eps(u)), eps(v))
+residual = internal * part.dx - ufl.dot(part.traction, v) * part.ds_load
 # -
 
 # ### The solver and the load steps
@@ -190,7 +200,7 @@ residual = (ufl.inner(material.stress(eps(u)), eps(v)) * part.dx
 # +
 def solve(newton):
     """Load steps with one Newton variant; returns the bracket and a record per step."""
-    u.x.array[:] = 0.0
+    part.unknown.x.array[:] = 0.0
     if plastic:
         material.reset()
     b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
@@ -360,7 +370,8 @@ def writers(b, vm, steps, args):
     if args.output:
         def fields():
             extra = b.contact_fields() if args.support == "contact" else []
-            paths = output.write_fields(args.output, [b.u, vm, *extra])
+            fields = [part.displacement(), *([part.mixed.pressure()] if args.mixed else [])]
+            paths = output.write_fields(args.output, [*fields, vm, *extra])
             say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
         todo.append(fields)
     if args.plot:

@@ -140,6 +140,18 @@ point = [20.0, 2.0]
 """
 
 
+def test_incompressible_thick_cylinder_in_the_mixed_formulation(tmp_path, demo):
+    # the same case at ν = 0.5: a one-line error without the mixed formulation, Lamé with it
+    text = (CASES / "thick_cylinder.toml").read_text().replace("nu = 0.3", "nu = 0.5")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    plain = demo.run(["-m fenics_nl", "check", write(tmp_path, "c.toml", text)], check=False)
+    assert plain.returncode != 0 and 'formulation = "mixed"' in plain.stderr
+    mixed = text.replace("degree = 2", 'degree = 2\nformulation = "mixed"')
+    d = demo.case(write(tmp_path, "m.toml", mixed))
+    for name, r in (("inner", 10.0), ("outer", 20.0)):
+        assert d["probes"][name]["displacement"][0] == pytest.approx(lame(r, nu=0.5), rel=3e-4)
+
+
 def test_thick_cylinder_axisymmetric_matches_lame(tmp_path, demo):
     # ends held axially: plane strain, the same u_r(r) as the 2D case
     write(tmp_path, "ring.geo", AXI_GEO)

@@ -22,6 +22,8 @@ from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.materials import mixed as mixed_form
+from fenics_nl.materials.mixed import MixedUnknown
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import SnesSolver
@@ -41,8 +43,14 @@ class CaseProblem:
         self.probes, outside = self._locate_probes()
         if problems + outside:
             raise CaseError(problems + outside)
-        self.V = fem.functionspace(msh, ("Lagrange", case.degree, (dim,)))
-        self.u = fem.Function(self.V, name="displacement")
+        # `unknown`: what the solver updates; `u`: the displacement in forms (its part, if
+        # mixed); `displacement()`: a Function of it to probe, draw and write
+        self.mixed = MixedUnknown(msh, case.degree) if case.formulation == "mixed" else None
+        if self.mixed:
+            self.V, self.unknown, self.u = self.mixed.V, self.mixed.w, self.mixed.u
+        else:
+            self.V = fem.functionspace(msh, ("Lagrange", case.degree, (dim,)))
+            self.u = self.unknown = fem.Function(self.V, name="displacement")
         self.material = case.material()
         self.t = fem.Constant(msh, 0.0)  # the load factor
         tags = data.facet_tags
@@ -89,9 +97,14 @@ class CaseProblem:
 
     def _residual(self, data) -> ufl.Form:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
-        u, v = self.u, ufl.TestFunction(self.V)
         tag = {n: g.tag for n, g in data.physical_groups.items()}
-        R = self.material.internal_work(u, v, self.model) * self.dx
+        if self.mixed:
+            m = self.mixed
+            v = m.v
+            R = mixed_form.internal_work(self.material, m.u, m.p, m.v, m.q, self.model) * self.dx
+        else:
+            v = ufl.TestFunction(self.V)
+            R = self.material.internal_work(self.u, v, self.model) * self.dx
         w = self.weight
         for c in self.case.conditions:
             ds = self.ds(tag[c.group])
@@ -231,29 +244,36 @@ class CaseProblem:
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": not self.material.is_linear, "force_scale": self.force_scale}
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = self.material.modified_newton_tangent(
-                self.u, self.model, self.dx)
+            opts["constant_tangent"] = (
+                mixed_form.modified_newton_tangent(self.material, self.mixed, self.model,
+                                                   self.dx) if self.mixed else
+                self.material.modified_newton_tangent(self.u, self.model, self.dx))
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(
-                self.residual, self.u, self.bcs, facets, self.gap(0.0), normal_axis=axis,
+                self.residual, self.unknown, self.bcs, facets, self.gap(0.0), normal_axis=axis,
                 normal_sign=sign, initial="penetrating", prefix=PREFIX,
-                newton_options={"method": method, **opts})
+                newton_options={"method": method, **opts},
+                displacement_space=self.V if self.mixed else None)
             return ContactSteps(contact, self)
         if case.newton == "snes":
-            return SnesSolver(self.residual, self.u, self.bcs, prefix=PREFIX + "snes_",
+            return SnesSolver(self.residual, self.unknown, self.bcs, prefix=PREFIX + "snes_",
                               rtol=opts["rtol"], atol=case.tolerance,
                               force_scale=self.force_scale, max_it=case.max_iterations,
                               linear_solver=linear)
-        return NewtonSolver(self.residual, self.u, self.bcs, method=method, prefix=PREFIX,
+        return NewtonSolver(self.residual, self.unknown, self.bcs, method=method, prefix=PREFIX,
                             linear_solver=linear, **opts)
 
     # -- loads and results --------------------------------------------------------------
 
     @property
     def dofs(self) -> int:
-        """Global number of scalar unknowns."""
-        return output.dofs(self.V)
+        """Global number of scalar unknowns (with the pressure's, if mixed)."""
+        return output.dofs(self.unknown.function_space)
+
+    def displacement(self) -> fem.Function:
+        """The displacement as a Function (a copy of the mixed unknown's part)."""
+        return self.mixed.displacement() if self.mixed else self.u
 
     def set_load(self, t: float) -> None:
         """Scale every load of the case by t."""
@@ -268,10 +288,14 @@ class CaseProblem:
         resultant of the whole revolution). A node component held by two groups counts in
         the contact group, else in the first listed.
         """
-        return boundary.reactions(self.residual, self.u, self.supports, self.held)
+        return boundary.reactions(self.residual, self.unknown, self.supports, self.held,
+                                  space=self.V)
 
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (Cauchy stress; DG0)."""
+        if self.mixed:
+            return mixed_form.von_mises(self.material, self.u, self.mixed.p, self.model,
+                                        self.mesh)
         return self.material.von_mises(self.u, self.model)
 
     def _locate_probes(self):
@@ -284,9 +308,11 @@ class CaseProblem:
         """Displacement and von Mises stress at every probe (see `domain.probes`)."""
         if not self.case.probes:
             return {}
-        u = self.probes.continuous(self.u)
-        vm = self.probes.discontinuous(
-            "von_mises", self.material.von_mises_expression(self.u, self.model), self.case.degree)
+        u = self.probes.continuous(self.displacement())
+        expression = (mixed_form.von_mises_expression(self.material, self.u, self.mixed.p,
+                                                      self.model) if self.mixed else
+                      self.material.von_mises_expression(self.u, self.model))
+        vm = self.probes.discontinuous("von_mises", expression, self.case.degree)
         return {p.name: {"displacement": d, "von_mises": s}
                 for p, d, s in zip(self.case.probes, u, vm, strict=True)}
 
@@ -295,7 +321,7 @@ class ContactSteps:
     """The active-set loop as a load-step solver: each step moves the obstacle first."""
 
     def __init__(self, contact: ActiveSetContact, problem: CaseProblem):
-        self.contact, self.problem, self.u = contact, problem, problem.u
+        self.contact, self.problem, self.u = contact, problem, problem.unknown
 
     def solve(self) -> SolveResult:
         """The contact state at the current load factor, from the last active set."""

@@ -86,8 +86,8 @@ def warnings(problem: CaseProblem) -> list[str]:
     comm = problem.mesh.comm
     x = problem.mesh.geometry.x
     size = comm.allreduce(float(np.ptp(x, axis=0).max()) if len(x) else 0.0, op=MPI.MAX)
-    u_max = global_max(comm, np.linalg.norm(problem.u.x.array.reshape(-1, problem.case.dim),
-                                            axis=1))
+    u = problem.displacement().x.array
+    u_max = global_max(comm, np.linalg.norm(u.reshape(-1, problem.case.dim), axis=1))
     if not problem.material.finite_strain and u_max > 0.05 * size:
         notes.append(f"the largest displacement is {100 * u_max / size:.0f} % of the body's "
                      f"size: a small-strain law ({problem.case.law}) is not valid there")
@@ -100,7 +100,9 @@ def write_outputs(problem: CaseProblem, folder: str | None, png: str | None):
     writers = []
     if folder:
         def fields():
-            functions = [problem.u, vm]
+            functions = [problem.displacement(), vm]
+            if problem.mixed:
+                functions.append(problem.mixed.pressure())
             if problem.contact is not None:
                 functions += problem.solver.contact.fields(problem.weight)
             paths = output.write_fields(folder, functions)
@@ -126,11 +128,12 @@ def write_outputs(problem: CaseProblem, folder: str | None, png: str | None):
                 c, S = problem.solver.contact, problem.solver.contact.surface
                 axis = problem.contact[2]
                 moved = c.x.copy()  # the nodes in contact where they are now
-                moved[:, axis] += S.sign * S.normal_displacement(problem.u)
+                moved[:, axis] += S.sign * S.normal_displacement(problem.unknown)
                 focus = moved[c.owned & c.active][:, : problem.case.dim]
                 obstacle = problem.obstacle_at(float(problem.t.value))
                 title += f", {S.count(c.active)} nodes in contact"
-            deformed_picture(problem.u, vm, png, title, marked, arrows, focus, obstacle)
+            deformed_picture(problem.displacement(), vm, png, title, marked, arrows, focus,
+                             obstacle)
             say(f"wrote {png}")
         writers.append(picture)
     return writers

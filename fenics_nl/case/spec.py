@@ -23,6 +23,8 @@ file = "part.geo"        # .msh, or .geo meshed by gmsh at run time (path relati
 size = 2.0               # .geo only, optional: largest element size (gmsh Mesh.MeshSizeMax)
 model = "plane_strain"   # 3d | plane_strain | plane_stress | axisymmetric (x = r, y = z)
 degree = 2               # Lagrange degree of the displacement (default 1)
+formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Hood u–p: no
+                         # locking as nu -> 0.5, nu = 0.5 allowed; degree >= 2, not plane stress)
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
@@ -128,6 +130,7 @@ class Case:
     tolerance: float = 1e-9
     max_iterations: int = 50
     probes: list[Probe] = field(default_factory=list)
+    formulation: str = "displacement"  # or "mixed": Taylor–Hood (u, p), materials.mixed
 
     @property
     def dim(self) -> int:
@@ -233,7 +236,7 @@ def read_case(path: str | Path) -> Case:
     r = _Reader()
     r.unknown(data, "case", ("mesh", "material", "boundary", "loading", "solver", "probe"))
 
-    m = r.table(data, "mesh", ("file", "size", "model", "degree"))
+    m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation"))
     file = r.get(m, "file", "mesh", str, required=True)
     size = r.get(m, "size", "mesh", float, positive=True)
     model = r.get(m, "model", "mesh", str, required=True, choices=MODELS)
@@ -249,9 +252,17 @@ def read_case(path: str | Path) -> Case:
             r.fail("mesh.size", "applies to a .geo only (a .msh is already meshed)")
     if degree is not None and degree > 3:
         r.fail("mesh.degree", f"must be 1, 2 or 3, got {degree}")
+    formulation = r.get(m, "formulation", "mesh", str, default="displacement",
+                        choices=("displacement", "mixed"))
+    if formulation == "mixed" and degree is not None and degree < 2:
+        r.fail("mesh.formulation", f'"mixed" is Taylor–Hood: it needs degree >= 2, got {degree}')
+    if formulation == "mixed" and model == "plane_stress":
+        r.fail("mesh.formulation", '"mixed" has no plane-stress form (no volume constraint)')
     dim = 3 if model == "3d" else 2
 
     law, parameters = _material(r, data, model)
+    if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"):
+        r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive = _loading(r, data)
     s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
@@ -270,7 +281,7 @@ def read_case(path: str | Path) -> Case:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
-                adaptive, equal, newton, linear, tolerance, max_it, probes)
+                adaptive, equal, newton, linear, tolerance, max_it, probes, formulation)
 
 
 def _material(r: _Reader, data: dict, model: str | None):

@@ -61,7 +61,7 @@ def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: flo
     """
     bar_title = label or f"von Mises stress [N/{units}²]"
     comm = b.mesh.comm
-    u1 = vertex_interpolant(b.u)
+    u1 = vertex_interpolant(b.part.displacement())
     grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(field)})
     bolts = gather_rows(comm, facet_points(b.mesh, b.part.groups["bolts"]))
     load = gather_rows(comm, facet_points(b.mesh, b.part.load_facets))

@@ -22,6 +22,8 @@ from fenics_nl.domain import boundary
 from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.materials import mixed as mixed_form
+from fenics_nl.materials.mixed import MixedUnknown
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes import bracket_geometry
 from fenics_nl.solvers.newton import NewtonSolver
@@ -77,7 +79,8 @@ class BracketPart:
 
     def __init__(self, *, size: float = 5.0, mesh_file: str | None = None,
                  support: str = "clamped", degree: int = 1, length_scale: float = 1.0,
-                 quadrature_degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD):
+                 quadrature_degree: int | None = None, mixed: bool = False,
+                 comm: MPI.Comm = MPI.COMM_WORLD):
         if support not in ("clamped", "contact"):
             raise ValueError(f"support must be clamped or contact, got {support!r}")
         self.support = support
@@ -95,8 +98,16 @@ class BracketPart:
         self.load_facets, self.base_facets = facets("load"), facets("base")
         if support == "contact":
             self.groups["base"] = self.base_facets
-        self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
-        self.u = fem.Function(self.V, name="displacement")
+        if mixed and degree < 2:
+            raise ValueError("--mixed is Taylor–Hood: P2 displacements (--degree 2)")
+        self.mixed = MixedUnknown(self.mesh, degree) if mixed else None
+        if mixed:  # `unknown` is what a solver updates, `u` the displacement in forms
+            self.V, self.unknown = self.mixed.V, self.mixed.w
+            self.u, self.p = self.mixed.u, self.mixed.p
+        else:
+            self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
+            self.u = self.unknown = fem.Function(self.V, name="displacement")
+            self.p = None
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
         self.ds_load = ds(data.physical_groups["load"].tag)
         self.load_area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * self.ds_load)))
@@ -109,8 +120,12 @@ class BracketPart:
 
     @property
     def dofs(self) -> int:
-        """Global number of scalar unknowns."""
-        return output.dofs(self.V)
+        """Global number of scalar unknowns (with the pressure's, if mixed)."""
+        return output.dofs(self.unknown.function_space)
+
+    def displacement(self) -> fem.Function:
+        """The displacement as a Function (a copy of the mixed unknown's part)."""
+        return self.mixed.displacement() if self.mixed else self.u
 
     def set_load(self, force: float) -> None:
         """Total force `force` [N] along +x, spread uniformly over the loaded hole."""
@@ -129,18 +144,23 @@ class BracketPart:
 
 def build_bracket(material, *, size: float = 5.0, mesh_file: str | None = None,
                   support: str = "clamped", degree: int = 1, length_scale: float = 1.0,
-                  quadrature_degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD,
-                  **options) -> Bracket:
+                  quadrature_degree: int | None = None, mixed: bool = False,
+                  comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Bracket:
     """The bracket scene in one call (as `demos/bracket.py` composes it).
 
     `options` go to `Bracket` (newton, linear_solver, period, force_scale, tolerance).
     """
     part = BracketPart(size=size, mesh_file=mesh_file, support=support, degree=degree,
                        length_scale=length_scale, quadrature_degree=quadrature_degree,
-                       comm=comm)
-    eps, v = kinematics.small_strain, ufl.TestFunction(part.V)
-    residual = (ufl.inner(material.stress(eps(part.u)), eps(v)) * part.dx
-                - ufl.dot(part.traction, v) * part.ds_load)
+                       mixed=mixed, comm=comm)
+    if mixed:
+        m = part.mixed
+        residual = (mixed_form.internal_work(material, m.u, m.p, m.v, m.q, "3d") * part.dx
+                    - ufl.dot(part.traction, m.v) * part.ds_load)
+    else:
+        eps, v = kinematics.small_strain, ufl.TestFunction(part.V)
+        residual = (ufl.inner(material.stress(eps(part.u)), eps(v)) * part.dx
+                    - ufl.dot(part.traction, v) * part.ds_load)
     return Bracket(part, material, residual, **options)
 
 
@@ -168,7 +188,8 @@ class Bracket:
         if newton == "snes" and part.support == "contact":
             raise ValueError("--newton snes works with --support clamped only")
         self.part, self.material, self.residual = part, material, residual
-        self.mesh, self.V, self.u, self.bcs = part.mesh, part.V, part.u, part.bcs
+        self.mesh, self.V, self.bcs = part.mesh, part.V, part.bcs
+        self.u = part.unknown  # what the solver updates (u, or (u, p) if mixed)
         self.support, self.largest_cell = part.support, part.largest_cell
         self.set_load, self.load_point_motion = part.set_load, part.load_point_motion
         self.load_point_displacement = part.load_point_displacement
@@ -181,13 +202,16 @@ class Bracket:
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = material.modified_newton_tangent(self.u, "3d", part.dx)
+            opts["constant_tangent"] = (
+                mixed_form.modified_newton_tangent(material, part.mixed, "3d", part.dx)
+                if part.mixed else material.modified_newton_tangent(self.u, "3d", part.dx))
         if part.support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
             self.solver = ActiveSetContact(
                 residual, self.u, self.bcs, part.base_facets, lambda x: np.zeros(x.shape[1]),
                 normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
-                newton_options={k: v for k, v in opts.items() if k != "linear_solver"})
+                newton_options={k: v for k, v in opts.items() if k != "linear_solver"},
+                displacement_space=part.V if part.mixed else None)
         elif newton == "snes":
             self.solver = SnesSolver(residual, self.u, self.bcs, prefix="bracket_snes_",
                                      rtol=1e-10, atol=tolerance, force_scale=force_scale,
@@ -198,7 +222,7 @@ class Bracket:
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
-        return output.dofs(self.V)
+        return self.part.dofs
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal floor pressure and active set (1/0) on the base (contact support only)."""
@@ -206,11 +230,14 @@ class Bracket:
 
     def von_mises(self) -> fem.Function:
         """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""
+        p = self.part
+        if p.mixed:
+            return mixed_form.von_mises(self.material, p.u, p.p, "3d", self.mesh)
         return self.material.von_mises(self.u)
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on the bolts (and on the base from the floor), see `boundary`."""
-        return boundary.reactions(self.residual, self.u, self.part.groups)
+        return boundary.reactions(self.residual, self.u, self.part.groups, space=self.V)
 
     def lifted_off_area(self) -> float:
         """Area of the base not in contact with the floor [mm²] (contact support only)."""
