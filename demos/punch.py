@@ -347,7 +347,12 @@ def plot(punch, states, ref, args):
 
 
 def title(state, ref, args):
-    """The load and the key figure, with what is checked against Hertz."""
+    """The material, the load and the key figure, with what is checked against Hertz."""
+    return (f"ν = {args.nu:g}, {'Taylor–Hood P2–P1' if args.mixed else 'P1'}: "
+            + _checked(state, ref, args))
+
+
+def _checked(state, ref, args):
     if ref is None:
         return f"{args.model} punch: no contact (δ = {state.indentation:.3g})"
     a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
