@@ -92,7 +92,7 @@ def parser():
                    help="Lagrange degree (P1 is far too stiff here: see the README)")
     p.add_argument("--mixed", action="store_true",
                    help="Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
-                        "direct solver)")
+                        "--solver iterative: MINRES with a block preconditioner)")
     p.add_argument("--mesh", metavar="MSH",
                    help="a .msh file with groups bolts, load, base (in --units; not with --size)")
     p.add_argument("--solver", choices=["direct", "iterative"], default="direct",

@@ -150,6 +150,11 @@ def test_incompressible_thick_cylinder_in_the_mixed_formulation(tmp_path, demo):
     d = demo.case(write(tmp_path, "m.toml", mixed))
     for name, r in (("inner", 10.0), ("outer", 20.0)):
         assert d["probes"][name]["displacement"][0] == pytest.approx(lame(r, nu=0.5), rel=3e-4)
+    # and iteratively (MINRES, block preconditioner): the same answer
+    iterative = mixed.replace("[loading]", '[solver]\nlinear = "iterative"\n\n[loading]')
+    i = demo.case(write(tmp_path, "i.toml", iterative))
+    assert i["probes"]["inner"]["displacement"][0] == pytest.approx(
+        d["probes"]["inner"]["displacement"][0], rel=1e-7)
 
 
 def test_thick_cylinder_axisymmetric_matches_lame(tmp_path, demo):

@@ -243,6 +243,9 @@ class CaseProblem:
         linear = "lu" if case.linear == "direct" else "gamg"
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": not self.material.is_linear, "force_scale": self.force_scale}
+        if linear == "gamg" and self.mixed:  # MINRES with the block preconditioner
+            opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed,
+                                                               self.model, self.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
             opts["constant_tangent"] = (
                 mixed_form.modified_newton_tangent(self.material, self.mixed, self.model,

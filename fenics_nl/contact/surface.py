@@ -19,6 +19,8 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_nl.materials.mixed import collapsed
+
 
 class ContactSurface:
     """Nodes of S_C for the displacement space V, and the obstacle's gap at them.
@@ -34,7 +36,7 @@ class ContactSurface:
         self.W = unknown_space or V
         # every displacement dof in the unknown's numbering (all of them without a pressure)
         self.displacement_dofs = (slice(None) if self.W is V
-                                  else np.asarray(V.collapse()[1], dtype=np.int32))
+                                  else collapsed(V)[1])
         self.comm = self.mesh.comm
         self.axis, self.sign = normal_axis, int(np.sign(normal_sign))
         self.facets = np.asarray(facets, dtype=np.int32)

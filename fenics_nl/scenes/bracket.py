@@ -201,6 +201,9 @@ class Bracket:
         opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}
+        if linear_solver == "gamg" and part.mixed:  # MINRES, block preconditioner
+            opts["preconditioner"] = mixed_form.preconditioner(material, part.mixed, "3d",
+                                                               part.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
             opts["constant_tangent"] = (
                 mixed_form.modified_newton_tangent(material, part.mixed, "3d", part.dx)

@@ -7,6 +7,7 @@ coarse spaces miss rotations and CG stalls on elasticity.
 
 from __future__ import annotations
 
+import numpy as np
 from dolfinx import fem, la
 from petsc4py import PETSc
 
@@ -92,3 +93,44 @@ def _keep_mumps(ksp: PETSc.KSP, A: PETSc.Mat, prefix: str) -> None:
     if pc.getType() == "cholesky":  # an energy's tangent: symmetric (not always definite)
         A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
+
+
+def block_preconditioned_ksp(A: PETSc.Mat, M: PETSc.Mat, W: fem.FunctionSpace,
+                             prefix: str = "", rtol: float = 1e-10) -> PETSc.KSP:
+    """MINRES on a symmetric saddle-point tangent (u, p), preconditioned block-diagonally.
+
+    `M` = diag(2μ ε:ε, (1/μ + 1/k) mass): the displacement block by GAMG (with the rigid-body
+    near-nullspace), the pressure block by Jacobi on the mass matrix, which is spectrally
+    equivalent to the Schur complement whatever the bulk modulus: the iteration count does
+    not grow as ν → 1/2 (Silvester–Wathen). The fields are W's sub-spaces 0 and 1.
+    """
+    from fenics_nl.materials.mixed import collapsed
+
+    comm = W.mesh.comm
+    imap = W.dofmap.index_map
+    owned = imap.size_local * W.dofmap.index_map_bs
+    fields = []
+    for i in (0, 1):
+        Vi, dofs = collapsed(W.sub(i))
+        dofs = dofs[: Vi.dofmap.index_map.size_local * Vi.dofmap.index_map_bs]
+        if not np.all(dofs < owned):  # a collapsed space lists its owned dofs first
+            raise RuntimeError("collapsed sub-space with a ghost among its owned dofs")
+        fields.append((Vi, PETSc.IS().createGeneral(
+            imap.local_to_global(dofs).astype(PETSc.IntType), comm=comm)))
+    fields[0][1].compose("nearnullspace", rigid_body_modes(fields[0][0]))
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOptionsPrefix(prefix)
+    ksp.setOperators(A, M)
+    ksp.setType("minres")
+    ksp.setTolerances(rtol=rtol, atol=0.0, max_it=2000)
+    pc = ksp.getPC()
+    pc.setType("fieldsplit")
+    pc.setFieldSplitIS(("u", fields[0][1]), ("p", fields[1][1]))
+    pc.setFieldSplitType(PETSc.PC.CompositeType.ADDITIVE)
+    opts = PETSc.Options()
+    for field, pc_type in (("u", "gamg"), ("p", "jacobi")):
+        for name, value in (("ksp_type", "preonly"), ("pc_type", pc_type)):
+            if not opts.hasName(f"{prefix}fieldsplit_{field}_{name}"):
+                opts[f"{prefix}fieldsplit_{field}_{name}"] = value
+    ksp.setFromOptions()
+    return ksp

@@ -42,7 +42,11 @@ from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.errors import SolveError
 from fenics_nl.io import output
-from fenics_nl.solvers.linear_solver import create_ksp, rigid_body_modes
+from fenics_nl.solvers.linear_solver import (
+    block_preconditioned_ksp,
+    create_ksp,
+    rigid_body_modes,
+)
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
@@ -238,6 +242,8 @@ class NewtonSolver:
         line_search: backtracking on ‖R‖ (halving, at most 10 times).
         bfgs_memory: pairs kept by ``bfgs``.
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
+        preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
+            preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
 
     Example::
 
@@ -266,6 +272,7 @@ class NewtonSolver:
         line_search: bool = False,
         bfgs_memory: int = 30,
         reuse_factorization: bool = False,
+        preconditioner: ufl.Form | None = None,
     ):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -308,12 +315,19 @@ class NewtonSolver:
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
+        self._M = None  # the block preconditioner of a mixed unknown's iterative solve
         if linear_solver == "gamg" and V.ufl_element().is_mixed:
-            raise ValueError("CG + GAMG (rigid-body near-nullspace) is for a displacement "
-                             "unknown; a mixed displacement-pressure one takes a direct solver")
-        nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
-        self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
-                              P=self.A if reuse else None, rtol=1e-12)
+            if preconditioner is None:
+                raise ValueError("an iterative solve of a mixed displacement-pressure unknown "
+                                 "needs its block preconditioner (materials.mixed."
+                                 "preconditioner)")
+            self._M_form = fem.form(preconditioner)
+            self._M = petsc.create_matrix(self._M_form)
+            self.ksp = block_preconditioned_ksp(self.A, self._M, V, prefix, rtol=1e-12)
+        else:
+            nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
+            self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
+                                  P=self.A if reuse else None, rtol=1e-12)
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
@@ -461,6 +475,10 @@ class NewtonSolver:
                 petsc.assemble_matrix(self.A, self._K_used, bcs=self.bcs, diag=1.0)
                 self.A.assemble()
                 work.tangent_assemblies += 1
+            if self._M is not None:  # its Dirichlet rows follow the tangent's
+                self._M.zeroEntries()
+                petsc.assemble_matrix(self._M, self._M_form, bcs=self.bcs, diag=1.0)
+                self._M.assemble()
         if self.policy.needs_factorization():
             self._factorize(work)
         self.policy.assembled()
