@@ -85,6 +85,27 @@ def cylinder(nu: float, use_mixed: bool, h: float) -> dict:
             "newton_iterations": result.iterations}
 
 
+def linear_solvers(nu: float, linear: str, h: float) -> dict:
+    """The incompressible Lamé cylinder (linear, mixed): MUMPS LU or MINRES + blocks."""
+    A, B, E = 1.0, 2.0, 3.0
+    law = LinearElastic(E, nu)
+    body = VesselBody("cylinder", A, B, size=h, mixed=True)
+    m = body.mixed
+    dx = kinematics.quadrature_measure("dx", body.mesh, 4)
+    R = (mixed.internal_work(law, m.u, m.p, m.v, m.q, body.model) * dx
+         + 1e-3 * ufl.dot(body.normal, m.v) * body.ds_inner)
+    extra = ({"preconditioner": mixed.preconditioner(law, m, body.model, dx)}
+             if linear == "gamg" else {})
+    solver = NewtonSolver(R, body.unknown, body.supports, linear_solver=linear, rtol=1e-10,
+                          atol=1e-10, force_scale=law.mu * A, prefix=f"mixed_{linear}_",
+                          **extra)
+    t0 = time.perf_counter()
+    result = solver.solve()
+    return {"dofs": body.dofs, "time_s": time.perf_counter() - t0,
+            "krylov_iterations": result.work.krylov_iterations, "linear": linear, "nu": nu,
+            "h": h}
+
+
 def run(problem, nu, use_mixed, size):
     problem(nu, use_mixed, size)  # warm-up: the forms compiled
     r = problem(nu, use_mixed, size)
@@ -108,6 +129,17 @@ def table(out: dict) -> str:
                          f"{100 * r['error']:+.3f} % |")
     lines += ["", "`python benchmarks/mixed.py`; the displacement formulation refuses ν = 0.5 "
               "(one-line error), so it has no row there."]
+    if out.get("linear_solvers"):
+        lines += ["", "Direct against iterative on the mixed Lamé cylinder (linear, one solve):",
+                  "", "| h | unknowns | ν | MUMPS LU (s) | MINRES + blocks (s) | "
+                  "MINRES iterations |",
+                  "|---|---|---|---|---|---|"]
+        rows = out["linear_solvers"]
+        for d in (r for r in rows if r["linear"] == "lu"):
+            it = next(r for r in rows if r["linear"] == "gamg" and r["nu"] == d["nu"]
+                      and r["h"] == d["h"])
+            lines.append(f"| {d['h']:g} | {d['dofs']} | {d['nu']} | {d['time_s']:.2f} | "
+                         f"{it['time_s']:.2f} | {it['krylov_iterations']} |")
     return "\n".join(lines)
 
 
@@ -121,6 +153,10 @@ def main():
     for name, problem, size in (("punch", punch, refine), ("cylinder", cylinder, h)):
         out[name] = [run(problem, nu, m, size) for nu in POISSON for m in (False, True)
                      if m or nu < 0.5]
+    sizes = [0.05] if args.quick else [0.025, 0.0125]
+    linear_solvers(0.3, "lu", 0.2), linear_solvers(0.3, "gamg", 0.2)  # forms compiled
+    out["linear_solvers"] = [linear_solvers(nu, s, h) for h in sizes for nu in POISSON
+                             for s in ("lu", "gamg")]
     out["benchmark_time_s"] = elapsed()
     text = table(out)
     print(text)
