@@ -61,30 +61,32 @@ def say(*a):
     print(*a, flush=True)
 
 
-def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float) -> float:
+def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float, dx=None,
+                      prefix: str = "linear_") -> float:
     """One elastic solve of the vessel's mesh: assemble K and the load, factorize (MUMPS LU),
-    solve; the second of two runs (the first compiles)."""
+    solve; the second of two runs (the first compiles). `dx`: the non-linear forms' rule
+    (default the body's)."""
     from dolfinx import fem
     from dolfinx.fem import petsc
 
     du, v = ufl.TrialFunction(body.V), ufl.TestFunction(body.V)
     K = fem.form(ufl.derivative(LinearElastic(E, nu).internal_work(body.u, v, body.model)
-                                * body.dx, body.u, du))  # the non-linear forms' rule
+                                * (dx or body.dx), body.u, du))
     L = fem.form(-pressure * ufl.dot(body.normal, v) * body.weight * body.ds_inner)
     x = fem.Function(body.V)
 
     def solve() -> float:
         t0 = time.perf_counter()
-        A = petsc.assemble_matrix(K, bcs=body.supports)
-        A.assemble()
+        matrix = petsc.assemble_matrix(K, bcs=body.supports)
+        matrix.assemble()
         b = petsc.assemble_vector(L)
         petsc.apply_lifting(b, [K], [body.supports])
         b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
         petsc.set_bc(b, body.supports)
-        ksp = create_ksp(A, "lu", prefix="linear_")
+        ksp = create_ksp(matrix, "lu", prefix=prefix)
         ksp.solve(b, x.x.petsc_vec)
         spent = time.perf_counter() - t0
-        for obj in (ksp, A, b):
+        for obj in (ksp, matrix, b):
             obj.destroy()
         return spent
 

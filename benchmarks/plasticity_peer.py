@@ -59,15 +59,14 @@ except ImportError as err:
 # isort: split
 
 import numpy as np
+import plasticity
 import ufl
 from common import elapsed, machine, update_readme
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
-from fenics_nl.solvers.linear_solver import create_ksp
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import EventCounter, all_event_names, petsc_work
 
@@ -92,36 +91,9 @@ def body(h: float) -> VesselBody:
 
 
 def linear_solve_time(vb: VesselBody) -> float:
-    """One elastic solve of the mesh: assemble K and the load, factorize, solve (MUMPS LU)."""
-    from dolfinx import fem
-    from dolfinx.fem import petsc
-
-    from fenics_nl.materials.laws import LinearElastic
-
-    u, v = ufl.TrialFunction(vb.V), ufl.TestFunction(vb.V)
-    dx = kinematics.quadrature_measure("dx", vb.mesh, QUADRATURE)  # the non-linear forms' rule
-    K = fem.form(ufl.derivative(LinearElastic(E, NU).internal_work(vb.u, v, vb.model) * dx,
-                                vb.u, u))
-    L = fem.form(-LOADS[0] * ufl.dot(vb.normal, v) * vb.ds_inner)
-    x = fem.Function(vb.V)
-
-    def solve() -> float:
-        t0 = time.perf_counter()
-        matrix = petsc.assemble_matrix(K, bcs=vb.supports)
-        matrix.assemble()
-        b = petsc.assemble_vector(L)
-        petsc.apply_lifting(b, [K], [vb.supports])
-        b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-        petsc.set_bc(b, vb.supports)
-        ksp = create_ksp(matrix, "lu", prefix="peer_linear_")
-        ksp.solve(b, x.x.petsc_vec)
-        spent = time.perf_counter() - t0
-        for obj in (ksp, matrix, b):
-            obj.destroy()
-        return spent
-
-    solve()  # warm
-    return solve()
+    """One elastic solve of the mesh (assemble, factorize, solve) on the forms' rule."""
+    dx = kinematics.quadrature_measure("dx", vb.mesh, QUADRATURE)
+    return plasticity.linear_solve_time(vb, E, NU, LOADS[0], dx=dx, prefix="peer_linear_")
 
 
 def ours(vb: VesselBody) -> dict:
