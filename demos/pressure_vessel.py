@@ -65,7 +65,8 @@ def parser():
         "Thick sphere or cylinder under internal pressure in J2 plasticity: yield onset, "
         "plastic zone, limit load and residual stresses against the closed forms. Units are "
         "the user's, consistent (e.g. N, mm, MPa).",
-        epilog="PETSc options take the prefix -vessel_ (e.g. -vessel_ksp_view).")
+        epilog="PETSc options take the prefix -vessel_ (Newton's KSP) or -vessel_snes_ "
+               "(--newton snes), e.g. -vessel_ksp_view.")
     p.add_argument("--shape", choices=["sphere", "cylinder"], default="sphere",
                    help="hollow sphere (axisymmetric) or long cylinder (plane strain)")
     p.add_argument("--inner-radius", type=cli.positive, default=100.0, help="a [length]")
@@ -346,7 +347,8 @@ def summary():
 
 def state_title(sep: str = ", ") -> str:
     """What the run ends in, loaded or unloaded from its peak; `sep` before the radius."""
-    closed = "closed form" + (" for ν = 1/2" if shape == "cylinder" else "")
+    # plain "nu": pyvista's font has no Greek letters (the picture shares this title)
+    closed = "closed form" + (" for nu = 1/2" if shape == "cylinder" else "")
     radius = f"plastic radius {c_fe:.4g} ({closed} {c_exact:.4g})"
     if args.unload:
         return (f"{shape}: unloaded from {loaded / p_lim:.3f} p_lim, permanent u(a) = "
