@@ -41,7 +41,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
@@ -86,6 +86,9 @@ def parser():
                    help="lateral end load as a fraction of P [-], in [0, 0.1)")
     p.add_argument("--refine", type=cli.at_least(0), default=0,
                    help="mesh: 2·2^refine Q2 elements through the height, square elements")
+    p.add_argument("--mixed", action="store_true",
+                   help="Q2-Q1 Taylor-Hood displacement-pressure elements, for a nearly or "
+                        "exactly incompressible beam (nu up to 0.5; --plane strain)")
     cli.add_outputs(p, output="the final displacement",
                     png="deformed shapes along the path, with the elastica's",
                     plot="P/P_cr against tip rotation and deflection")
@@ -100,6 +103,9 @@ if not 0 <= args.imperfection < 0.1:
     p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
 if args.material == "neo-hookean" and args.plane == "stress":
     p.error("neo-hookean is implemented in plane strain only (--plane strain)")
+if args.mixed and args.plane == "stress":
+    p.error("--mixed needs --plane strain (in plane stress the out-of-plane strain takes "
+            "the volume change: nothing locks)")
 
 
 # -
@@ -107,10 +113,11 @@ if args.material == "neo-hookean" and args.plane == "stress":
 # ### The cantilever
 #
 # Q2 quadrilaterals (square, 2·2^refine through the height), clamped at $x = 0$, a dead
-# traction $(-P, \varepsilon P)/h$ on the end face.
+# traction $(-P, \varepsilon P)/h$ on the end face. With `--mixed`, the unknown is the
+# Q2–Q1 pair $(u, p)$.
 
 cantilever = Cantilever(args.length, args.thickness, plane=args.plane,
-                        refine=args.refine, imperfection=args.imperfection)
+                        refine=args.refine, imperfection=args.imperfection, mixed=args.mixed)
 
 # ### The material
 #
@@ -123,17 +130,22 @@ material = MATERIALS[args.material](args.E, args.nu)
 #
 # Total Lagrangian: $R(u; v) = \int_{\Omega_0} P(u) : \nabla v\,d\Omega_0 -
 # \int_{end} t \cdot v\,dS_0$ with $P = F S$ the first Piola–Kirchhoff stress and $t$
-# the dead traction.
+# the dead traction. With `--mixed` the first term is the variation of the perturbed
+# Lagrangian $\Pi(u, p) = \int \tilde\varphi(e) + p\,g(e) - p^2/(2k)$
+# (`fenics_nl.materials.mixed`).
 
 # +
-u, v = cantilever.u, ufl.TestFunction(cantilever.V)
-grad_v = kinematics.displacement_gradient(v, cantilever.model)
-residual = (ufl.inner(material.first_piola(u, cantilever.model), grad_v) * cantilever.dx
-            - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
+f = cantilever.fields
+if args.mixed:
+    internal = mixed.internal_work(material, f.u, f.p, f.v, f.q, cantilever.model)
+else:
+    grad_v = kinematics.displacement_gradient(f.v, cantilever.model)
+    internal = ufl.inner(material.first_piola(f.u, cantilever.model), grad_v)
+residual = internal * cantilever.dx - ufl.dot(cantilever.traction, f.v) * cantilever.ds_end
 # -
 beam = Beam(cantilever, material, residual)
 say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
-    f"{args.material}, plane {args.plane}")
+    f"{args.material}, plane {args.plane}{', mixed Q2-Q1' if args.mixed else ''}")
 
 # ### Linear buckling (SLEPc) against Euler
 #
@@ -170,9 +182,10 @@ def progress(steps):
 
 def centreline(beam):
     """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
-    X = beam.V.tabulate_dof_coordinates()
+    d = beam.fields.displacement()
+    X = d.function_space.tabulate_dof_coordinates()
     on = np.isclose(X[:, 1], 0.0)
-    u = beam.u.x.array.reshape(-1, 2)[on]
+    u = d.x.array.reshape(-1, 2)[on]
     rows = gather_rows(comm, X[on, 0], X[on, :2] + u)
     if rows is None:
         return None
@@ -229,7 +242,7 @@ out = {
     "load_steps": len(path.factors), "step_cuts": path.failures,
     "newton_iterations": sum(r.iterations for r in path.results),
     "factorizations": path.work.factorizations, "branch_switched": switched,
-    "newton": args.newton, "reactions": beam.reactions(),
+    "newton": args.newton, "mixed": args.mixed, "reactions": beam.reactions(),
     "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
     "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
              for h in history],
@@ -320,7 +333,8 @@ def picture(shapes, args):
 writers = []
 if args.output:
     def fields():
-        paths = output.write_fields(args.output, [beam.u])
+        paths = output.write_fields(args.output, [beam.fields.displacement(),
+                                                  *([f.pressure()] if args.mixed else [])])
         say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
     writers.append(fields)
 if args.plot:

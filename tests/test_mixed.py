@@ -238,3 +238,39 @@ def test_incompressible_bracket_iterative_equals_direct(demo):
     assert iterative["krylov_iterations"] > 0
     assert iterative["load_point_displacement"] == pytest.approx(
         direct["load_point_displacement"], rel=1e-8)
+
+
+INCOMPRESSIBLE_BEAM = ("--mixed", "--plane", "strain", "--nu", "0.5")
+
+
+def test_incompressible_beam_follows_the_elastica(demo, on_elastica):
+    # Q2-Q1 at ν = 1/2 on the default mesh: P_cr +0.23 % from Euler (+0.16 % at --refine 2:
+    # the clamp's 2D effect), α 0.4° from the elastica. Q2 displacements at ν = 0.499 lock
+    # in bending: P_cr +1.14 % (+0.33 % at --refine 2) and α 2.3° short
+    on_elastica(demo.beam(*INCOMPRESSIBLE_BEAM, "--load-ratio", "1.2"))
+    locked = demo.beam("--plane", "strain", "--nu", "0.499", "--load-ratio", "1.2")
+    assert locked["critical_load_rel_error"] > 0.008
+
+
+def test_incompressible_beam_leaves_a_higher_branch(demo, on_elastica):
+    # 40 steps to 10 P_cr end, at ν = 1/2, on an equilibrium with 52° of tip rotation whose
+    # negative eigenvalue (−12.9) is far from 0, while the one nearest 0 is positive: the
+    # inertia of the tangent (less one negative eigenvalue per pressure unknown) tells
+    d = demo.beam(*INCOMPRESSIBLE_BEAM, "--load-ratio", "10")
+    assert d["branch_switched"]
+    on_elastica(d)
+
+
+@pytest.mark.parametrize("ranks", [2])
+def test_mixed_beam_two_ranks_give_the_serial_answer(demo, ranks):
+    args = (*INCOMPRESSIBLE_BEAM, "--load-ratio", "1.2", "--steps", "20")
+    s, p = demo.beam(*args), demo.beam(*args, ranks=ranks)
+    assert p["ranks"] == ranks and p["dofs"] == s["dofs"]
+    assert p["critical_load"] == pytest.approx(s["critical_load"], rel=1e-8)
+    assert p["tip_rotation_deg"] == pytest.approx(s["tip_rotation_deg"], rel=1e-6)
+
+
+def test_mixed_beam_in_plane_stress_is_one_line(demo):
+    proc = demo.run(["buckling_beam.py", "--mixed"], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and "--plane strain" in lines[0]

@@ -23,7 +23,7 @@ from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
-from fenics_nl.materials.mixed import MixedUnknown
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import SnesSolver
@@ -38,19 +38,16 @@ class CaseProblem:
         self.case = case
         data = load_mesh(case, comm)
         self.mesh = msh = data.mesh
-        self.model, dim = case.model, case.dim
+        self.model = case.model
         self.facets, problems = self._groups(data)
         self.probes, outside = self._locate_probes()
         if problems + outside:
             raise CaseError(problems + outside)
         # `unknown`: what the solver updates; `u`: the displacement in forms (its part, if
         # mixed); `displacement()`: a Function of it to probe, draw and write
-        self.mixed = MixedUnknown(msh, case.degree) if case.formulation == "mixed" else None
-        if self.mixed:
-            self.V, self.unknown, self.u = self.mixed.V, self.mixed.w, self.mixed.u
-        else:
-            self.V = fem.functionspace(msh, ("Lagrange", case.degree, (dim,)))
-            self.u = self.unknown = fem.Function(self.V, name="displacement")
+        self.fields = f = unknowns(msh, case.degree, case.formulation == "mixed")
+        self.mixed = f if f.mixed else None
+        self.V, self.unknown, self.u = f.V, f.w, f.u
         self.material = case.material()
         self.t = fem.Constant(msh, 0.0)  # the load factor
         tags = data.facet_tags
@@ -276,7 +273,7 @@ class CaseProblem:
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
-        return self.mixed.displacement() if self.mixed else self.u
+        return self.fields.displacement()
 
     def set_load(self, t: float) -> None:
         """Scale every load of the case by t."""

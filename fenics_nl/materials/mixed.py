@@ -143,13 +143,37 @@ def preconditioner(material, unknown: MixedUnknown, model: str, dx):
         * weight * dx
 
 
+class DisplacementUnknown:
+    """The displacement formulation's unknown, with `MixedUnknown`'s attributes.
+
+    `w` and `u` are the same Function, `V` = `W` its space; `p`, `q` are None.
+    """
+
+    mixed = False
+
+    def __init__(self, mesh, degree: int = 2):
+        self.W = self.V = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
+        self.w = self.u = fem.Function(self.V, name="displacement")
+        self.v, self.p, self.q = ufl.TestFunction(self.V), None, None
+        self.pressure_dofs = 0
+        self.displacement_space = self.V
+        self.displacement_dofs = np.arange(self.w.x.array.size, dtype=np.int32)
+
+    def displacement(self) -> fem.Function:
+        """The displacement Function itself."""
+        return self.w
+
+
 class MixedUnknown:
     """w = (u, p) in Taylor–Hood, and what scenes read of it.
 
     `w` is the Function a solver updates; `u`, `p` its parts for forms; `V` the displacement
     sub-space (Dirichlet conditions, contact nodes: dofs in `w`'s numbering); and
-    `displacement()`, `pressure()` collapsed copies to probe, draw and write.
+    `displacement()`, `pressure()` collapsed copies to probe, draw and write
+    (`displacement_space`, and `displacement_dofs`: where its values sit in `w`).
     """
+
+    mixed = True
 
     def __init__(self, mesh, degree: int = 2):
         self.W = taylor_hood(mesh, degree)
@@ -157,17 +181,24 @@ class MixedUnknown:
         self.V, self.Q = self.W.sub(0), self.W.sub(1)
         self.u, self.p = ufl.split(self.w)
         self.v, self.q = ufl.TestFunctions(self.W)
-        Vc, self._u_dofs = collapsed(self.V)
+        self.displacement_space, self.displacement_dofs = collapsed(self.V)
         Qc, self._p_dofs = collapsed(self.Q)
-        self._u = fem.Function(Vc, name="displacement")
+        self.pressure_dofs = Qc.dofmap.index_map.size_global  # the constraints' number
+        self._u = fem.Function(self.displacement_space, name="displacement")
         self._p = fem.Function(Qc, name="pressure")
 
     def displacement(self) -> fem.Function:
         """The current displacement (a copy in the collapsed P2 space)."""
-        self._u.x.array[:] = self.w.x.array[self._u_dofs]
+        self._u.x.array[:] = self.w.x.array[self.displacement_dofs]
         return self._u
 
     def pressure(self) -> fem.Function:
         """The current pressure field p (a copy in the collapsed P1 space)."""
         self._p.x.array[:] = self.w.x.array[self._p_dofs]
         return self._p
+
+
+def unknowns(mesh, degree: int = 2, mixed: bool = False
+             ) -> DisplacementUnknown | MixedUnknown:
+    """The unknown of either formulation: P`degree` displacement, or Taylor–Hood (u, p)."""
+    return MixedUnknown(mesh, degree) if mixed else DisplacementUnknown(mesh, degree)

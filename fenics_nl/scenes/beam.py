@@ -5,6 +5,9 @@ end x = L carries the dead traction (−P, H)/h: the axial load P and a small la
 H = ε P, the imperfection that picks the buckled branch. Tip quantities are averages over
 the end face (parallel-safe integrals): lateral deflection, axial displacement, and the
 rotation α of the end section, from its deformed tangent F·e_y.
+
+`mixed=True` (plane strain): the Q2–Q1 Taylor–Hood pair (u, p) of `materials.mixed`, for a
+nearly or exactly incompressible beam, where Q2 displacements lock in bending.
 """
 
 from __future__ import annotations
@@ -19,8 +22,9 @@ from mpi4py import MPI
 from fenics_nl.domain import boundary
 from fenics_nl.errors import SolveError
 from fenics_nl.io import output
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean, StVenantKirchhoff
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.solvers.loading import LoadPath, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
@@ -37,15 +41,20 @@ class Cantilever:
     """The beam's mesh and conditions: clamped at x = 0, a dead traction on the end x = L.
 
     Q`degree` quadrilaterals, 2·2^refine through the height, square-ish. Everything a
-    residual is written with is public: `u`, `V`, `model` (plane_stress | plane_strain),
-    `dx` (degree 4), `traction` (set by `set_load`) and `ds_end`.
+    residual is written with is public: `u` (the displacement in forms), `V`, `model`
+    (plane_stress | plane_strain), `dx` (degree 4), `traction` (set by `set_load`) and
+    `ds_end`; `unknown` is the Function a solver updates (u, or (u, p) if `mixed`) and
+    `fields` the `materials.mixed` unknown it belongs to.
     """
 
     def __init__(self, length: float, thickness: float, *, plane: str = "stress",
                  refine: int = 0, imperfection: float = 1e-4, degree: int = 2,
-                 comm: MPI.Comm = MPI.COMM_WORLD):
+                 mixed: bool = False, comm: MPI.Comm = MPI.COMM_WORLD):
         if plane not in ("stress", "strain"):
             raise ValueError(f"plane must be stress or strain, got {plane!r}")
+        if mixed and plane == "stress":
+            raise ValueError("--mixed needs --plane strain (plane stress has no volumetric "
+                             "constraint: its out-of-plane strain takes the volume change)")
         if not (length > 0 and thickness > 0):
             raise ValueError(f"length and thickness must be > 0, got {length}, {thickness}")
         if thickness > length / 5:
@@ -59,8 +68,8 @@ class Cantilever:
         nx = max(4, round(length / thickness * ny / 2))  # square-ish Q2 elements
         self.mesh = mesh.create_rectangle(comm, [[0, -thickness / 2], [length, thickness / 2]],
                                           [nx, ny], mesh.CellType.quadrilateral)
-        self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (2,)))
-        self.u = fem.Function(self.V, name="displacement")
+        self.fields = unknowns(self.mesh, degree, mixed)
+        self.V, self.u, self.unknown = self.fields.V, self.fields.u, self.fields.w
         fdim = 1
         clamped = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], 0))
         end = mesh.locate_entities_boundary(self.mesh, fdim, lambda x: np.isclose(x[0], length))
@@ -77,8 +86,8 @@ class Cantilever:
 
     @property
     def dofs(self) -> int:
-        """Global number of scalar unknowns."""
-        return output.dofs(self.V)
+        """Global number of scalar unknowns (with the pressure's, if mixed)."""
+        return output.dofs(self.unknown.function_space)
 
     def set_load(self, P: float) -> None:
         """Dead end load: axial compression P and the lateral imperfection ε P."""
@@ -101,10 +110,13 @@ def build_beam(length: float, thickness: float, E: float, nu: float, *,
         raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
     cantilever = Cantilever(length, thickness, **options)
     law = MATERIALS[material](E, nu)
-    v = ufl.TestFunction(cantilever.V)
-    H_v = kinematics.displacement_gradient(v, cantilever.model)
-    residual = (ufl.inner(law.first_piola(cantilever.u, cantilever.model), H_v) * cantilever.dx
-                - ufl.dot(cantilever.traction, v) * cantilever.ds_end)
+    f, model = cantilever.fields, cantilever.model
+    if f.mixed:
+        work = mixed.internal_work(law, f.u, f.p, f.v, f.q, model)
+    else:
+        work = ufl.inner(law.first_piola(f.u, model),
+                         kinematics.displacement_gradient(f.v, model))
+    residual = work * cantilever.dx - ufl.dot(cantilever.traction, f.v) * cantilever.ds_end
     return Beam(cantilever, law, residual)
 
 
@@ -120,8 +132,10 @@ class Beam:
     def __init__(self, cantilever: Cantilever, material, residual):
         self.cantilever, self.material, self.residual = cantilever, material, residual
         self.L, self.h, self.model = cantilever.L, cantilever.h, cantilever.model
-        self.mesh, self.V, self.u, self.bcs = (cantilever.mesh, cantilever.V, cantilever.u,
-                                               cantilever.bcs)
+        # `u`: what the solvers update (the mixed unknown (u, p) if mixed)
+        self.mesh, self.V, self.u, self.bcs = (cantilever.mesh, cantilever.V,
+                                               cantilever.unknown, cantilever.bcs)
+        self.fields = cantilever.fields
         self.dx, self.ds_end = cantilever.dx, cantilever.ds_end
         self.set_load, self.tip = cantilever.set_load, cantilever.tip
         E, nu = material.E, material.nu
@@ -130,32 +144,63 @@ class Beam:
 
     @property
     def dofs(self) -> int:
-        """Global number of scalar unknowns."""
-        return output.dofs(self.V)
+        """Global number of scalar unknowns (with the pressure's, if mixed)."""
+        return self.cantilever.dofs
+
+    def _split(self, w):
+        """(displacement, pressure or None) of a Function or argument of the unknown's space."""
+        return ufl.split(w) if self.fields.mixed else (w, None)
 
     def critical_loads(self, n: int = 3):
-        """SLEPc: the first n critical loads and modes around the undeformed state."""
-        du, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        """SLEPc: the first n critical loads and modes around the undeformed state.
+
+        Mixed: K is the mixed tangent of Hooke's law and K_G acts on the displacement part.
+        """
+        f, W = self.fields, self.u.function_space
         lin = LinearElastic(self.material.E, self.material.nu)
+        if f.mixed:
+            work = mixed.internal_work(lin, f.u, f.p, f.v, f.q, self.model)
+        else:
+            work = lin.internal_work(f.u, f.v, self.model)
+        a = ufl.derivative(work * self.dx, f.w)  # Hooke's tangent: the same at any state
         # pre-stress of a unit compressive load: one linear solve
-        u0 = fem.Function(self.V)
-        eps = kinematics.small_strain
-        a = ufl.inner(lin.stress(eps(du, self.model)), eps(v, self.model)) * self.dx
+        w0 = fem.Function(W)
         t = fem.Constant(self.mesh, np.array([-1.0 / self.h, 0.0]))
         from dolfinx.fem.petsc import LinearProblem
 
         from fenics_nl.solvers.snes import unless_set
 
-        LinearProblem(a, ufl.dot(t, v) * self.ds_end, u=u0, bcs=self.bcs,
+        LinearProblem(a, ufl.dot(t, f.v) * self.ds_end, u=w0, bcs=self.bcs,
                       petsc_options_prefix="beam_prestress_",
                       petsc_options=unless_set("beam_prestress_", {
                           "ksp_type": "preonly", "pc_type": "lu",
                           "pc_factor_mat_solver_type": "mumps"})).solve()
-        sigma0 = lin.stress(eps(u0, self.model))
-        a_G = geometric_stiffness(sigma0, du, v,  # embedded 3x3 ∇ matches a 3x3 σ₀
+        u0, p0 = self._split(w0)
+        sigma0 = (mixed.cauchy_stress(lin, u0, p0, self.model) if f.mixed
+                  else lin.stress(kinematics.small_strain(u0, self.model)))
+        du = self._split(ufl.TrialFunction(W))[0]
+        a_G = geometric_stiffness(sigma0, du, f.v,  # embedded 3x3 ∇ matches a 3x3 σ₀
                                   lambda w: kinematics.displacement_gradient(w, self.model))
-        a_G = a_G * self.dx
-        return critical_loads(a, a_G, self.bcs, self.V, n=n, prefix="beam_buckling_")
+        return critical_loads(a, a_G * self.dx, self.bcs, W, n=n, prefix="beam_buckling_",
+                              scale_dofs=f.displacement_dofs)
+
+    def _displacement_mass(self) -> ufl.Form:
+        """∫ du · v: the metric of the stability eigenproblem (zero on the pressure)."""
+        du = self._split(ufl.TrialFunction(self.u.function_space))[0]
+        return ufl.inner(du, self.fields.v) * self.dx
+
+    def lowest_mode(self) -> tuple[float, fem.Function]:
+        """The tangent's eigenvalue nearest 0 at the current state, and its mode.
+
+        K_T φ = λ M φ with M the displacement's mass: for the mixed saddle point this is the
+        tangent with the pressure condensed out, whose sign is the stability of the
+        equilibrium (K_T's own spectrum also holds one negative value per pressure unknown,
+        which `lowest_tangent_mode` discounts).
+        """
+        tangent = ufl.derivative(self.residual, self.u)
+        return lowest_tangent_mode(tangent, self.bcs, self.u.function_space,
+                                   "beam_stability_", mass=self._displacement_mass(),
+                                   multipliers=self.fields.pressure_dofs)
 
     def solve_path(self, ratio: float, steps: int = 40, method: str = "full", *,
                    grow: bool = False, on_step=None, progress=None) -> tuple[LoadPath, bool]:
@@ -175,14 +220,13 @@ class Beam:
         solver = NewtonSolver(self.residual, self.u, self.bcs, method=method, rtol=1e-8,
                               atol=1e-9, force_scale=P, max_it=30 if method == "full" else 500,
                               prefix=f"beam_{method}_")
-        tangent = ufl.derivative(self.residual, self.u)
         while True:
             self.path_steps = steps  # the number of steps of the last path run
             self.u.x.array[:] = 0.0
             path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
                                        max_step=1.0 if grow else 1.0 / steps,
                                        on_step=on_step, progress=progress)
-            lam, mode = lowest_tangent_mode(tangent, self.bcs, self.V, "beam_stability_")
+            lam, mode = self.lowest_mode()
             if lam >= 0:
                 return path, False
             if progress:
@@ -190,7 +234,7 @@ class Beam:
             self.kick_along(mode, elastica.tip_position(ratio)[0] * self.L)
             try:
                 result = solver.solve()
-                if lowest_tangent_mode(tangent, self.bcs, self.V, "beam_stability_")[0] >= 0:
+                if self.lowest_mode()[0] >= 0:
                     path.results.append(result)
                     path.work.add(result.work)
                     if on_step:
@@ -207,13 +251,19 @@ class Beam:
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""
-        return boundary.reactions(self.residual, self.u, self.cantilever.groups)
+        space = self.V if self.fields.mixed else None
+        return boundary.reactions(self.residual, self.u, self.cantilever.groups, space=space)
 
     def kick_along(self, mode: fem.Function, deflection: float) -> None:
-        """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`."""
-        comm = self.mesh.comm
-        at_tip = np.isclose(self.V.tabulate_dof_coordinates()[:, 0], self.L)
-        lateral = mode.x.array.reshape(-1, 2)[:, 1]
+        """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`.
+
+        φ is scaled as a whole (with its pressure part, if mixed). The mean is over the owned
+        end-face nodes, so it is the same at any number of ranks.
+        """
+        comm, f = self.mesh.comm, self.fields
+        owned = f.displacement_space.dofmap.index_map.size_local
+        at_tip = np.isclose(f.displacement_space.tabulate_dof_coordinates()[:owned, 0], self.L)
+        lateral = mode.x.array[f.displacement_dofs].reshape(-1, 2)[:owned, 1]
         mean = comm.allreduce(float(lateral[at_tip].sum())) / comm.allreduce(int(at_tip.sum()))
         self.u.x.array[:] += deflection / mean * mode.x.array
         self.u.x.scatter_forward()

@@ -23,7 +23,7 @@ from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
-from fenics_nl.materials.mixed import MixedUnknown
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes import bracket_geometry
 from fenics_nl.solvers.newton import NewtonSolver
@@ -100,14 +100,10 @@ class BracketPart:
             self.groups["base"] = self.base_facets
         if mixed and degree < 2:
             raise ValueError("--mixed is Taylor–Hood: P2 displacements (--degree 2)")
-        self.mixed = MixedUnknown(self.mesh, degree) if mixed else None
-        if mixed:  # `unknown` is what a solver updates, `u` the displacement in forms
-            self.V, self.unknown = self.mixed.V, self.mixed.w
-            self.u, self.p = self.mixed.u, self.mixed.p
-        else:
-            self.V = fem.functionspace(self.mesh, ("Lagrange", degree, (3,)))
-            self.u = self.unknown = fem.Function(self.V, name="displacement")
-            self.p = None
+        # `unknown` is what a solver updates, `u` the displacement in forms
+        self.fields = f = unknowns(self.mesh, degree, mixed)
+        self.mixed = f if mixed else None
+        self.V, self.unknown, self.u, self.p = f.V, f.w, f.u, f.p
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
         self.ds_load = ds(data.physical_groups["load"].tag)
         self.load_area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * self.ds_load)))
@@ -125,7 +121,7 @@ class BracketPart:
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
-        return self.mixed.displacement() if self.mixed else self.u
+        return self.fields.displacement()
 
     def set_load(self, force: float) -> None:
         """Total force `force` [N] along +x, spread uniformly over the loaded hole."""

@@ -33,7 +33,7 @@ from fenics_nl.errors import SolveError
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
-from fenics_nl.materials.mixed import MixedUnknown
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import gather_rows, global_max
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
@@ -101,14 +101,9 @@ class PunchBlock:
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth)
         self.mesh = data.mesh
-        self.mixed = MixedUnknown(self.mesh) if mixed else None
-        if mixed:
-            self.V, self.unknown = self.mixed.V, self.mixed.w
-            self.u, self.p = self.mixed.u, self.mixed.p
-        else:
-            self.V = fem.functionspace(self.mesh, ("Lagrange", 1, (dim,)))
-            self.u = self.unknown = fem.Function(self.V, name="displacement")
-            self.p = None
+        self.fields = f = unknowns(self.mesh, 2 if mixed else 1, mixed)
+        self.mixed = f if mixed else None
+        self.V, self.unknown, self.u, self.p = f.V, f.w, f.u, f.p
         self.kinematics = ("axisymmetric" if model == "axisymmetric"
                            else "3d" if dim == 3 else "plane_strain")
         self.weight = kinematics.measure_weight(self.mesh, self.kinematics)
@@ -131,7 +126,7 @@ class PunchBlock:
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
-        return self.mixed.displacement() if self.mixed else self.u
+        return self.fields.displacement()
 
     def radius_of(self, x):
         """Distance from the punch axis (the x coordinate in plane strain)."""

@@ -23,7 +23,7 @@ from fenics_nl.domain.meshes import quarter_annulus
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, mixed
-from fenics_nl.materials.mixed import MixedUnknown
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
 
 SHAPES = ("sphere", "cylinder")
@@ -43,13 +43,10 @@ class VesselBody:
         self.h = size or (b - a) / 16
         data = quarter_annulus(comm, a, b, self.h)
         self.mesh = msh = data.mesh
-        self.mixed = MixedUnknown(msh, degree) if mixed else None
-        if mixed:
-            self.V, self.unknown, self.u = self.mixed.V, self.mixed.w, self.mixed.u
-            motion_space, _ = self.V.collapse()
-        else:
-            self.V = motion_space = fem.functionspace(msh, ("Lagrange", degree, (2,)))
-            self.u = self.unknown = fem.Function(self.V, name="displacement")
+        self.fields = f = unknowns(msh, degree, mixed)
+        self.mixed = f if mixed else None
+        self.V, self.unknown, self.u = f.V, f.w, f.u
+        motion_space = f.displacement_space
 
         def facets(name):
             return data.facet_tags.find(data.physical_groups[name].tag)
@@ -82,7 +79,7 @@ class VesselBody:
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
-        return self.mixed.displacement() if self.mixed else self.u
+        return self.fields.displacement()
 
     def move_inner(self, delta: float) -> None:
         """Prescribe the radial displacement δ of the inner surface (tangential 0)."""

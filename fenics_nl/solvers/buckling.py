@@ -42,10 +42,10 @@ def _stiffness(a: ufl.Form, bcs) -> PETSc.Mat:
 
 
 def _nearest_zero(comm, prefix: str, n: int, A: PETSc.Mat, B: PETSc.Mat | None = None,
-                  tol: float | None = None) -> SLEPc.EPS:
-    """An EPS for the `n` eigenvalues of A x = λ B x (or A x = λ x) nearest 0.
+                  tol: float | None = None, target: float = 0.0) -> SLEPc.EPS:
+    """An EPS for the `n` eigenvalues of A x = λ B x (or A x = λ x) nearest `target` (0).
 
-    Shift-and-invert at 0 with MUMPS LU; `-{prefix}eps_...` options are read last.
+    Shift-and-invert with MUMPS LU; `-{prefix}eps_...` options are read last.
     """
     eps = SLEPc.EPS().create(comm)
     eps.setOptionsPrefix(prefix)
@@ -58,11 +58,11 @@ def _nearest_zero(comm, prefix: str, n: int, A: PETSc.Mat, B: PETSc.Mat | None =
     eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP if B is not None
                        else SLEPc.EPS.ProblemType.HEP)
     eps.setDimensions(n)
-    eps.setTarget(0.0)
+    eps.setTarget(target)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     st = eps.getST()
     st.setType("sinvert")
-    st.setShift(0.0)
+    st.setShift(target)
     ksp = st.getKSP()
     ksp.setType("preonly")
     ksp.getPC().setType("lu")
@@ -72,8 +72,13 @@ def _nearest_zero(comm, prefix: str, n: int, A: PETSc.Mat, B: PETSc.Mat | None =
 
 
 def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: int = 3,
-                   prefix: str = "buckling_") -> tuple[list[float], list[fem.Function]]:
-    """The `n` smallest positive load factors λ and their modes (normalised, max |φ| = 1)."""
+                   prefix: str = "buckling_", scale_dofs: np.ndarray | None = None
+                   ) -> tuple[list[float], list[fem.Function]]:
+    """The `n` smallest positive load factors λ and their modes.
+
+    Modes are normalised to max |φ| = 1 over `scale_dofs` (local indices; all by default:
+    a mixed space gives its displacement's, so that the pressure's units do not count).
+    """
     K = _stiffness(a_K, bcs)
     G = petsc.assemble_matrix(fem.form(-a_G), bcs=bcs, diag=0.0)
     G.assemble()
@@ -88,7 +93,8 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
         phi = fem.Function(V, name=f"mode_{len(modes) + 1}")
         vr.copy(phi.x.petsc_vec)
         phi.x.scatter_forward()
-        scale = V.mesh.comm.allreduce(float(np.max(np.abs(phi.x.array), initial=0.0)),
+        values_ = phi.x.array if scale_dofs is None else phi.x.array[scale_dofs]
+        scale = V.mesh.comm.allreduce(float(np.max(np.abs(values_), initial=0.0)),
                                       op=MPI.MAX)
         phi.x.array[:] /= scale or 1.0
         values.append(lam.real)
@@ -99,21 +105,93 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
     return [values[i] for i in order][:n], [modes[i] for i in order][:n]
 
 
-def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "stability_"
-                        ) -> tuple[float, fem.Function]:
-    """Eigenvalue of the tangent K_T nearest 0 and its mode: negative means unstable.
+def negative_eigenvalues(A: PETSc.Mat, prefix: str) -> int:
+    """The number of negative eigenvalues of the symmetric matrix A, from its inertia.
 
-    Dirichlet rows are identity rows (eigenvalue 1), kept away from the target by scaling
-    them to the largest diagonal entry.
+    Sylvester's law: A = L D Lᵀ (MUMPS) has as many negative eigenvalues as D has negative
+    pivots. One factorization, no eigensolver; `-{prefix}...` options reach its KSP.
     """
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOptionsPrefix(prefix)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("cholesky")
+    pc.setFactorSolverType("mumps")
+    pc.setFactorSetUpSolverType()
+    factor = pc.getFactorMatrix()
+    factor.setMumpsIcntl(13, 1)  # the inertia of the whole matrix in parallel (MUMPS)
+    factor.setMumpsIcntl(24, 1)  # null pivots detected, as MUMPS requires for the inertia
+    ksp.setFromOptions()
+    ksp.setUp()
+    negative = factor.getInertia()[0]
+    ksp.destroy()
+    return negative
+
+
+def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "stability_",
+                        mass: ufl.Form | None = None, multipliers: int = 0
+                        ) -> tuple[float, fem.Function]:
+    """Whether the tangent K_T is positive definite, told by a negative eigenvalue.
+
+    Returns the smallest eigenvalue of K_T φ = λ M φ and its mode if there is a negative one
+    (unstable), else the one nearest 0 (M: the bilinear form `mass`, or the identity).
+
+    The count of negative eigenvalues is the inertia of K_T (`negative_eigenvalues`), less
+    `multipliers`: a saddle point [[A, Bᵀ], [B, −C]] with C ≥ 0 and B of full rank m has m
+    negative eigenvalues for the constraint, and the others are those of A condensed on
+    it (Haynsworth's inertia additivity; Gould's for C = 0). The count matters: an
+    equilibrium on a higher branch has a negative eigenvalue far from 0, where a search
+    nearest 0 finds a positive one. A mass that vanishes on part of the unknown (a mixed
+    formulation's pressure) condenses that part out of the pencil: infinite eigenvalues.
+    Dirichlet rows are identity rows scaled to the largest diagonal entry (and zero in M).
+    """
+    comm = V.mesh.comm
     K = _stiffness(a_T, bcs)
-    eps = _nearest_zero(V.mesh.comm, prefix, 1, K)
+    M = None
+    if mass is not None:
+        M = petsc.assemble_matrix(fem.form(mass), bcs=bcs, diag=0.0)
+        M.assemble()
+    unstable = negative_eigenvalues(K, f"{prefix}inertia_") > multipliers
+    lam, mode = _eigenpair_nearest(comm, prefix, K, M, 0.0, V)
+    if unstable:  # shift below the smallest eigenvalue (counted), then find it there
+        shift = -1.01 * max(abs(lam), 1e-12 * K.norm(PETSc.NormType.INFINITY))
+        for _ in range(60):
+            shifted = K.duplicate(copy=True)
+            shifted.axpy(-shift, M if M is not None else _identity(K),
+                         PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            below = negative_eigenvalues(shifted, f"{prefix}inertia_") - multipliers
+            shifted.destroy()
+            if below == 0:  # no eigenvalue below the shift: the nearest is the smallest
+                break
+            shift *= 4
+        lam, mode = _eigenpair_nearest(comm, prefix, K, M, shift, V)
+    for obj in (K, M):
+        if obj is not None:
+            obj.destroy()
+    return lam, mode
+
+
+def _identity(K: PETSc.Mat) -> PETSc.Mat:
+    """The identity with K's layout."""
+    eye = K.duplicate()
+    eye.zeroEntries()
+    eye.shift(1.0)
+    return eye
+
+
+def _eigenpair_nearest(comm, prefix: str, K: PETSc.Mat, M: PETSc.Mat | None, target: float,
+                       V: fem.FunctionSpace) -> tuple[float, fem.Function]:
+    """The eigenpair of K φ = λ M φ (or K φ = λ φ) nearest `target`."""
+    eps = _nearest_zero(comm, prefix, 1, K, M, target=target)
     eps.solve()
+    if eps.getConverged() < 1:
+        raise RuntimeError(f"SLEPc found no eigenvalue of the tangent (-{prefix}eps_...)")
     vr = K.createVecRight()
     lam = eps.getEigenpair(0, vr).real
     mode = fem.Function(V, name="lowest_mode")
     vr.copy(mode.x.petsc_vec)
     mode.x.scatter_forward()
-    for obj in (eps, K, vr):
-        obj.destroy()
+    eps.destroy()
+    vr.destroy()
     return lam, mode
