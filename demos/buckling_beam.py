@@ -308,12 +308,20 @@ def picture(shapes, args):
     picks = list({round(r, 6): (r, pts) for r, pts in picks}.values())
     cmap = plt.get_cmap("viridis")
     top = max(s[0] for s in picks)
+    sign = 1 if picks[-1][1][-1, 1] >= 0 else -1  # the side the beam buckled to, at the end
+    # states the path left straight past P_cr (unstable: the end state was switched off it)
+    straight = [r for r, pts in picks[:-1]
+                if abs(pts[-1, 1]) < 0.01 * elastica.tip_position(r)[0] * L]
     for r, pts in picks:
-        colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
-        sign = 1 if pts[-1, 1] >= 0 else -1
-        ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
+        if r not in straight:
+            colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
+            ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
         xe, ye = elastica.shape(r)
         ax.plot(xe * L, sign * ye * L, "--", color="k", lw=0.8)
+    if straight:
+        ax.plot([0, L], [0, 0], color="tab:red", lw=2,
+                label=f"FE, still straight (unstable) at P/P_cr = {straight[0]:.3g}"
+                      f"–{straight[-1]:.3g}")
     ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
     ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
                 arrowprops={"arrowstyle": "->"})

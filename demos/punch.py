@@ -128,9 +128,9 @@ args = cli.arguments(p, prefixes=lambda a: {
 # j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
 cli.material_flags(p, args, power_law={"sigma0": 0.01, "n": 0.3},
                    j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
-if args.mixed and args.formulation == "multiplier":
-    p.error("--mixed works with --formulation elimination (the multiplier formulation is "
-            "written for P1 displacements)")
+if args.mixed and args.formulation == "multiplier" and args.model == "3d":
+    p.error("--mixed --formulation multiplier is 2D and axisymmetric only (no nodal rule with "
+            "positive weights on P2 triangles): use --formulation elimination in 3d")
 if args.unload and args.force is not None:
     p.error("--unload takes the punch back up under displacement control: drop --force")
 if args.refine > MAX_REFINE:

@@ -96,8 +96,23 @@ def test_quadratic_elements_use_every_surface_node():
     T_n, gap = c.normal_forces(), c.normal_gap()
     assert np.all(T_n[c.active] <= 1e-10 * np.abs(T_n).max())
     assert np.all(gap[~c.active] <= 1e-12)
-    with pytest.raises(ValueError, match="multiplier formulation needs a P1"):
-        axisymmetric_punch("multiplier", degree=2)
+    # P2 multipliers with Gauss-Lobatto's nodal rule: the elimination's discrete problem
+    cm, _ = axisymmetric_punch("multiplier", degree=2)
+    assert np.array_equal(c.active, cm.active)
+    Te, Tm = c.normal_forces(), cm.normal_forces()
+    assert np.max(np.abs(Te - Tm)) < 1e-9 * np.max(np.abs(Te))
+
+
+def test_multipliers_on_p2_triangles_are_refused():
+    # a P2 triangle has no nodal quadrature with positive weights: the constraint could not
+    # stay nodal, so 3D P2 takes the elimination
+    msh = mesh.create_unit_cube(MPI.COMM_WORLD, 2, 2, 2)
+    V = fem.functionspace(msh, ("Lagrange", 2, (3,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    top = mesh.locate_entities_boundary(msh, 2, lambda x: np.isclose(x[2], 1.0))
+    with pytest.raises(ValueError, match="use the elimination"):
+        ActiveSetContact(ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx, u, [], top,
+                         lambda x: 0 * x[0], normal_axis=2, formulation="multiplier")
 
 
 def test_nonlinear_material_runs_newton_inside_each_iteration():

@@ -20,9 +20,9 @@ and stops when the set does not change. Two formulations of each iteration:
   quadrature so that the constraint is nodal, as in the elimination.
 
 The nodes are the displacement dofs on S_C: vertices for P1, vertices and edge midpoints for
-P2 (the multiplier formulation is written for P1). Non-linear materials: each active-set
-iteration is a full Newton solve (warm-started), so the set is only updated from
-equilibrium states, where the course's rules are meaningful.
+P2 (the multiplier formulation: P1, or P2 in 2D and axisymmetric models). Non-linear
+materials: each active-set iteration is a full Newton solve (warm-started), so the set is
+only updated from equilibrium states, where the course's rules are meaningful.
 The active set is kept as DOLFINx meshtags: vertices (`active_vertices`) and the facets of
 S_C whose vertices are all active (`active_facets`), ready to write out.
 """
@@ -125,11 +125,6 @@ class ActiveSetContact:
         if initial not in ("all", "none", "penetrating"):
             raise ValueError(f"initial must be all, none or penetrating, got {initial!r}")
         V = displacement_space or u.function_space
-        if formulation == "multiplier" and displacement_space is not None:
-            raise ValueError("the multiplier contact formulation does not take a mixed "
-                             "displacement-pressure unknown: use the elimination")
-        if formulation == "multiplier" and V.element.basix_element.degree != 1:
-            raise ValueError("the multiplier formulation needs a P1 displacement space")
         self.u, self.formulation, self.max_iterations = u, formulation, max_iterations
         self.surface = ContactSurface(V, facets, gap, normal_axis=normal_axis,
                                       normal_sign=normal_sign,

@@ -1,14 +1,18 @@
 """The course's saddle-point form of one active-set iteration, on a facet submesh.
 
-Unknowns: u, and the multiplier λ (P1 on a submesh of S_C) standing for the normal contact
-traction. The equations, for all (v, μ):
+Unknowns: u, and the multiplier λ (on a submesh of S_C, of the displacement's degree)
+standing for the normal contact traction. The equations, for all (v, μ):
 
     R(u; v) − ∫_{S_C} λ v_n ds = 0
     −∫_{S_C} [χ (u_n − γ) − (1 − χ) λ / k] μ ds = 0
 
-with χ the nodal indicator of the active set (a P1 function on the submesh) and a *vertex*
+with χ the nodal indicator of the active set (a function on the submesh) and a *nodal*
 quadrature rule on S_C: integrals become nodal sums, so an active node gets exactly
 u_n = γ and an inactive one exactly λ = 0, the same discrete problem as the elimination.
+P1: the vertex rule; P2 (2D and axisymmetric): Gauss–Lobatto's 3 points, the P2 nodes of
+an edge, weights h/6, 2h/3, h/6. A P2 triangle (3D) has no nodal rule with positive
+weights, so 3D P2 is refused. `u` may be a mixed (u, p) unknown: `u[axis]` is its
+displacement's component.
 On active nodes the tangent is the course's [K −A; −Aᵀ 0]. `k` only scales the inactive
 rows. Assembled as a mixed-dimensional block system (`entity_maps`) and solved by SNES with
 MUMPS LU. In the axisymmetric model the 2πr weight is left out of these two integrals
@@ -25,7 +29,6 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.contact.surface import vertex_of_dof
 from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import (
@@ -50,20 +53,22 @@ class MultiplierSystem:
         fdim = msh.topology.dim - 1
         if fdim == 0:
             raise ValueError("the multiplier formulation needs a 2D or 3D mesh (use elimination)")
+        degree = surface.Vn.element.basix_element.degree
+        if degree not in (1, 2) or (degree == 2 and fdim == 2):
+            raise ValueError("the multiplier formulation takes P1 displacements, or P2 in 2D "
+                             "and axisymmetric models (no nodal rule with positive weights "
+                             "on a P2 triangle): use the elimination")
         facets = np.sort(surface.facets)
-        sub, emap, vmap, _ = mesh.create_submesh(msh, fdim, facets)
-        Q = fem.functionspace(sub, ("Lagrange", 1))
+        sub, emap, _, _ = mesh.create_submesh(msh, fdim, facets)
+        Q = fem.functionspace(sub, ("Lagrange", degree))
         self.lam = fem.Function(Q, name="multiplier")
         self.chi = fem.Function(Q, name="active")
         self.gamma = fem.Function(Q, name="gap")
-        # S_C node i (the surface's ordering) <-> Q dof, through the parent mesh vertices
-        q_parent_vertex = vmap.sub_topology_to_topology(vertex_of_dof(Q), inverse=False)
-        parent_vertex_to_q = {int(pv): q for q, pv in enumerate(q_parent_vertex)}
-        self.q_of_node = np.array([parent_vertex_to_q[int(vv)] for vv in surface.vertices],
-                                  dtype=np.int32)
+        self.q_of_node = dofs_at(Q, surface.x)  # S_C node i (the surface's order) -> Q dof
         tags = mesh.meshtags(msh, fdim, facets, np.ones(len(facets), dtype=np.int32))
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags,
-                         metadata={"quadrature_rule": "vertex", "quadrature_degree": 1})(1)
+        rule = ({"quadrature_rule": "vertex", "quadrature_degree": 1} if degree == 1
+                else {"quadrature_rule": "GLL", "quadrature_degree": 2})
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=rule)(1)
         v = residual.arguments()[0]
         mu = ufl.TestFunction(Q)
         s, k = surface.sign, stiffness_scale
@@ -116,3 +121,20 @@ class MultiplierSystem:
         """Nodal normal contact forces w_j λ_j at the S_C nodes (the surface's ordering)."""
         with self.weights.localForm() as w:
             return w.array_r[self.q_of_node] * self.lam.x.array[self.q_of_node]
+
+
+def dofs_at(Q: fem.FunctionSpace, points: np.ndarray) -> np.ndarray:
+    """The local dof of the scalar space Q at each of `points` (n x 3), checked.
+
+    Every S_C node lies on a facet of the submesh on its own rank, so its dof is local.
+    """
+    if len(points) == 0:
+        return np.zeros(0, dtype=np.int32)
+    from scipy.spatial import cKDTree
+
+    xq = Q.tabulate_dof_coordinates()
+    distance, index = cKDTree(xq).query(points)
+    scale = float(np.ptp(xq, axis=0).max()) if len(xq) > 1 else 1.0
+    if np.any(distance > 1e-9 * (scale or 1.0)):
+        raise RuntimeError("an S_C node has no multiplier dof at its place")
+    return index.astype(np.int32)

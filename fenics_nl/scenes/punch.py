@@ -77,16 +77,17 @@ class PunchBlock:
 
     Element size h = a/(20·2^refine) (plane strain a/40, 3D a/6) within 1.5a of the axis;
     `a` is the expected contact radius. Everything a residual is written with is public:
-    `u`, `V`, `kinematics` (the strain model), `dx` (degree-2 quadrature, exact for P1) and
-    `weight` (2πr in the axisymmetric model, else 1).
+    `u`, `V`, `kinematics` (the strain model), `dx` (of degree 2·`degree`, exact for the
+    linear law) and `weight` (2πr in the axisymmetric model, else 1). `degree`: of the
+    displacement, P1 by default.
 
     `mixed=True`: the Taylor–Hood pair (u, p) of `materials.mixed` (P2–P1) on the same
     mesh; `unknown` is the Function a solver updates (u itself otherwise), `u` and `p` the
-    parts for forms, `displacement()` a Function of u to probe and draw, `dx` of degree 4.
+    parts for forms, `displacement()` a Function of u to probe and draw.
     """
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
-                 growth: float | None = None, mixed: bool = False,
+                 growth: float | None = None, mixed: bool = False, degree: int | None = None,
                  comm: MPI.Comm = MPI.COMM_WORLD):
         if model not in MODELS:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
@@ -101,13 +102,14 @@ class PunchBlock:
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth)
         self.mesh = data.mesh
-        self.fields = f = unknowns(self.mesh, 2 if mixed else 1, mixed)
+        degree = degree or (2 if mixed else 1)
+        self.fields = f = unknowns(self.mesh, degree, mixed)
         self.mixed = f if mixed else None
         self.V, self.unknown, self.u, self.p = f.V, f.w, f.u, f.p
         self.kinematics = ("axisymmetric" if model == "axisymmetric"
                            else "3d" if dim == 3 else "plane_strain")
         self.weight = kinematics.measure_weight(self.mesh, self.kinematics)
-        self.quadrature_degree = 4 if mixed else 2
+        self.quadrature_degree = 2 * degree
         self.dx = kinematics.quadrature_measure("dx", self.mesh, self.quadrature_degree)
 
         def facets(name):
@@ -135,13 +137,14 @@ class PunchBlock:
 
 def build_punch(model: str, material, radius: float, a: float, *, refine: int = 1,
                 block: float = 1000.0, growth: float | None = None, mixed: bool = False,
-                comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Punch:
+                degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD,
+                **options) -> Punch:
     """The punch scene in one call (as `demos/punch.py` composes it), for tests and benchmarks.
 
     `options` go to `Punch` (formulation, gap, newton_options).
     """
     body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm,
-                      mixed=mixed)
+                      mixed=mixed, degree=degree)
     if mixed:
         m = body.mixed
         residual = mixed_form.internal_work(material, m.u, m.p, m.v, m.q,
@@ -190,8 +193,8 @@ class Punch:
             force /= a
         opts = {"line_search": not material.is_linear,
                 "force_scale": force / self.block.symmetry_factor}
-        if block.mixed:  # a symmetric saddle point: MUMPS LDLᵀ, 16-25 % faster than LU
-            opts["linear_solver"] = "cholesky"  # (97,832 unknowns, the same force to 4e-15)
+        if block.mixed and formulation == "elimination":  # a symmetric saddle point: MUMPS
+            opts["linear_solver"] = "cholesky"  # LDLᵀ (benchmarks/mixed.py)
         opts.update(newton_options or {})
         self.contact = ActiveSetContact(
             residual, self.u, self.bcs, self.block.contact_facets, self.gap(0.0),
