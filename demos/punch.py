@@ -52,7 +52,7 @@ from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
-from fenics_nl.theory import hertz
+from fenics_nl.theory import hertz, mindlin
 
 if __name__ == "__main__":  # `python demos/punch.py [options]`: the cells below, run by
     sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
@@ -114,6 +114,19 @@ def parser():
                         f"at most {MAX_REFINE}")
     p.add_argument("--block", type=cli.positive, default=None,
                    help="block size in contact radii, >= 10 (default 1000, 3D 100)")
+    p.add_argument("--friction", type=cli.finite, default=None, metavar="F",
+                   help="Coulomb friction coefficient f >= 0 (statuses open / stick / slip; "
+                        "plane strain and axisymmetric; default: frictionless)")
+    tangential = p.add_mutually_exclusive_group()
+    tangential.add_argument("--tangential-ratio", type=cli.finite, default=None, metavar="R",
+                            help="after the normal load, a tangential force Q = R f P along x, "
+                                 "0 <= R < 1 (Cattaneo-Mindlin partial slip)")
+    tangential.add_argument("--tangential-force", type=cli.finite, default=None, metavar="Q",
+                            help="after the normal load, the tangential force Q [force] (per "
+                                 "unit length in plane strain), below f P")
+    tangential.add_argument("--tangential-displacement", type=cli.finite, default=None,
+                            metavar="D", help="after the normal load, move the punch by D "
+                                              "[length] along x")
     cli.add_outputs(p, output="displacement, von Mises stress, contact pressure and active set",
                     png="the deformed contact zone (von Mises stress) beside the contact "
                         "pressure, against Hertz",
@@ -139,6 +152,24 @@ if args.indentation is not None and args.indentation == 0:
     p.error("--indentation must be non-zero (negative: the punch stays clear)")
 if args.indentation is None and args.force is None:
     args.indentation = 0.01 * args.radius
+moved = [x for x in (args.tangential_ratio, args.tangential_force, args.tangential_displacement)
+         if x is not None]
+if args.friction is not None and args.friction < 0:
+    p.error(f"--friction must be >= 0, got {args.friction}")
+if moved and args.friction is None:
+    p.error("a tangential load needs --friction F: without friction nothing holds the punch")
+if moved and args.model == "axisymmetric":
+    p.error("a tangential load breaks the axial symmetry: use --model plane-strain or 3d")
+if args.friction is not None and args.model == "3d":
+    p.error("--friction is 2D for now (plane strain, axisymmetric): in 3D the slip "
+            "directions of the status loop do not settle yet")
+if args.friction is not None and args.formulation == "multiplier":
+    p.error("--friction is written for --formulation elimination")
+if args.tangential_ratio is not None and not 0 <= args.tangential_ratio < 1:
+    p.error(f"--tangential-ratio must be in [0, 1), got {args.tangential_ratio} (at Q = f P "
+            "the punch slides: no static equilibrium)")
+if args.tangential_force is not None and args.tangential_force < 0:
+    p.error(f"--tangential-force must be >= 0, got {args.tangential_force}")
 # -
 
 # ### The block
@@ -160,7 +191,8 @@ else:
     a = hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
 size = args.block or (100.0 if args.model == "3d" else 1000.0)
 say(f"meshing the {args.model} block ({size:g} contact radii) ...")
-block = PunchBlock(args.model, a, refine=args.refine, block=size, mixed=args.mixed)
+block = PunchBlock(args.model, a, refine=args.refine, block=size, mixed=args.mixed,
+                   tangential=bool(moved))
 # -
 
 # ### The material
@@ -207,7 +239,8 @@ else:
 # each started from the last active set.
 
 # +
-punch = Punch(block, material, residual, R, formulation=args.formulation, gap=args.gap)
+punch = Punch(block, material, residual, R, formulation=args.formulation, gap=args.gap,
+              friction=args.friction)
 say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
 load = PunchLoad(punch, indentation=args.indentation, force=args.force,
                  first_guess=a * a / R)
@@ -269,6 +302,65 @@ if len(loading) >= 2 and all(s.force > 0 for s in loading):
                                                    else " (Hertz: 1.5)"))
 # -
 
+# ### The tangential load, with friction (Cattaneo–Mindlin)
+#
+# With `--friction`, every node of $S_C$ is open, sticking or slipping
+# (`fenics_nl.contact.friction.FrictionalContact`): sticking nodes keep their position
+# relative to the punch, slipping ones carry the tangential force $f |T_n|$ against their
+# slip. After the normal load the punch moves along x, by a prescribed D or until the
+# tangential force is Q (`Punch.pull`, secant steps on the punch's position). Partial slip
+# against Cattaneo–Mindlin (exact at ν = 1/2, where the normal and tangential problems
+# decouple): the stick zone c = a √(1 − Q/(fP)) (cylinder) or a (1 − Q/(fP))^{1/3}
+# (sphere), the traction profile (cylinder), the punch's displacement (sphere).
+
+# +
+traction, mindlin_checks = None, {}
+if moved:
+    if last.force <= 0:
+        raise ValueError("the punch does not touch the block: no normal force holds it "
+                         "against a tangential load")
+    fP = args.friction * last.force
+    if args.tangential_displacement is not None:
+        traction = punch.shift(args.tangential_displacement)
+    else:
+        Q = (args.tangential_force if args.tangential_force is not None
+             else args.tangential_ratio * fP)
+        traction, _ = punch.pull(Q)
+    punch.commit()
+    T = traction
+    say(f"tangential: d = {T.tangential_displacement:.5g}, Q = {T.tangential_force:.6g} = "
+        f"{T.tangential_force / fP:.4f} f P; {T.stick_nodes} nodes stick, {T.slip_nodes} "
+        f"slip, stick radius {T.stick_radius:.5g}; {T.status_iterations} status iterations")
+    if ref is not None and T.tangential_force < fP:
+        a_H, p0_H = ref["contact_radius"], ref["max_pressure"]
+        if args.model == "plane-strain":
+            c_exact = mindlin.cylinder_stick_half_width(a_H, T.tangential_force, fP)
+            x_n, _, q_n, status = punch.traction_profile() or (None,) * 4
+            if comm.rank == 0:
+                q_ex = mindlin.traction(x_n, a_H, p0_H, args.friction, c_exact)
+                # away from the stick-slip edges ±c, where the exact q has an infinite slope
+                away = (np.abs(np.abs(x_n) - c_exact) > 2 * block.h) & (np.abs(x_n) < 1.5 * a_H)
+                mindlin_checks["tangential_traction_max_error"] = float(
+                    np.abs(q_n - q_ex)[away].max() / (args.friction * p0_H))
+            mindlin_checks = comm.bcast(mindlin_checks, root=0)
+        else:
+            c_exact = mindlin.sphere_stick_radius(a_H, T.tangential_force, fP)
+            mindlin_checks["tangential_displacement_exact"] = (
+                mindlin.sphere_tangential_displacement(E, nu, a_H, T.tangential_force, fP))
+        mindlin_checks["stick_radius_exact"] = c_exact
+        checked = [f"stick radius {c_exact:.5g} (FE: (c - c_exact)/h = "
+                   f"{(T.stick_radius - c_exact) / block.h:+.2f})"]
+        if "tangential_traction_max_error" in mindlin_checks:
+            error = mindlin_checks["tangential_traction_max_error"]
+            checked.append(f"tangential traction within {100 * error:.2f} % of f p0 (beyond "
+                           "2 h of the stick-slip edges)")
+        else:
+            d_t = mindlin_checks["tangential_displacement_exact"]
+            checked.append(f"punch displacement {d_t:.5g} (FE "
+                           f"{100 * (T.tangential_displacement / d_t - 1):+.2f} %)")
+        say("Cattaneo-Mindlin: " + "; ".join(checked))
+# -
+
 # ## Outputs
 #
 # The JSON (every quantity above, the reactions of the supports, the work done) and, when
@@ -300,6 +392,19 @@ def summary():
     if args.material != "linear":
         warnings.append(f"{args.material} material: Hertz's values are the linear "
                         f"reference, not a check")
+    if args.friction is not None:
+        out["friction"] = args.friction
+    if traction is not None:
+        T = traction
+        out.update({"tangential_force": T.tangential_force,
+                    "tangential_displacement": T.tangential_displacement,
+                    "stick_radius": T.stick_radius, "stick_nodes": T.stick_nodes,
+                    "slip_nodes": T.slip_nodes, "status_iterations": T.status_iterations,
+                    **mindlin_checks})
+        if nu != 0.5:
+            warnings.append(f"Cattaneo-Mindlin is exact for a rigid punch on an "
+                            f"incompressible body (ν = 1/2, --mixed); at ν = {nu:g} the "
+                            "normal and tangential problems couple")
     if imprint is not None:
         out["residual_imprint_depth"] = imprint
         out["unloading"] = [{"indentation": s.indentation, "force": s.force}
@@ -340,7 +445,9 @@ def plot(punch, states, ref, args):
                                         else ""))
     ax1.legend()
     ax1.grid(alpha=0.3)
-    if ref is not None:
+    if traction is not None and ref is not None:
+        traction_panel(ax2, traction_profile, ref)
+    elif ref is not None:
         pressure_panel(ax2, profile, states[-1], ref)
     fig.suptitle(title(states[-1], ref, args))
     pictures.save_figure(fig, args.plot)
@@ -368,6 +475,33 @@ def _checked(state, ref, args):
     return (f"{args.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
             f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
             f"p0 {p_err:+.1f} %")
+
+
+def traction_panel(ax, profile, ref):
+    """p/p0 and q/(f p0) along x through the axis: FE nodes (stick, slip) against
+    Hertz and Cattaneo-Mindlin (a, p0 of Hertz for the computed P)."""
+    x, p, q, status = profile
+    a, p0, f = ref["contact_radius"], ref["max_pressure"], args.friction
+    c = mindlin_checks.get("stick_radius_exact")
+    xx = np.linspace(-1.5, 1.5, 601)
+    ax.plot(xx, hertz.pressure_profile(1.0, 1.0, xx), color="0.6", lw=1, label="Hertz p/p0")
+    ax.plot(x / a, p / p0, ".", color="0.6", ms=2, label="FE p/p0")
+    if c is not None:
+        ax.plot(xx, mindlin.traction(xx * a, a, p0, f, c) / (f * p0), "k-", lw=1,
+                label="Cattaneo-Mindlin q/(f p0)")
+        for side in (-1, 1):
+            ax.axvline(side * c / a, color="k", ls=":", lw=0.8)
+    for code, name, colour in ((1, "stick", "C0"), (2, "slip", "C1")):
+        on = status == code
+        ax.plot(x[on] / a, q[on] / (f * p0), "o", ms=3, color=colour, label=f"FE q, {name}")
+    ax.set_xlim(-1.5, 1.5)
+    ax.set_ylim(-0.05, 1.25)
+    ax.set_xlabel("x / a (Hertz)" + (" on y = 0" if args.model == "3d" else ""))
+    ax.set_ylabel("traction / p0, f p0")
+    ax.set_title(f"f = {f:g}, Q = {traction.tangential_force / (f * traction.normal_force):.3g}"
+                 f" f P: stick zone |x| < c (dotted: c of Cattaneo-Mindlin)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
 
 
 def pressure_panel(ax, profile, state, ref):
@@ -412,15 +546,15 @@ def picture(punch, vm, state, ref, args):
     tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
                        edgecolors="face", vmin=0)
     ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
-    rr = np.linspace(0, window, 300)
-    gap = punch.gap_at(rr, state.indentation)
+    rr = np.linspace(-window if block.tangential else 0, window, 600)
+    gap = punch.gap_at(np.abs(rr), state.indentation)
     ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
     ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
     ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
     if ref:
         ax.plot([ref["contact_radius"]] * 2, [-0.3 * a, -0.15 * a], color="k", lw=1)
         ax.annotate("a (Hertz)", (ref["contact_radius"], -0.38 * a), ha="center", fontsize=8)
-    ax.set_xlim(0, window)
+    ax.set_xlim(-window if block.tangential else 0, window)
     ax.set_ylim(-2 * a, 0.5 * a)
     ax.set_aspect("equal")
     ax.set_xlabel("r [length]" if args.model == "axisymmetric" else "x [length]")
@@ -431,7 +565,9 @@ def picture(punch, vm, state, ref, args):
     cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
     cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
     ax.legend(loc="lower right", fontsize=8)
-    if ref is not None:
+    if traction is not None and ref is not None:
+        traction_panel(ax2, traction_profile, ref)
+    elif ref is not None:
         pressure_panel(ax2, profile, state, ref)
     fig.suptitle(title(state, ref, args), fontsize=10)
     pictures.save_figure(fig, args.png)
@@ -440,6 +576,9 @@ def picture(punch, vm, state, ref, args):
 
 writers = []
 vm = punch.von_mises() if args.output or args.png else None  # once for both
+# gathered on every rank's call (rank 0 keeps it) before the writers run on rank 0
+traction_profile = (punch.traction_profile() if traction is not None and (args.png or args.plot)
+                    else None)
 if args.output:
     writers.append(lambda: write_fields(vm))
 if args.plot:

@@ -73,17 +73,25 @@ class EliminationSystem:
         opts = {"reuse_factorization": True, **newton_options}
         self.newton = NewtonSolver(residual, u, self.bcs, prefix=prefix, **opts)
 
-    def set_active(self, active: np.ndarray, changes: int | None) -> None:
-        """u_n = γ on the active nodes; `changes`: nodes changed since the last solve."""
+    def set_active(self, active: np.ndarray, changes: int | None,
+                   extra_bcs: Sequence[fem.DirichletBC] = ()) -> None:
+        """u_n = γ on the active nodes; `changes`: nodes changed since the last solve.
+
+        `extra_bcs`: more rows of S_C (the tangential ones of sticking nodes).
+        """
         small = changes is not None and changes <= self.SMALL_CHANGE
-        self.newton.set_bcs([*self.bcs, self.surface.dirichlet(active)], small_change=small)
+        self.newton.set_bcs([*self.bcs, self.surface.dirichlet(active), *extra_bcs],
+                            small_change=small)
 
     def solve(self) -> SolveResult:
         """Newton on the current set."""
         return self.newton.solve()
 
-    def normal_forces(self) -> np.ndarray:
-        """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
+    def reactions_at(self, dofs: np.ndarray) -> np.ndarray:
+        """f_int − f_ext at `dofs` (local, in the unknown's numbering).
+
+        The residual without the constrained rows: the force the constraints put on the body.
+        """
         b = self._reaction
         with b.localForm() as loc:
             loc.set(0.0)
@@ -91,7 +99,11 @@ class EliminationSystem:
         b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
         b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         with b.localForm() as loc:
-            return self.surface.sign * loc.array_r[self.surface.dofs_V].copy()
+            return loc.array_r[dofs].copy()
+
+    def normal_forces(self) -> np.ndarray:
+        """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
+        return self.surface.sign * self.reactions_at(self.surface.dofs_V)
 
 
 class ActiveSetContact:

@@ -57,6 +57,7 @@ class ContactSurface:
         self.vertices = vertex_of_dof(self.Vn)[self.dofs_n]  # −1: not at a vertex
         self._flags = la.vector(self.Vn.dofmap.index_map)
         self._areas: dict = {}
+        self._tangential: dict = {}
 
     # -- nodes --------------------------------------------------------------------------
 
@@ -158,6 +159,36 @@ class ContactSurface:
         if self.component is self.Vn:
             return fem.dirichletbc(self.g, self.dofs_V[mask])
         return fem.dirichletbc(self.g, [self.dofs_V[mask], self.dofs_n[mask]], self.component)
+
+    # -- tangential directions (friction) ------------------------------------------------
+
+    @property
+    def tangential_axes(self) -> list[int]:
+        """The coordinate axes along S_C (every axis but the normal one)."""
+        return [i for i in range(self.mesh.geometry.dim) if i != self.axis]
+
+    def tangential(self, i: int) -> tuple[np.ndarray, fem.Function]:
+        """(dofs of displacement component `i` at the nodes, a Function for its values).
+
+        The dofs are in the unknown's numbering; the Function is on the component's space,
+        for the Dirichlet values of sticking nodes.
+
+        Component spaces share one layout (checked), so node j is dof `dofs_n[j]` in each.
+        """
+        if i not in self._tangential:
+            part = self.V.sub(i)
+            space, parent = collapsed(part)
+            if not np.allclose(space.tabulate_dof_coordinates()[self.dofs_n], self.x):
+                raise RuntimeError("displacement components with different dof layouts")
+            self._tangential[i] = (parent[self.dofs_n], fem.Function(space))
+        return self._tangential[i]
+
+    def tangential_dirichlet(self, i: int, mask: np.ndarray, values: np.ndarray
+                             ) -> fem.DirichletBC:
+        """u_i = `values` (one per node) on the nodes of `mask`."""
+        dofs, g = self.tangential(i)
+        g.x.array[self.dofs_n] = values
+        return fem.dirichletbc(g, [dofs[mask], self.dofs_n[mask]], self.V.sub(i))
 
     # -- output -------------------------------------------------------------------------
 

@@ -37,8 +37,8 @@ def _graded_size_field(h_fine: float, fine_radius: float, h_coarse: float, far: 
 
 
 def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: float,
-                 fine_radius: float, growth: float = 0.15, msh_file: str | None = None
-                 ) -> gmshio.MeshData:
+                 fine_radius: float, growth: float = 0.15, msh_file: str | None = None,
+                 both_sides: bool = False) -> gmshio.MeshData:
     """A block under a surface load near the origin, refined there.
 
     2D: [0, width] x [-depth, 0] (axisymmetric or half plane-strain model).
@@ -46,6 +46,7 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     physical group ``contact``; ``symmetry_x`` (x = 0), ``symmetry_y`` (3D, y = 0),
     ``bottom`` and ``side`` complete it. Element size h_fine inside `fine_radius` of the
     origin, then growing by `growth` per unit distance (geometric-like grading).
+    `both_sides`: x runs from -width to width (no ``symmetry_x``), for a load along x.
 
     gmsh works in units of `fine_radius` (its tolerances are absolute) and the coordinates
     are scaled back, so the mesh is the same, up to scale, in any unit system. `msh_file`:
@@ -56,10 +57,13 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
     if comm.rank == 0:
         start_model(f"block{dim}d")
         occ = gmsh.model.occ
+        x0, wx = (-width, 2 * width) if both_sides else (0.0, width)
         if dim == 2:
-            occ.addRectangle(0, -depth, 0, width, depth)
+            body = occ.addRectangle(x0, -depth, 0, wx, depth)
         else:
-            occ.addBox(0, 0, -depth, width, width, depth)
+            body = occ.addBox(x0, 0, -depth, wx, width, depth)
+        if both_sides:  # a vertex at the origin, which the size field is measured from
+            occ.fragment([(dim, body)], [(0, occ.addPoint(0, 0, 0))])
         occ.synchronize()
         up = 1 if dim == 2 else 2  # index of the vertical coordinate
         groups = {"contact": [], "symmetry_x": [], "symmetry_y": [], "bottom": [], "side": []}
@@ -69,7 +73,7 @@ def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: f
                 groups["contact"].append(tag)
             elif abs(c[up] + depth) < 1e-9 * depth:
                 groups["bottom"].append(tag)
-            elif abs(c[0]) < 1e-9 * width:
+            elif abs(c[0]) < 1e-9 * width and not both_sides:
                 groups["symmetry_x"].append(tag)
             elif dim == 3 and abs(c[1]) < 1e-9 * width:
                 groups["symmetry_y"].append(tag)

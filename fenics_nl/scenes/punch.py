@@ -27,6 +27,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
 from fenics_nl.errors import SolveError
@@ -72,6 +73,21 @@ class Indentation:
     factorizations: int
 
 
+@dataclass
+class Traction:
+    """One converged state of the punch moved tangentially (along x) after pressing it."""
+
+    tangential_displacement: float  # the punch's, since the unloaded state
+    tangential_force: float  # Q, total (3D) or per unit length (plane strain)
+    normal_force: float  # P, the same way
+    stick_radius: float  # the outermost sticking node's distance from the axis
+    stick_nodes: int
+    slip_nodes: int
+    status_iterations: int
+    newton_iterations: int
+    factorizations: int
+
+
 class PunchBlock:
     """The block under the punch: graded mesh, displacement space, supports, S_C.
 
@@ -84,13 +100,20 @@ class PunchBlock:
     `mixed=True`: the Taylor–Hood pair (u, p) of `materials.mixed` (P2–P1) on the same
     mesh; `unknown` is the Function a solver updates (u itself otherwise), `u` and `p` the
     parts for forms, `displacement()` a Function of u to probe and draw.
+
+    `tangential=True` (a tangential load along x; plane strain or 3D): the block spans
+    both sides of the punch, x in [−L, L], and its bottom is clamped (u = 0) instead of
+    sliding; the 3D model is then the half y >= 0.
     """
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
                  growth: float | None = None, mixed: bool = False, degree: int | None = None,
-                 comm: MPI.Comm = MPI.COMM_WORLD):
+                 tangential: bool = False, comm: MPI.Comm = MPI.COMM_WORLD):
         if model not in MODELS:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if tangential and model == "axisymmetric":
+            raise ValueError("a tangential load breaks the axial symmetry: use --model "
+                             "plane-strain or 3d")
         if refine < 0 or block < 10:
             raise ValueError("refine must be >= 0 and block >= 10 (block size in contact radii)")
         self.model, self.a = model, a
@@ -100,7 +123,8 @@ class PunchBlock:
         self.h = a / ({"axisymmetric": 20, "3d": 6, "plane-strain": 40}[model] * 2**refine)
         growth = growth if growth is not None else (0.10 if dim == 3 else 0.05)
         L = block * a
-        data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth)
+        data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth, both_sides=tangential)
+        self.tangential = tangential
         self.mesh = data.mesh
         degree = degree or (2 if mixed else 1)
         self.fields = f = unknowns(self.mesh, degree, mixed)
@@ -116,15 +140,21 @@ class PunchBlock:
             return data.facet_tags.find(data.physical_groups[name].tag)
 
         # the constrained groups, whose reactions are reported (the side is free)
-        names = ["contact", "bottom", "symmetry_x"] + (["symmetry_y"] if dim == 3 else [])
+        names = (["contact", "bottom"] + ([] if tangential else ["symmetry_x"])
+                 + (["symmetry_y"] if dim == 3 else []))
         self.groups = {name: facets(name) for name in names}
-        self.bcs = [boundary.component(self.V, 0, facets("symmetry_x")),
-                    boundary.component(self.V, self.vertical, facets("bottom"))]
+        if tangential:
+            self.bcs = [boundary.fixed(self.V, facets("bottom"))]
+        else:
+            self.bcs = [boundary.component(self.V, 0, facets("symmetry_x")),
+                        boundary.component(self.V, self.vertical, facets("bottom"))]
         if dim == 3:
             self.bcs.append(boundary.component(self.V, 1, facets("symmetry_y")))
         self.contact_facets = facets("contact")
         # force of the whole body from the modelled part (2πr is in the weight)
         self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
+        if tangential:
+            self.symmetry_factor /= 2
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
@@ -137,14 +167,14 @@ class PunchBlock:
 
 def build_punch(model: str, material, radius: float, a: float, *, refine: int = 1,
                 block: float = 1000.0, growth: float | None = None, mixed: bool = False,
-                degree: int | None = None, comm: MPI.Comm = MPI.COMM_WORLD,
-                **options) -> Punch:
+                degree: int | None = None, tangential: bool = False,
+                comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Punch:
     """The punch scene in one call (as `demos/punch.py` composes it), for tests and benchmarks.
 
-    `options` go to `Punch` (formulation, gap, newton_options).
+    `options` go to `Punch` (formulation, gap, friction, newton_options).
     """
     body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm,
-                      mixed=mixed, degree=degree)
+                      mixed=mixed, degree=degree, tangential=tangential)
     if mixed:
         m = body.mixed
         residual = mixed_form.internal_work(material, m.u, m.p, m.v, m.q,
@@ -170,12 +200,13 @@ class Punch:
         radius: the punch radius R.
         formulation: ``elimination`` or ``multiplier`` (see `ActiveSetContact`).
         gap: ``parabola`` (Hertz's) or ``sphere`` (exact).
+        friction: Coulomb's coefficient f (`FrictionalContact`), or None: frictionless.
         newton_options: passed to the Newton solver of each active-set iteration.
     """
 
     def __init__(self, block: PunchBlock, material, residual, radius: float, *,
                  formulation: str = "elimination", gap: str = "parabola",
-                 newton_options: dict | None = None):
+                 friction: float | None = None, newton_options: dict | None = None):
         if not radius > 0:
             raise ValueError(f"radius must be > 0, got {radius}")
         if gap not in ("parabola", "sphere"):
@@ -196,12 +227,18 @@ class Punch:
         if block.mixed and formulation == "elimination":  # a symmetric saddle point: MUMPS
             opts["linear_solver"] = "cholesky"  # LDLᵀ (benchmarks/mixed.py)
         opts.update(newton_options or {})
-        self.contact = ActiveSetContact(
-            residual, self.u, self.bcs, self.block.contact_facets, self.gap(0.0),
-            normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
-            initial="penetrating", newton_options=opts,
-            prefix=f"punch_{model.replace('-', '')}_",
-            displacement_space=block.V if block.mixed else None)
+        contact = dict(normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
+                       initial="penetrating", newton_options=opts,
+                       prefix=f"punch_{model.replace('-', '')}_",
+                       displacement_space=block.V if block.mixed else None)
+        self.friction = friction
+        if friction is None:
+            self.contact = ActiveSetContact(residual, self.u, self.bcs,
+                                            self.block.contact_facets, self.gap(0.0), **contact)
+        else:
+            self.contact = FrictionalContact(residual, self.u, self.bcs,
+                                             self.block.contact_facets, self.gap(0.0),
+                                             friction=friction, **contact)
 
     @property
     def dofs(self) -> int:
@@ -230,6 +267,69 @@ class Punch:
         p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])
         return Indentation(delta, self.block.symmetry_factor * c.force, radius, p_max,
                            res.active_set_iterations, res.iterations, res.work.factorizations)
+
+    # -- tangential load (with friction) ----------------------------------------------
+
+    def _frictional(self):
+        if self.friction is None or not self.block.tangential:
+            raise ValueError("a tangential load needs friction (--friction) and a block on "
+                             "both sides of the punch (tangential=True)")
+        return self.contact
+
+    def commit(self) -> None:
+        """The current state becomes the start of the next load step (friction's history)."""
+        if self.friction is not None:
+            self.contact.commit()
+
+    def restore(self) -> None:
+        """Back to the last committed state's statuses (after a failed step)."""
+        if self.friction is not None:
+            self.contact.restore()
+
+    def shift(self, d: float) -> Traction:
+        """Move the pressed punch to the tangential position d (along x).
+
+        From the last committed state, the statuses of the last solve as a warm start.
+        """
+        c = self._frictional()
+        c.set_motion([d] + [0.0] * (len(c.axes) - 1))
+        res = c.solve()
+        stick = c.stick
+        r = self.block.radius_of(c.x[stick].T) if stick.any() else np.zeros(0)
+        k = self.block.symmetry_factor
+        return Traction(d, k * c.tangential_force()[0], k * c.force,
+                        global_max(self.mesh.comm, r), c.surface.count(stick),
+                        c.surface.count(c.slip), res.active_set_iterations, res.iterations,
+                        res.work.factorizations)
+
+    def pull(self, force: float, rtol: float = 1e-8, max_it: int = 60
+             ) -> tuple[Traction, int]:
+        """Tangential force control: the position d with Q(d) = `force`, by secant steps.
+
+        Q(d) rises and bends down as nodes slip (concave): secant steps from the full-stick
+        slope approach the root from below and never overshoot. Q >= f P has no static
+        equilibrium (gross sliding): a ValueError.
+        """
+        c = self._frictional()
+        P = self.block.symmetry_factor * c.force
+        if not (math.isfinite(force) and 0 <= force < self.friction * P):
+            raise ValueError(f"tangential force {force:g} must be in [0, f P) = [0, "
+                             f"{self.friction * P:.6g}): at f P the punch slides (no static "
+                             "equilibrium under force control)")
+        d_prev = float(c.committed_motion[0])
+        q_prev = self.block.symmetry_factor * float(c.committed_tangential_force[0])
+        s1 = self.shift(d_prev + 1e-6 * self.block.a)  # the full-stick slope
+        for k in range(max_it):
+            if abs(s1.tangential_force - force) <= rtol * self.friction * P:
+                return s1, k + 1
+            slope = (s1.tangential_force - q_prev) / (s1.tangential_displacement - d_prev)
+            if not slope > 0:
+                raise SolveError(f"tangential force does not grow with the punch's position "
+                                 f"(slope {slope:.3g} at d = {s1.tangential_displacement:.6g})")
+            d_next = s1.tangential_displacement + (force - s1.tangential_force) / slope
+            d_prev, q_prev = s1.tangential_displacement, s1.tangential_force
+            s1 = self.shift(d_next)
+        raise SolveError(f"tangential force {force:g} not reached in {max_it} positions")
 
     def _contact_radius(self) -> float:
         """Distance of the outermost active node from the axis (within h of the true edge)."""
@@ -271,6 +371,25 @@ class Punch:
         r, p, active = rows
         order = np.argsort(r)
         return r[order], p[order], active[order]
+
+    def traction_profile(self):
+        """(x, p, q, status) of every S_C node along y = 0, on rank 0 sorted by x (else None).
+
+        x is signed (the block spans both sides of the punch), p the contact pressure and q
+        the tangential traction along x (the punch's on the block), nodal forces over nodal
+        areas; status 0 open, 1 stick, 2 slip.
+        """
+        c = self._frictional()
+        on = c.owned & (np.abs(c.x[:, 1]) < 1e-9 * self.block.a if self.model == "3d"
+                        else c.owned)
+        areas = c.surface.nodal_areas(self.block.weight)
+        status = np.where(c.slip, 2, np.where(c.active, 1, 0))
+        rows = gather_rows(self.mesh.comm, c.x[on, 0], c.pressure(self.block.weight)[on],
+                           (c.tangential_forces()[:, 0] / areas)[on], status[on])
+        if rows is None:
+            return None
+        order = np.argsort(rows[0])
+        return tuple(r[order] for r in rows)
 
     def nodes_in_contact(self) -> int:
         """Global number of active S_C nodes."""
@@ -331,6 +450,7 @@ class PunchLoad:
             guess = (self.states[-1].indentation * (self.t / self._t_last) ** (2 / 3)
                      if self.states else self.first_guess * self.t ** (2 / 3))
             s, _ = self.punch.push(self.t * self.force, guess)
+        self.punch.commit()  # the start of the next step (friction's slip history)
         self.states.append(s)
         self._t_last = self.t
         work = WorkCounts(factorizations=s.factorizations)

@@ -315,6 +315,7 @@ class NewtonSolver:
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
+        self._nodal_load = None  # (dofs, values): point forces (`set_nodal_load`)
         self._M = None  # the block preconditioner of a mixed unknown's iterative solve
         if linear_solver == "gamg" and V.ufl_element().is_mixed:
             if preconditioner is None:
@@ -356,6 +357,14 @@ class NewtonSolver:
         """
         self.bcs = list(bcs)
         self.policy.bcs_changed(small_change)
+
+    def set_nodal_load(self, dofs: np.ndarray, values: np.ndarray) -> None:
+        """External point forces: R(u) − F, F = `values` at `dofs` (owned, local indices).
+
+        For loads that no integral gives exactly, e.g. the friction force of a slipping
+        contact node. Replaces the previous ones; the tangent does not depend on them.
+        """
+        self._nodal_load = (np.asarray(dofs, dtype=np.int32), np.asarray(values, dtype=float))
 
     # -- the loop --------------------------------------------------------------------
 
@@ -449,6 +458,9 @@ class NewtonSolver:
             if lift:
                 petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
             self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            if self._nodal_load is not None:
+                dofs, values = self._nodal_load
+                self.b.array[dofs] -= values
             petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
             work.residual_assemblies += 1
             return self._force_norm()

@@ -1,0 +1,183 @@
+"""Coulomb friction on the active set: each node of S_C is open, sticking or slipping.
+
+The course's law on the effective contact zone: T_t < f |T_n| sticks, T_t = f |T_n| slips,
+T_t = ‖T − T_n n‖. Loading is quasi-static and incremental: within a step the rigid
+obstacle moves tangentially by Δd (`set_motion`), and a node's slip increment is
+Δg = Δu_t − Δd, its tangential displacement since the last committed state less the
+obstacle's. Each iteration solves (elimination) with
+
+* open nodes free;
+* sticking nodes: u_n = γ and Δg = 0 (all their components are Dirichlet rows);
+* slipping nodes: u_n = γ and the tangential nodal force f |T_n| s, s the unit direction of
+  the friction force on the body (`NewtonSolver.set_nodal_load`), T_n from the last solve;
+
+then updates the statuses by the course's rules, extended to friction:
+
+* a closed node in tension (T_n > 0) opens; an open node that penetrates closes, sticking;
+* a sticking node whose tangential reaction exceeds f |T_n| slips, s along that reaction;
+* a slipping node whose slip increment goes along its friction force (Δg·s > 0, the
+  friction would drive it) sticks; in 3D, a node that keeps slipping takes s = −Δg/|Δg|;
+
+and stops when no status changes and the friction forces agree with the normal forces of
+the same solve. The slip history lives in the committed tangential displacement; the driver
+commits it after a converged step (`commit`) or goes back to it (`restore`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from fenics_nl.contact.active_set import ActiveSetContact, ContactError, log
+from fenics_nl.parallel import global_max
+from fenics_nl.solvers.result import SolveResult, WorkCounts
+
+
+class FrictionalContact(ActiveSetContact):
+    """The active-set loop with Coulomb friction (coefficient `friction`), elimination only.
+
+    Statuses: `active` (closed nodes, as in the frictionless loop) and `slip` (closed
+    nodes that slip); `stick` = active and not slip. Everything else is ActiveSetContact's.
+    """
+
+    def __init__(self, *args, friction: float, **kwargs):
+        if not (math.isfinite(friction) and friction >= 0):
+            raise ValueError(f"the friction coefficient must be a finite number >= 0, got "
+                             f"{friction}")
+        if kwargs.get("formulation", "elimination") != "elimination":
+            raise ValueError("friction is written for the elimination formulation "
+                             "(--formulation elimination)")
+        super().__init__(*args, **kwargs)
+        self.f = float(friction)
+        S = self.surface
+        self.axes = S.tangential_axes
+        n, m = len(S.dofs_n), len(self.axes)
+        self.slip = np.zeros(n, dtype=bool)
+        self.direction = np.zeros((n, m))  # s: the friction force's direction on the body
+        self.slip_force = np.zeros((n, m))
+        self.motion = np.zeros(m)  # the obstacle's tangential displacement d
+        self.commit()
+
+    # -- state -------------------------------------------------------------------------
+
+    @property
+    def stick(self) -> np.ndarray:
+        """Mask of the sticking nodes."""
+        return self.active & ~self.slip
+
+    def _state(self):
+        return (self.active.copy(), self.slip.copy(), self.direction.copy(),
+                self.slip_force.copy())
+
+    def commit(self) -> None:
+        """The current state becomes the start of the next step's increments."""
+        self._committed = self._state()
+        self._u_t_committed = self.tangential_displacement()
+        self.committed_motion = self.motion.copy()
+        self.committed_tangential_force = self.tangential_force()
+
+    def restore(self) -> None:
+        """Back to the last committed statuses (after a failed step)."""
+        self.active, self.slip, self.direction, self.slip_force = (
+            a.copy() for a in self._committed)
+        self.motion = self.committed_motion.copy()
+
+    def set_motion(self, d) -> None:
+        """The obstacle's tangential displacement d (one value per tangential axis)."""
+        self.motion = np.asarray(d, dtype=float).reshape(len(self.axes))
+
+    # -- the surface's tangential quantities ------------------------------------------
+
+    def tangential_displacement(self) -> np.ndarray:
+        """u_t at the nodes, one column per tangential axis."""
+        x = self.u.x.array
+        return np.column_stack([x[self.surface.tangential(i)[0]] for i in self.axes])
+
+    def tangential_forces(self) -> np.ndarray:
+        """T_t at the nodes (the obstacle's force on the body), one column per axis."""
+        return np.column_stack([self.system.reactions_at(self.surface.tangential(i)[0])
+                                for i in self.axes])
+
+    def slip_increment(self) -> np.ndarray:
+        """Δg = Δu_t − Δd since the last committed state, at the nodes."""
+        return (self.tangential_displacement() - self._u_t_committed
+                - (self.motion - self.committed_motion))
+
+    def tangential_force(self) -> np.ndarray:
+        """Σ T_t over S_C (every rank's owned nodes), one value per axis."""
+        T_t = self.tangential_forces()
+        return np.array([self.surface.total(T_t[:, k]) for k in range(len(self.axes))])
+
+    # -- one iteration's conditions ---------------------------------------------------
+
+    def _set_conditions(self, changes: int | None) -> None:
+        S, stick = self.surface, self.stick
+        held = self._u_t_committed + (self.motion - self.committed_motion)
+        sticking = [S.tangential_dirichlet(i, stick, held[:, k])
+                    for k, i in enumerate(self.axes)]
+        self.system.set_active(self.active, changes, extra_bcs=sticking)
+        owned = S.owned & self.slip
+        dofs = np.concatenate([S.tangential(i)[0][owned] for i in self.axes])
+        values = np.concatenate([self.slip_force[owned, k] for k in range(len(self.axes))])
+        self.system.newton.set_nodal_load(dofs, values)
+
+    # -- the loop ----------------------------------------------------------------------
+
+    def solve(self) -> SolveResult:
+        """Statuses to a fixed point, friction forces consistent; ContactError if not."""
+        t0 = time.perf_counter()
+        seen = set()
+        res = SolveResult(False, "frictional active set", 0, [], WorkCounts())
+        S = self.surface
+        changes = None
+        for k in range(1, self.max_iterations + 1):
+            self._set_conditions(changes)
+            nr = self.system.solve()
+            res.iterations += nr.iterations
+            res.work.add(nr.work)
+            res.residual_norms = nr.residual_norms
+            T_n, T_t, g = self.normal_forces(), self.tangential_forces(), self.slip_increment()
+            scale_T = global_max(self.comm, np.abs(T_n))
+            scale_u = max(global_max(self.comm, np.abs(S.gamma)), S.displacement_scale(self.u))
+            tol_T, tol_u = 1e-10 * scale_T, 1e-10 * scale_u
+            bound = self.f * np.maximum(-T_n, 0.0)
+            size = np.linalg.norm(T_t, axis=1)
+            leave = self.active & (T_n > tol_T)
+            join = ~self.active & (self.normal_gap() > tol_u)
+            to_slip = self.stick & ~leave & (size > bound + tol_T)
+            back = self.slip & ~leave & (np.sum(g * self.direction, axis=1) > tol_u)
+            active = S.sync((self.active & ~leave) | join)
+            slip = S.sync(((self.slip & ~back) | to_slip) & active)
+            direction = self.direction.copy()
+            direction[to_slip] = T_t[to_slip] / size[to_slip, None]
+            moving = slip & ~to_slip & (np.linalg.norm(g, axis=1) > tol_u)
+            if len(self.axes) > 1:  # in 3D a slipping node's force turns against its slip
+                direction[moving] = -g[moving] / np.linalg.norm(g[moving], axis=1)[:, None]
+            slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
+            drift = global_max(self.comm, np.abs(slip_force - self.slip_force))
+            changes = S.count(active != self.active) + S.count(slip != self.slip)
+            n_slip, n_stick = S.count(slip), S.count(active & ~slip)
+            res.active_set_iterations, res.active_sizes = k, [*res.active_sizes, S.count(active)]
+            res.history.append({"stick": n_stick, "slip": n_slip, "changes": changes,
+                                "to_slip": S.count(to_slip), "to_stick": S.count(back),
+                                "opened": S.count(leave), "closed": S.count(join),
+                                "friction_force_change": drift,
+                                "newton_iterations": nr.iterations})
+            log.info("status iteration %d: %d stick, %d slip, %d changes, friction force "
+                     "change %.3e", k, n_stick, n_slip, changes, drift)
+            self.active, self.slip, self.direction = active, slip, direction
+            self.slip_force = slip_force
+            if changes == 0 and drift <= 1e-9 * self.f * scale_T:
+                self.force = self.total_force(T_n)
+                res.converged, res.reason = True, "statuses fixed"
+                res.wall_time = time.perf_counter() - t0
+                return res
+            if changes:
+                key = (S.fingerprint(active), S.fingerprint(slip))
+                if key in seen:
+                    raise ContactError(f"statuses cycle (iteration {k}: {n_stick} stick, "
+                                       f"{n_slip} slip)", res)
+                seen.add(key)
+        raise ContactError(f"statuses did not settle in {self.max_iterations} iterations", res)

@@ -1,0 +1,130 @@
+"""Coulomb friction on the active set: statuses open / stick / slip (`contact.friction`)."""
+
+import math
+
+import basix.ufl
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl.contact.friction import FrictionalContact
+
+# the plane-strain cylinder of Cattaneo-Mindlin: a rigid punch (R = 1, δ = 0.01) on an
+# incompressible block (Taylor-Hood), h = a/24, 100 a wide
+INCOMPRESSIBLE_CYLINDER = ("--model", "plane-strain", "--mixed", "--nu", "0.5", "--refine", "0",
+                           "--block", "100", "--friction", "0.3")
+# the same on a compressible P1 block: cheap, but not Cattaneo-Mindlin's (Spence's coupling)
+COMPRESSIBLE_CYLINDER = ("--model", "plane-strain", "--refine", "0", "--block", "100")
+
+
+def jenkins_element(k_n, k_t, delta, f):
+    """A 2-node spring (axial k_n, transverse k_t) whose foot touches a rigid floor with
+    friction f, its head pressed down by δ: a spring in series with a Coulomb slider of
+    threshold F = f k_n δ. Returns (contact, the head's Dirichlet values)."""
+    domain = ufl.Mesh(basix.ufl.element("Lagrange", "interval", 1, shape=(2,)))
+    msh = mesh.create_mesh(MPI.COMM_SELF, np.array([[0, 1]], dtype=np.int64), domain,
+                           np.array([[0.0, 0.0], [0.0, 1.0]]))
+    V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    R = (k_n * u[1].dx(1) * v[1].dx(1) + k_t * u[0].dx(1) * v[0].dx(1)) * ufl.dx
+    head = mesh.locate_entities_boundary(msh, 0, lambda x: np.isclose(x[1], 1.0))
+    foot = mesh.locate_entities_boundary(msh, 0, lambda x: np.isclose(x[1], 0.0))
+    g = fem.Function(V)
+    bc = fem.dirichletbc(g, fem.locate_dofs_topological(V, 0, head))
+    contact = FrictionalContact(R, u, [bc], foot, lambda x: 0 * x[0], normal_axis=1,
+                                normal_sign=-1, friction=f, initial="all",
+                                prefix=f"jenkins{id(u)}_")
+    return contact, g
+
+
+def test_a_spring_on_a_rough_floor_follows_the_exact_stick_slip_cycle():
+    # the head moves 0 -> W -> -W -> W in steps of 0.03, which never land on a stick-slip
+    # corner; the foot's force is the Jenkins element's at every step, and the energy
+    # dissipated over the closed cycle, Σ |Q| |Δs|, is the loop's area 4 F (W − F/k)
+    k_n, k_t, delta, f = 2.0, 0.5, 0.05, 0.5
+    F, W, dw = f * k_n * delta, 0.3, 0.03
+    contact, head = jenkins_element(k_n, k_t, delta, f)
+    path = [0.0]
+    for target in (W, -W, W):
+        while abs(path[-1] - target) > 1e-12:
+            path.append(path[-1] + math.copysign(min(dw, abs(target - path[-1])),
+                                                 target - path[-1]))
+    s, forces, feet = 0.0, [], []
+    for i, w in enumerate(path):
+        head.interpolate(lambda x, w=w: np.vstack([w + 0 * x[0], -delta + 0 * x[0]]))
+        contact.solve()
+        contact.commit()
+        Q = -contact.tangential_force()[0]  # the spring's force on the floor
+        trial = k_t * (w - s)  # the exact element: stick, or slip back to the threshold
+        if abs(trial) > F:
+            s = w - math.copysign(F / k_t, trial)
+        assert Q == pytest.approx(k_t * (w - s), abs=1e-12 * F), (i, w)
+        assert contact.force == pytest.approx(k_n * delta, rel=1e-12)
+        forces.append(Q)
+        feet.append(contact.tangential_displacement()[0, 0])
+    first_peak = round(W / dw)  # the cycle W -> -W -> W starts there
+    dissipated = sum(abs(forces[i]) * abs(feet[i] - feet[i - 1])
+                     for i in range(first_peak + 1, len(path)))
+    assert dissipated == pytest.approx(4 * F * (W - F / k_t), rel=1e-12)
+
+
+def test_bad_coefficients_and_formulations_are_refused():
+    for f in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="friction coefficient"):
+            jenkins_element(1.0, 1.0, 0.1, f)
+    assert jenkins_element(1.0, 1.0, 0.1, 0.3)[0].f == 0.3  # a valid one builds
+
+
+def test_cattaneo_mindlin_partial_slip_of_a_cylinder(demo):
+    # the punch moved by d = 0.0023 after pressing it: Q = 0.4976 f P. Measured (h = a/24):
+    # the stick half-width 0.08 h from a √(1 − Q/(fP)), and the tangential traction within
+    # 2.0 % of f p0 of (f p0/a)(√(a² − x²) − √(c² − x²)) except within 2 h of the
+    # stick-slip edges ±c, where its slope is infinite (3.4 % within 1 h of them)
+    d = demo.punch(*INCOMPRESSIBLE_CYLINDER, "--tangential-displacement", "0.0023")
+    assert d["friction"] == 0.3 and d["stick_nodes"] > 0 and d["slip_nodes"] > 0
+    assert 0.4 < d["tangential_force"] / (0.3 * d["force"]) < 0.6
+    assert abs(d["stick_radius"] - d["stick_radius_exact"]) < d["element_size"]
+    assert d["tangential_traction_max_error"] < 0.03
+
+
+def test_force_control_reaches_the_tangential_force_and_coulombs_law_holds(demo):
+    d = demo.punch(*COMPRESSIBLE_CYLINDER, "--friction", "0.3", "--tangential-ratio", "0.5")
+    assert d["tangential_force"] == pytest.approx(0.5 * 0.3 * d["force"], rel=1e-8)
+    assert d["slip_nodes"] > 0 and d["stick_nodes"] > 0
+
+
+def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
+    free = demo.punch("--refine", "0")
+    smooth = demo.punch("--refine", "0", "--friction", "0")
+    assert smooth["force"] == pytest.approx(free["force"], rel=1e-9)
+    # f = 10 and Q = 1e-4 f P: no node slips
+    rough = demo.punch(*COMPRESSIBLE_CYLINDER, "--friction", "10", "--tangential-ratio", "1e-4")
+    assert rough["slip_nodes"] == 0 and rough["stick_nodes"] == rough["nodes_in_contact"]
+
+
+def test_friction_two_ranks_give_the_serial_answer(demo):
+    args = (*COMPRESSIBLE_CYLINDER, "--friction", "0.3", "--tangential-displacement", "0.002")
+    s, p = demo.punch(*args), demo.punch(*args, ranks=2)
+    assert p["ranks"] == 2
+    assert p["tangential_force"] == pytest.approx(s["tangential_force"], rel=1e-8)
+    assert (p["stick_nodes"], p["slip_nodes"]) == (s["stick_nodes"], s["slip_nodes"])
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--friction", "-0.1"], "--friction must be >= 0"),
+    (["--model", "plane-strain", "--tangential-ratio", "0.5"], "needs --friction"),
+    (["--friction", "0.3", "--tangential-ratio", "0.5"], "axial symmetry"),
+    (["--friction", "0.3", "--formulation", "multiplier"], "elimination"),
+    (["--friction", "0.3", "--model", "3d"], "2D for now"),
+    (["--model", "plane-strain", "--friction", "0.3", "--tangential-ratio", "1"], "slides"),
+    (["--model", "plane-strain", "--refine", "0", "--block", "100", "--friction", "0.3",
+      "--tangential-force", "1"], "slides"),
+    (["--model", "plane-strain", "--refine", "0", "--block", "100", "--indentation", "-0.01",
+      "--friction", "0.3", "--tangential-displacement", "0.001"], "does not touch"),
+])
+def test_friction_bad_input_is_one_line(demo, args, words):
+    proc = demo.run(["punch.py", *args], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode != 0 and len(lines) == 1 and words in lines[0], proc.stderr
