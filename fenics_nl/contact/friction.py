@@ -58,6 +58,12 @@ class FrictionalContact(ActiveSetContact):
         self.direction = np.zeros((n, m))  # s: the friction force's direction on the body
         self.slip_force = np.zeros((n, m))
         self.motion = np.zeros(m)  # the obstacle's tangential displacement d
+        # a component the body's own supports hold (a symmetry plane, the axis) is no
+        # friction's: its reaction is the support's
+        held = np.zeros(self.u.x.array.size, dtype=bool)
+        for bc in self.system.bcs:
+            held[bc.dof_indices()[0]] = True
+        self.free = np.column_stack([~held[S.tangential(i)[0]] for i in self.axes])
         self.commit()
 
     # -- state -------------------------------------------------------------------------
@@ -96,14 +102,17 @@ class FrictionalContact(ActiveSetContact):
         return np.column_stack([x[self.surface.tangential(i)[0]] for i in self.axes])
 
     def tangential_forces(self) -> np.ndarray:
-        """T_t at the nodes (the obstacle's force on the body), one column per axis."""
-        return np.column_stack([self.system.reactions_at(self.surface.tangential(i)[0])
-                                for i in self.axes])
+        """T_t at the nodes (the obstacle's force on the body), one column per axis.
+
+        Zero in a component the body's supports hold.
+        """
+        return self.free * np.column_stack(
+            [self.system.reactions_at(self.surface.tangential(i)[0]) for i in self.axes])
 
     def slip_increment(self) -> np.ndarray:
-        """Δg = Δu_t − Δd since the last committed state, at the nodes."""
-        return (self.tangential_displacement() - self._u_t_committed
-                - (self.motion - self.committed_motion))
+        """Δg = Δu_t − Δd since the last committed state, at the nodes (0 where held)."""
+        return self.free * (self.tangential_displacement() - self._u_t_committed
+                            - (self.motion - self.committed_motion))
 
     def tangential_force(self) -> np.ndarray:
         """Σ T_t over S_C (every rank's owned nodes), one value per axis."""
@@ -115,12 +124,13 @@ class FrictionalContact(ActiveSetContact):
     def _set_conditions(self, changes: int | None) -> None:
         S, stick = self.surface, self.stick
         held = self._u_t_committed + (self.motion - self.committed_motion)
-        sticking = [S.tangential_dirichlet(i, stick, held[:, k])
+        sticking = [S.tangential_dirichlet(i, stick & self.free[:, k], held[:, k])
                     for k, i in enumerate(self.axes)]
         self.system.set_active(self.active, changes, extra_bcs=sticking)
-        owned = S.owned & self.slip
-        dofs = np.concatenate([S.tangential(i)[0][owned] for i in self.axes])
-        values = np.concatenate([self.slip_force[owned, k] for k in range(len(self.axes))])
+        loaded = [S.owned & self.slip & self.free[:, k] for k in range(len(self.axes))]
+        dofs = np.concatenate([S.tangential(i)[0][on]
+                               for i, on in zip(self.axes, loaded, strict=True)])
+        values = np.concatenate([self.slip_force[on, k] for k, on in enumerate(loaded)])
         self.system.newton.set_nodal_load(dofs, values)
 
     # -- the loop ----------------------------------------------------------------------
