@@ -29,6 +29,7 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.contact.surface import nodal_quadrature
 from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import (
@@ -58,6 +59,7 @@ class MultiplierSystem:
             raise ValueError("the multiplier formulation takes P1 displacements, or P2 in 2D "
                              "and axisymmetric models (no nodal rule with positive weights "
                              "on a P2 triangle): use the elimination")
+        rule = nodal_quadrature(degree, fdim)
         facets = np.sort(surface.facets)
         sub, emap, _, _ = mesh.create_submesh(msh, fdim, facets)
         Q = fem.functionspace(sub, ("Lagrange", degree))
@@ -66,8 +68,6 @@ class MultiplierSystem:
         self.gamma = fem.Function(Q, name="gap")
         self.q_of_node = dofs_at(Q, surface.x)  # S_C node i (the surface's order) -> Q dof
         tags = mesh.meshtags(msh, fdim, facets, np.ones(len(facets), dtype=np.int32))
-        rule = ({"quadrature_rule": "vertex", "quadrature_degree": 1} if degree == 1
-                else {"quadrature_rule": "GLL", "quadrature_degree": 2})
         ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=rule)(1)
         v = residual.arguments()[0]
         mu = ufl.TestFunction(Q)

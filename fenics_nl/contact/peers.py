@@ -4,6 +4,8 @@
   active-set Newton method inside PETSc.
 * Penalty: R(u; v) + k ∫_{S_C} ⟨u_n − γ⟩₊ v_n ds = 0, solved by full Newton; the
   pressure is k times the penetration, so the constraint only holds as k → ∞.
+* Friction penalty: the same, with the tangential traction an elastic spring of stiffness
+  k up to the Coulomb bound f p_n (`solve_friction_penalty`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.contact.surface import nodal_quadrature
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import (
@@ -96,3 +99,60 @@ def solve_penalty(punch, delta: float, stiffness: float, prefix: str = "pen_") -
 
 def _max_penetration(punch) -> float:
     return global_max(punch.mesh.comm, punch.contact.normal_gap())
+
+
+def solve_friction_penalty(punch, delta: float, shift: float, stiffness: float,
+                           friction: float, prefix: str = "fpen_") -> dict:
+    """Cattaneo–Mindlin's two steps, regularised by one penalty stiffness k.
+
+    Press by δ, then move the punch by `shift` along x; k in force/length³. Normal:
+    p_n = k ⟨u_n − γ⟩₊. Tangential, from the state after pressing: the elastic-plastic
+    law t = −clip(k Δg, −f p_n, f p_n) of the slip Δg = Δu_x − shift: stick is an elastic
+    spring, slip the Coulomb bound. Both conditions hold only as k → ∞, at the nodes (a
+    nodal rule on S_C), so the limit is the active set's discrete problem. Plane strain
+    (one tangential axis, x); the parabolic gap.
+    """
+    if punch.model != "plane-strain" or punch.gap_shape != "parabola":
+        raise ValueError("the friction penalty peer is written for the plane-strain "
+                         "cylinder with the parabolic gap")
+    u, c = punch.u, punch.contact
+    u.x.array[:] = 0.0
+    c.set_gap(punch.gap(delta))
+    msh, s, axis = punch.mesh, c.surface.sign, c.surface.axis
+    x = ufl.SpatialCoordinate(msh)
+    gamma = x[0] ** 2 / (2 * punch.R) - delta
+    pressed = fem.Function(u.function_space)  # the state the slip is counted from
+    d = fem.Constant(msh, 0.0)
+    k = fem.Constant(msh, float(stiffness))
+    p_n = k * ufl.max_value(s * u[axis] - gamma, 0.0)
+    bound = friction * p_n
+    t = -ufl.max_value(ufl.min_value(k * (u[0] - pressed[0] - d), bound), -bound)
+    v = punch.residual.arguments()[0]
+    # the nodal rule: the penalty acts at the nodes, as the active set's conditions do, so
+    # its limit k → ∞ is the same discrete problem (and t at a node is its nodal traction)
+    f_tags = np.sort(punch.block.contact_facets)
+    tags = mesh.meshtags(msh, 1, f_tags, np.ones(len(f_tags), dtype=np.int32))
+    rule = nodal_quadrature(c.surface.Vn.element.basix_element.degree, 1)
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=rule)(1)
+    R = punch.residual + (p_n * s * v[axis] - t * v[0]) * ds
+    solver = NewtonSolver(R, u, punch.bcs, method="full", line_search=True, prefix=prefix,
+                          rtol=1e-10, atol=1e-12, max_it=200)
+    t0 = time.perf_counter()
+    iterations, factorizations = 0, 0
+    for step_shift in (0.0, shift):
+        pressed.x.array[:] = u.x.array
+        d.value = step_shift
+        res = solver.solve()
+        iterations += res.iterations
+        factorizations += res.work.factorizations
+    wall = time.perf_counter() - t0
+    comm, factor = msh.comm, punch.block.symmetry_factor
+    force = comm.allreduce(fem.assemble_scalar(fem.form(p_n * ds))) * factor
+    tangential = comm.allreduce(fem.assemble_scalar(fem.form(t * ds))) * factor
+    S = c.surface
+    traction = fem.Function(S.Vn)
+    traction.interpolate(fem.Expression(t, S.Vn.element.interpolation_points))
+    return {"force": force, "tangential_force": tangential, "wall_time_s": wall,
+            "iterations": iterations, "factorizations": factorizations,
+            "x": S.x[S.owned, 0], "traction": traction.x.array[S.dofs_n][S.owned],
+            "max_penetration": _max_penetration(punch)}

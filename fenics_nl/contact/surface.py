@@ -219,6 +219,21 @@ class ContactSurface:
         return mesh.meshtags(self.mesh, fdim, self.facets[order], values[order])
 
 
+def nodal_quadrature(degree: int, facet_dim: int) -> dict:
+    """Form metadata for a rule on S_C whose points are the nodes of degree `degree`.
+
+    Integrals become nodal sums with positive weights (the nodal areas): the vertex rule
+    for P1, Gauss–Lobatto's 3 points (h/6, 2h/3, h/6) for P2 on edges. A P2 triangle has
+    no such rule (its vertex weights vanish): a ValueError.
+    """
+    if degree == 1:
+        return {"quadrature_rule": "vertex", "quadrature_degree": 1}
+    if degree == 2 and facet_dim == 1:
+        return {"quadrature_rule": "GLL", "quadrature_degree": 2}
+    raise ValueError("no nodal rule with positive weights on P2 triangles (3D): use the "
+                     "elimination")
+
+
 def vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
     """Mesh vertex of each dof of a scalar Lagrange space, −1 for dofs not at a vertex.
 
