@@ -74,6 +74,14 @@ def test_bad_coefficients_and_formulations_are_refused():
     for f in (-0.1, float("nan"), float("inf")):
         with pytest.raises(ValueError, match="friction coefficient"):
             jenkins_element(1.0, 1.0, 0.1, f)
+    msh = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    bottom = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[1], 0.0))
+    with pytest.raises(ValueError, match="elimination formulation"):
+        FrictionalContact(ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx, u, [], bottom,
+                          lambda x: 0 * x[0], normal_axis=1, normal_sign=-1, friction=0.3,
+                          formulation="multiplier")
     assert jenkins_element(1.0, 1.0, 0.1, 0.3)[0].f == 0.3  # a valid one builds
 
 
@@ -89,10 +97,29 @@ def test_cattaneo_mindlin_partial_slip_of_a_cylinder(demo):
     assert d["tangential_traction_max_error"] < 0.03
 
 
-def test_force_control_reaches_the_tangential_force_and_coulombs_law_holds(demo):
-    d = demo.punch(*COMPRESSIBLE_CYLINDER, "--friction", "0.3", "--tangential-ratio", "0.5")
-    assert d["tangential_force"] == pytest.approx(0.5 * 0.3 * d["force"], rel=1e-8)
-    assert d["slip_nodes"] > 0 and d["stick_nodes"] > 0
+def test_force_control_reaches_the_tangential_force_and_coulombs_law_holds():
+    # Q = f P / 2 by secant steps, then Coulomb's law node by node: |T_t| <= f |T_n| where
+    # the node sticks, = f |T_n| and against its slip where it slips, compression where
+    # closed, no penetration where open
+    from fenics_nl.materials.laws import LinearElastic
+    from fenics_nl.scenes.punch import build_punch
+
+    f = 0.3
+    punch = build_punch("plane-strain", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0,
+                        block=100.0, tangential=True, friction=f)
+    pressed = punch.indent(0.01)
+    punch.commit()
+    moved, positions = punch.pull(0.5 * f * pressed.force)
+    assert moved.tangential_force == pytest.approx(0.5 * f * pressed.force, rel=3e-8)
+    c = punch.contact
+    T_n, T_t, g = c.normal_forces(), c.tangential_forces()[:, 0], c.slip_increment()[:, 0]
+    scale = np.abs(T_n).max()
+    assert moved.slip_nodes > 0 and moved.stick_nodes > 0 and positions < 10
+    assert np.all(np.abs(T_t[c.stick]) <= f * np.abs(T_n[c.stick]) + 1e-9 * scale)
+    assert np.allclose(np.abs(T_t[c.slip]), f * np.abs(T_n[c.slip]), atol=1e-9 * scale)
+    assert np.all(T_t[c.slip] * g[c.slip] <= 1e-12)  # the force opposes the slip
+    assert np.all(T_n[c.active] <= 1e-9 * scale)
+    assert np.all(c.normal_gap()[~c.active] <= 1e-9 * 0.01)
 
 
 def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
@@ -110,7 +137,10 @@ def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
 
 
 def test_friction_two_ranks_give_the_serial_answer(demo):
-    args = (*COMPRESSIBLE_CYLINDER, "--friction", "0.3", "--tangential-displacement", "0.002")
+    # a block 10 a wide: there the partition cuts the contact zone (both ranks own stick
+    # and slip nodes: `test_friction_on_a_cut_contact_zone` checks it)
+    args = ("--model", "plane-strain", "--refine", "0", "--block", "10", "--friction", "0.3",
+            "--tangential-displacement", "0.002")
     s, p = demo.punch(*args), demo.punch(*args, ranks=2)
     assert p["ranks"] == 2
     assert p["tangential_force"] == pytest.approx(s["tangential_force"], rel=1e-8)
@@ -153,8 +183,31 @@ def test_the_penalty_peer_converges_to_the_active_set():
     gaps = []
     for kappa in (10.0, 100.0):
         r = solve_friction_penalty(punch, 0.01, 0.002, kappa / punch.block.h, 0.3)
-        assert np.allclose(r["x"], c.x[c.owned, 0])
         gaps.append((abs(r["tangential_force"] / moved.tangential_force - 1),
                      np.abs(r["traction"] - q).max() / np.abs(q).max()))
     (Q10, q10), (Q100, q100) = gaps
     assert Q100 < 0.2 * Q10 and q100 < 0.2 * q10 and Q100 < 1e-4 and q100 < 0.01
+
+
+@pytest.mark.mpi
+def test_friction_on_a_cut_contact_zone():
+    # the partition cuts S_C inside the contact zone, so sticking and slipping nodes are
+    # owned by both ranks and ghosts carry statuses; the answer is the serial one
+    from fenics_nl.materials.laws import LinearElastic
+    from fenics_nl.scenes.punch import build_punch
+
+    assert MPI.COMM_WORLD.size > 1
+
+    def run(comm):
+        punch = build_punch("plane-strain", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0,
+                            block=10.0, tangential=True, friction=0.3, comm=comm)
+        punch.indent(0.01)
+        punch.commit()
+        return punch, punch.shift(0.002)
+
+    (cp, tp), (_, ts) = run(MPI.COMM_WORLD), run(MPI.COMM_SELF)
+    c = cp.contact
+    assert MPI.COMM_WORLD.allreduce(int(np.any(c.stick & c.owned)), op=MPI.MIN) == 1
+    assert MPI.COMM_WORLD.allreduce(int(np.any(c.slip & c.owned)), op=MPI.MIN) == 1
+    assert tp.tangential_force == pytest.approx(ts.tangential_force, rel=1e-8)
+    assert (tp.stick_nodes, tp.slip_nodes) == (ts.stick_nodes, ts.slip_nodes)

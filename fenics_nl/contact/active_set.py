@@ -87,10 +87,11 @@ class EliminationSystem:
         """Newton on the current set."""
         return self.newton.solve()
 
-    def reactions_at(self, dofs: np.ndarray) -> np.ndarray:
-        """f_int − f_ext at `dofs` (local, in the unknown's numbering).
+    def reactions(self) -> np.ndarray:
+        """f_int − f_ext at every local dof (owned and ghosts, the unknown's numbering).
 
-        The residual without the constrained rows: the force the constraints put on the body.
+        The residual without the constrained rows: at a constrained dof, the force the
+        constraint puts on the body.
         """
         b = self._reaction
         with b.localForm() as loc:
@@ -99,11 +100,11 @@ class EliminationSystem:
         b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
         b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
         with b.localForm() as loc:
-            return loc.array_r[dofs].copy()
+            return loc.array_r.copy()
 
     def normal_forces(self) -> np.ndarray:
         """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
-        return self.surface.sign * self.reactions_at(self.surface.dofs_V)
+        return self.surface.sign * self.reactions()[self.surface.dofs_V]
 
 
 class ActiveSetContact:

@@ -53,6 +53,9 @@ class FrictionalContact(ActiveSetContact):
         self.f = float(friction)
         S = self.surface
         self.axes = S.tangential_axes
+        if len(self.axes) > 1:
+            raise ValueError("friction is 2D for now (plane strain, axisymmetric): in 3D the "
+                             "slip directions of the status loop do not settle yet")
         n, m = len(S.dofs_n), len(self.axes)
         self.slip = np.zeros(n, dtype=bool)
         self.direction = np.zeros((n, m))  # s: the friction force's direction on the body
@@ -85,7 +88,10 @@ class FrictionalContact(ActiveSetContact):
         self.committed_tangential_force = self.tangential_force()
 
     def restore(self) -> None:
-        """Back to the last committed statuses (after a failed step)."""
+        """Back to the last committed statuses and obstacle position (after a failed step).
+
+        The displacement is the caller's to restore (the driver keeps it).
+        """
         self.active, self.slip, self.direction, self.slip_force = (
             a.copy() for a in self._committed)
         self.motion = self.committed_motion.copy()
@@ -101,13 +107,15 @@ class FrictionalContact(ActiveSetContact):
         x = self.u.x.array
         return np.column_stack([x[self.surface.tangential(i)[0]] for i in self.axes])
 
-    def tangential_forces(self) -> np.ndarray:
+    def tangential_forces(self, reactions: np.ndarray | None = None) -> np.ndarray:
         """T_t at the nodes (the obstacle's force on the body), one column per axis.
 
-        Zero in a component the body's supports hold.
+        Zero in a component the body's supports hold. `reactions`: the residual's local
+        array if already assembled (`EliminationSystem.reactions`).
         """
-        return self.free * np.column_stack(
-            [self.system.reactions_at(self.surface.tangential(i)[0]) for i in self.axes])
+        r = self.system.reactions() if reactions is None else reactions
+        return self.free * np.column_stack([r[self.surface.tangential(i)[0]]
+                                            for i in self.axes])
 
     def slip_increment(self) -> np.ndarray:
         """Δg = Δu_t − Δd since the last committed state, at the nodes (0 where held)."""
@@ -123,8 +131,8 @@ class FrictionalContact(ActiveSetContact):
 
     def _set_conditions(self, changes: int | None) -> None:
         S, stick = self.surface, self.stick
-        held = self._u_t_committed + (self.motion - self.committed_motion)
-        sticking = [S.tangential_dirichlet(i, stick & self.free[:, k], held[:, k])
+        target = self._u_t_committed + (self.motion - self.committed_motion)
+        sticking = [S.tangential_dirichlet(i, stick & self.free[:, k], target[:, k])
                     for k, i in enumerate(self.axes)]
         self.system.set_active(self.active, changes, extra_bcs=sticking)
         loaded = [S.owned & self.slip & self.free[:, k] for k in range(len(self.axes))]
@@ -148,10 +156,13 @@ class FrictionalContact(ActiveSetContact):
             res.iterations += nr.iterations
             res.work.add(nr.work)
             res.residual_norms = nr.residual_norms
-            T_n, T_t, g = self.normal_forces(), self.tangential_forces(), self.slip_increment()
+            r = self.system.reactions()  # one assembly for T_n and T_t
+            T_n, T_t, g = S.sign * r[S.dofs_V], self.tangential_forces(r), self.slip_increment()
             scale_T = global_max(self.comm, np.abs(T_n))
-            scale_u = max(global_max(self.comm, np.abs(S.gamma)), S.displacement_scale(self.u))
-            tol_T, tol_u = 1e-10 * scale_T, 1e-10 * scale_u
+            # lengths of the state itself (not the far gap, which grows with the block): the
+            # body's motion and the obstacle's move in this step
+            step = float(np.abs(self.motion - self.committed_motion).max(initial=0.0))
+            tol_T, tol_u = 1e-10 * scale_T, 1e-10 * max(S.displacement_scale(self.u), step)
             bound = self.f * np.maximum(-T_n, 0.0)
             size = np.linalg.norm(T_t, axis=1)
             leave = self.active & (T_n > tol_T)
@@ -184,8 +195,9 @@ class FrictionalContact(ActiveSetContact):
                 res.converged, res.reason = True, "statuses fixed"
                 res.wall_time = time.perf_counter() - t0
                 return res
-            if changes:
-                key = (S.fingerprint(active), S.fingerprint(slip))
+            if changes:  # a state: the closed set, the slipping set and its slip senses
+                key = (S.fingerprint(active), S.fingerprint(slip),
+                       S.fingerprint(slip & (direction[:, 0] > 0)))
                 if key in seen:
                     raise ContactError(f"statuses cycle (iteration {k}: {n_stick} stick, "
                                        f"{n_slip} slip)", res)

@@ -178,7 +178,8 @@ class ContactSurface:
         if i not in self._tangential:
             part = self.V.sub(i)
             space, parent = collapsed(part)
-            if not np.allclose(space.tabulate_dof_coordinates()[self.dofs_n], self.x):
+            same = np.array_equal(space.tabulate_dof_coordinates()[self.dofs_n], self.x)
+            if not self.comm.allreduce(same, op=MPI.LAND):
                 raise RuntimeError("displacement components with different dof layouts")
             self._tangential[i] = (parent[self.dofs_n], fem.Function(space))
         return self._tangential[i]

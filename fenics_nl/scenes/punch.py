@@ -101,9 +101,9 @@ class PunchBlock:
     mesh; `unknown` is the Function a solver updates (u itself otherwise), `u` and `p` the
     parts for forms, `displacement()` a Function of u to probe and draw.
 
-    `tangential=True` (a tangential load along x; plane strain or 3D): the block spans
-    both sides of the punch, x in [−L, L], and its bottom is clamped (u = 0) instead of
-    sliding; the 3D model is then the half y >= 0.
+    `tangential=True` (a tangential load along x): the block spans both sides of the punch,
+    x in [−L, L], and its bottom is clamped (u = 0) instead of sliding; the 3D model is
+    then the half y >= 0 (friction itself is 2D for now).
     """
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
@@ -281,11 +281,6 @@ class Punch:
         if self.friction is not None:
             self.contact.commit()
 
-    def restore(self) -> None:
-        """Back to the last committed state's statuses (after a failed step)."""
-        if self.friction is not None:
-            self.contact.restore()
-
     def shift(self, d: float) -> Traction:
         """Move the pressed punch to the tangential position d (along x).
 
@@ -306,9 +301,10 @@ class Punch:
              ) -> tuple[Traction, int]:
         """Tangential force control: the position d with Q(d) = `force`, by secant steps.
 
-        Q(d) rises and bends down as nodes slip (concave): secant steps from the full-stick
-        slope approach the root from below and never overshoot. Q >= f P has no static
-        equilibrium (gross sliding): a ValueError.
+        From the committed state, Q(d) moves away from its committed value and bends as
+        nodes slip (concave for a monotone load from stick): secant steps from the
+        full-stick slope approach the root from its side and do not overshoot. Q >= f P
+        has no static equilibrium (gross sliding): a ValueError.
         """
         c = self._frictional()
         P = self.block.symmetry_factor * c.force
@@ -318,7 +314,8 @@ class Punch:
                              "equilibrium under force control)")
         d_prev = float(c.committed_motion[0])
         q_prev = self.block.symmetry_factor * float(c.committed_tangential_force[0])
-        s1 = self.shift(d_prev + 1e-6 * self.block.a)  # the full-stick slope
+        toward = 1.0 if force >= q_prev else -1.0
+        s1 = self.shift(d_prev + toward * 1e-6 * self.block.a)  # the full-stick slope
         for k in range(max_it):
             if abs(s1.tangential_force - force) <= rtol * self.friction * P:
                 return s1, k + 1
@@ -380,8 +377,7 @@ class Punch:
         areas; status 0 open, 1 stick, 2 slip.
         """
         c = self._frictional()
-        on = c.owned & (np.abs(c.x[:, 1]) < 1e-9 * self.block.a if self.model == "3d"
-                        else c.owned)
+        on = c.owned
         areas = c.surface.nodal_areas(self.block.weight)
         status = np.where(c.slip, 2, np.where(c.active, 1, 0))
         rows = gather_rows(self.mesh.comm, c.x[on, 0], c.pressure(self.block.weight)[on],

@@ -28,23 +28,10 @@ def cylinder_stick_half_width(a: float, Q: float, fP: float) -> float:
 def traction(x, a: float, p0: float, f: float, c: float):
     """q = (f p0/a)(√(a² − x²) − √(c² − x²)), the second term for |x| < c only.
 
-    x: the distance from the axis (the cylinder's x, or the sphere's radius r: the same
-    form, with each one's c).
+    x: the distance from the axis (the cylinder's x; the sphere's r has the same form, with
+    its own c).
     """
     x = np.abs(np.asarray(x, dtype=float))
     full = np.sqrt(np.clip(a * a - x * x, 0.0, None))
     stick = np.sqrt(np.clip(c * c - x * x, 0.0, None))
     return f * p0 / a * (full - stick)
-
-
-def sphere_stick_radius(a: float, Q: float, fP: float) -> float:
-    """c = a (1 − Q/(fP))^(1/3)."""
-    return a * (1 - _load_ratio(Q, fP)) ** (1 / 3)
-
-
-def sphere_tangential_displacement(E: float, nu: float, a: float, Q: float, fP: float
-                                   ) -> float:
-    """δ_t = 3fP/(16 G* a) [1 − (1 − Q/(fP))^(2/3)], 1/G* = (2 − ν)/G (rigid sphere)."""
-    G = E / (2 * (1 + nu))
-    G_star = G / (2 - nu)
-    return 3 * fP / (16 * G_star * a) * (1 - (1 - _load_ratio(Q, fP)) ** (2 / 3))
