@@ -37,6 +37,33 @@ def outside_kernels(r: dict) -> float:
     return r["wall_time_s"] - sum(r["phase_time_s"].values())
 
 
+def options(doc: str, quick: str):
+    """The flags every benchmark takes: --quick (`quick` says what it runs) and
+    --update-readme; `doc` is the benchmark's docstring."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help=quick)
+    ap.add_argument("--update-readme", action="store_true")
+    return ap.parse_args()
+
+
+def publish(name: str, out: dict, table, args, say=print) -> None:
+    """The end of a benchmark: its run time into `out`, `table(out)` shown, and unless
+    --quick the results file benchmarks/results/`name`.json and, with --update-readme,
+    the README section `name`."""
+    import json
+
+    out["benchmark_time_s"] = elapsed()
+    text = table(out)
+    say(text)
+    if not args.quick:
+        (README.parent / "benchmarks" / "results" / f"{name}.json").write_text(
+            json.dumps(out, indent=2))
+        if args.update_readme:
+            update_readme(name, text)
+
+
 def update_readme(name: str, text: str) -> None:
     """Replace the README's generated section `name` with `text`."""
     src = README.read_text()

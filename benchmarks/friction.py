@@ -15,25 +15,21 @@ then moved by D = 0.0023 along x (Q ≈ f P / 2). Same mesh, same two steps:
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import time
-from pathlib import Path
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
 # isort: split
 
 import numpy as np
-from common import elapsed, machine, update_readme
+from common import machine, options, publish
 
 from fenics_nl.contact.peers import solve_friction_penalty
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz, mindlin
 
-HERE = Path(__file__).resolve().parent
 R, DELTA, F, SHIFT = 1.0, 0.01, 0.3, 0.0023
 
 
@@ -132,10 +128,7 @@ def table(out: dict) -> str:
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="two penalty values, nothing written")
-    ap.add_argument("--update-readme", action="store_true")
-    args = ap.parse_args()
+    args = options(__doc__, "two penalty values, nothing written")
     out = {"machine": machine()}
     out["active_set"], (punch, x, q) = active_set(0)
     print(out["active_set"], flush=True)
@@ -145,13 +138,7 @@ def main():
         out["penalty"].append(penalty(punch, kappa, out["active_set"], x, q))
         print(out["penalty"][-1], flush=True)
     out["force_control"] = force_control(0)
-    out["benchmark_time_s"] = elapsed()
-    text = table(out)
-    print(text)
-    if not args.quick:
-        (HERE / "results" / "friction.json").write_text(json.dumps(out, indent=2))
-        if args.update_readme:
-            update_readme("friction", text)
+    publish("friction", out, table, args)
 
 
 if __name__ == "__main__":

@@ -21,18 +21,15 @@ Time is the solve's (the forms compiled by a first run of each configuration).
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import time
-from pathlib import Path
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
 # isort: split
 
 import ufl
-from common import elapsed, machine, update_readme
+from common import machine, options, publish
 
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean
@@ -42,7 +39,6 @@ from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import hertz
 
-HERE = Path(__file__).resolve().parent
 POISSON = (0.3, 0.49, 0.499, 0.5)
 
 
@@ -187,10 +183,7 @@ def table(out: dict) -> str:
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="coarse meshes, nothing written")
-    ap.add_argument("--update-readme", action="store_true")
-    args = ap.parse_args()
+    args = options(__doc__, "coarse meshes, nothing written")
     refine, h = (0, 0.2) if args.quick else (1, 0.1)
     out = {"machine": machine()}
     for name, problem, size in (("punch", punch, refine), ("cylinder", cylinder, h),
@@ -204,13 +197,7 @@ def main():
     linear_solvers(0.3, "lu", 0.2), linear_solvers(0.3, "gamg", 0.2)  # forms compiled
     out["linear_solvers"] = [linear_solvers(nu, s, h) for h in sizes for nu in POISSON
                              for s in ("lu", "gamg")]
-    out["benchmark_time_s"] = elapsed()
-    text = table(out)
-    print(text)
-    if not args.quick:
-        (HERE / "results" / "mixed.json").write_text(json.dumps(out, indent=2))
-        if args.update_readme:
-            update_readme("mixed", text)
+    publish("mixed", out, table, args)
 
 
 if __name__ == "__main__":

@@ -24,7 +24,6 @@ the same residual and consistent tangent.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import io
 import json
@@ -40,7 +39,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import bracket as bracket_benchmark
 import ufl
-from common import elapsed, machine, update_readme
+from common import machine, options, publish
 from petsc4py import PETSc
 
 from fenics_nl.io import cli
@@ -257,10 +256,7 @@ def table(s: dict) -> str:
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="coarse meshes, nothing written")
-    ap.add_argument("--update-readme", action="store_true")
-    args = ap.parse_args()
+    args = options(__doc__, "coarse meshes, nothing written")
     sphere_sizes = [12.5] if args.quick else [12.5, 6.25, 3.125, 1.5625]
     bracket_sizes = [14.0] if args.quick else [9.0, 6.0]
     with tempfile.TemporaryDirectory() as d:
@@ -271,13 +267,7 @@ def main():
     if not args.quick:
         out["near_limit"] = near_limit(sphere_sizes[1], 0.99)
         out["parallel"] = parallel(sphere_sizes[-1], bracket_sizes[-1])
-    out["benchmark_time_s"] = elapsed()
-    text = table(out)
-    say(text)
-    if not args.quick:
-        (HERE / "results" / "plasticity.json").write_text(json.dumps(out, indent=2))
-        if args.update_readme:
-            update_readme("plasticity", text)
+    publish("plasticity", out, table, args, say=say)
 
 
 if __name__ == "__main__":
