@@ -22,11 +22,13 @@
 # tangent of the step's start, factorized once per step), periodic (every 3 iterations),
 # quasi-Newton (BFGS on the step's first factorization) or PETSc SNES. Supports:
 # `clamped` (bolt holes fixed) or `contact` (bolts fixed and the base on a rigid floor,
-# frictionless, free to lift off: the course's combination of non-linearities).
+# frictionless unless `--friction F`, free to lift off: the course's combination of
+# non-linearities).
 #
 # ## Implementation
 
 # +
+import math
 import resource
 import sys
 import time
@@ -110,6 +112,9 @@ def parser():
     p.add_argument("--hardening", type=cli.finite, default=None,
                    help="j2: linear isotropic hardening modulus H (default 13 GPa: the power "
                         "law's secant at its peak strain, 14 ε0; in N/unit²)")
+    p.add_argument("--friction", type=cli.finite, default=None, metavar="F",
+                   help="Coulomb friction coefficient f >= 0 between the base and the floor "
+                        "(--support contact; default: frictionless)")
     p.add_argument("--unload", action="store_true",
                    help="unload in as many steps after loading: the permanent displacement")
     cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
@@ -135,6 +140,10 @@ mm = MM[args.units]
 args.E = args.E if args.E is not None else 200e3 / mm**2
 cli.material_flags(p, args, power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
                    j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
+if args.friction is not None and not args.friction >= 0:
+    p.error(f"--friction must be >= 0, got {args.friction}")
+if args.friction is not None and args.support != "contact":
+    p.error("--friction acts between the base and the floor: add --support contact")
 if args.unload and args.compare:
     p.error("--unload goes with one --newton, not --compare")
 if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
@@ -204,7 +213,7 @@ def solve(newton):
     if plastic:
         material.reset()
     b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
-                tolerance=args.tolerance,
+                tolerance=args.tolerance, friction=args.friction,
                 linear_solver="lu" if args.solver == "direct" else "gamg")
     say(f"{b.dofs} unknowns (P{args.degree}), {newton} Newton, {args.steps} load steps")
     steps = []
@@ -227,7 +236,11 @@ def solve(newton):
             f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
 
     total = 2 * args.steps if args.unload else args.steps
-    commit = (lambda: material.commit(u)) if plastic else None  # a converged step's state
+    def commit():  # a converged step's state: plastic strains, the floor's slip history
+        if plastic:
+            material.commit(u)
+        b.commit()
+
     t0 = time.perf_counter()
     try:
         solve_incrementally(b.solver, lambda t: b.set_load(t * args.force), args.steps,
@@ -311,6 +324,12 @@ def summary(b, steps, wall, args):
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
         c = b.solver
         out["max_floor_pressure"] = global_max(comm, c.pressure()[c.active])
+    if args.friction is not None:  # Coulomb on the whole floor: |T_t| <= f T_n
+        fx, fy, fz = out["reactions"]["base"]
+        out.update(friction=args.friction, stick_nodes=c.surface.count(c.stick),
+                   slip_nodes=c.surface.count(c.slip),
+                   floor_friction_ratio=math.hypot(fx, fy) / (args.friction * fz)
+                   if args.friction > 0 and fz > 0 else 0.0)
     return out, vm
 
 

@@ -116,7 +116,7 @@ def parser():
                    help="block size in contact radii, >= 10 (default 1000, 3D 100)")
     p.add_argument("--friction", type=cli.finite, default=None, metavar="F",
                    help="Coulomb friction coefficient f >= 0 (statuses open / stick / slip; "
-                        "plane strain and axisymmetric; default: frictionless)")
+                        "default: frictionless)")
     tangential = p.add_mutually_exclusive_group()
     tangential.add_argument("--tangential-ratio", type=cli.finite, default=None, metavar="R",
                             help="after the normal load, a tangential force Q = R f P along x, "
@@ -166,9 +166,6 @@ if args.tangential_displacement is not None and not args.tangential_displacement
             f"{args.tangential_displacement}")
 if moved and args.model == "axisymmetric":
     p.error("a tangential load breaks the axial symmetry: use --model plane-strain or 3d")
-if args.friction is not None and args.model == "3d":
-    p.error("--friction is 2D for now (plane strain, axisymmetric): in 3D the slip "
-            "directions of the status loop do not settle yet")
 if args.friction is not None and args.formulation == "multiplier":
     p.error("--friction is written for --formulation elimination")
 if args.tangential_ratio is not None and not 0 <= args.tangential_ratio < 1:
@@ -317,14 +314,79 @@ if len(loading) >= 2 and all(s.force > 0 for s in loading):
 # tangential force is Q (`Punch.pull`, secant steps on the punch's position). Partial slip
 # against Cattaneo–Mindlin (exact at ν = 1/2, where the normal and tangential problems
 # decouple): the stick half-width c = a √(1 − Q/(fP)) and the traction profile of the
-# cylinder (plane strain; friction is 2D for now).
+# cylinder (plane strain), and in 3D the sphere's stick radius c = a (1 − Q/(fP))^(1/3),
+# its traction along y = 0 and its tangential displacement δ_t(Q).
 
 # +
+def mindlin_check(T, fP):
+    """The stick radius, the traction and (3D) δ_t against Cattaneo–Mindlin's, for the
+    computed P (a, p0 of Hertz for it)."""
+    H = (hertz.sphere_from_force if args.model == "3d" else hertz.cylinder_from_force)(
+        E, nu, R, T.normal_force)
+    a_H, p0_H, f = H["contact_radius"], H["max_pressure"], args.friction
+    if args.model == "3d":
+        c_exact = mindlin.sphere_stick_radius(a_H, T.tangential_force, fP)
+        # P2 nodal forces are no pointwise traction in 3D (a vertex's is about 0): the
+        # force inside each radius r = k h, Q(r), is what they give
+        radii = np.arange(1, int(1.5 * a_H / block.h) + 1) * block.h
+        gap = punch.tangential_force_within(radii) - mindlin.sphere_tangential_force_within(
+            radii, a_H, p0_H, f, c_exact)
+        out = {"tangential_force_profile_max_error": float(np.abs(gap).max()
+                                                           / T.tangential_force),
+               **tangential_compliance(T, a_H, fP, bonded)}
+        traction_said = (f"tangential force inside r within "
+                         f"{100 * out['tangential_force_profile_max_error']:.2f} % of Q")
+    else:
+        c_exact = mindlin.cylinder_stick_half_width(a_H, T.tangential_force, fP)
+        x_n, _, q_n, _ = punch.traction_profile() or (None,) * 4
+        out = {}
+        if comm.rank == 0:
+            q_ex = mindlin.traction(x_n, a_H, p0_H, f, c_exact)
+            # away from the stick-slip edges ±c, where the exact q has an infinite slope
+            away = (np.abs(np.abs(x_n) - c_exact) > 2 * block.h) & (np.abs(x_n) < 1.5 * a_H)
+            out["tangential_traction_max_error"] = float(np.abs(q_n - q_ex)[away].max()
+                                                         / (f * p0_H))
+        out = comm.bcast(out, root=0)
+        traction_said = (f"tangential traction within "
+                         f"{100 * out['tangential_traction_max_error']:.2f} % of f p0 "
+                         f"(beyond 2 h of the stick-slip edges)")
+    out["stick_radius_exact"] = c_exact
+    say(f"Cattaneo-Mindlin: stick {'radius' if args.model == '3d' else 'half-width'} "
+        f"{c_exact:.5g} (FE: (c - c_exact)/h = {(T.stick_radius - c_exact) / block.h:+.2f}); "
+        + traction_said)
+    return out
+
+
+def tangential_compliance(T, a_H, fP, bonded):
+    """δ_t against Mindlin's, with the far field's share taken out.
+
+    The finite block (clamped bottom, free sides) adds a far-field compliance C_far to the
+    half-space's; it does not depend on how the contact zone sticks or slips, so the
+    punch's displacement less C_far Q compares with Mindlin's δ_t. C_far is the computed
+    bonded compliance (a move before any slip) less the half-space's (2 − ν)/(8 G a).
+    """
+    G = E / (2 * (1 + nu))
+    exact_bonded = (2 - nu) / (8 * G * a_H)
+    delta = mindlin.sphere_tangential_displacement(a_H, T.tangential_force, fP, G, nu)
+    local = T.tangential_displacement - (bonded - exact_bonded) * T.tangential_force
+    say(f"Mindlin: δ_t = {delta:.5g}; FE {T.tangential_displacement:.5g}, less the far "
+        f"field's {(bonded - exact_bonded) * T.tangential_force:.3g} (bonded compliance "
+        f"{bonded:.4g} against the half-space's {exact_bonded:.4g}): "
+        f"{100 * (local / delta - 1):+.2f} %")
+    return {"tangential_displacement_exact": delta, "bonded_compliance": bonded,
+            "bonded_compliance_exact": exact_bonded,
+            "tangential_displacement_local": local,
+            "tangential_displacement_rel_error": local / delta - 1}
+
+
 traction, mindlin_checks = None, {}
 if moved:
     if last.force <= 0:
         raise ValueError("the punch does not touch the block: no normal force holds it "
                          "against a tangential load")
+    # 3D: the bonded compliance of this mesh and block, to take the far field's share out
+    # of the punch's displacement (Mindlin's δ_t is the half-space's)
+    bonded = punch.bonded_compliance() if args.model == "3d" else None
     if args.tangential_displacement is not None:
         traction = punch.shift(args.tangential_displacement)
     else:
@@ -338,23 +400,9 @@ if moved:
         f"{T.tangential_force / fP:.4f} f P; {T.stick_nodes} nodes stick, {T.slip_nodes} "
         f"slip, stick radius {T.stick_radius:.5g}; {T.status_iterations} status iterations")
     if ref is not None and 0 <= T.tangential_force < fP:
-        H = punch.hertz(last) if T.normal_force == last.force else hertz.cylinder_from_force(
-            E, nu, R, T.normal_force)
-        a_H, p0_H = H["contact_radius"], H["max_pressure"]
-        c_exact = mindlin.cylinder_stick_half_width(a_H, T.tangential_force, fP)
-        x_n, _, q_n, status = punch.traction_profile() or (None,) * 4
-        if comm.rank == 0:
-            q_ex = mindlin.traction(x_n, a_H, p0_H, args.friction, c_exact)
-            # away from the stick-slip edges ±c, where the exact q has an infinite slope
-            away = (np.abs(np.abs(x_n) - c_exact) > 2 * block.h) & (np.abs(x_n) < 1.5 * a_H)
-            mindlin_checks["tangential_traction_max_error"] = float(
-                np.abs(q_n - q_ex)[away].max() / (args.friction * p0_H))
-        mindlin_checks = comm.bcast(mindlin_checks, root=0)
-        mindlin_checks["stick_radius_exact"] = c_exact
-        error = mindlin_checks["tangential_traction_max_error"]
-        say(f"Cattaneo-Mindlin: stick half-width {c_exact:.5g} (FE: (c - c_exact)/h = "
-            f"{(T.stick_radius - c_exact) / block.h:+.2f}); tangential traction within "
-            f"{100 * error:.2f} % of f p0 (beyond 2 h of the stick-slip edges)")
+        mindlin_checks = mindlin_check(T, fP)
+
+
 # -
 
 # ## Outputs
@@ -378,7 +426,7 @@ def summary():
                       "active_set_iterations": s.active_set_iterations} for s in states],
            "reactions": punch.reactions(),
            "reactions_of": {"axisymmetric": "the whole body (2πr in the residual)",
-                            "3d": "the modelled quarter",
+                            "3d": "the modelled half" if moved else "the modelled quarter",
                             "plane-strain": "the whole block, per unit length" if moved
                             else "the modelled half, per unit length"}[args.model],
            "dofs": punch.dofs, "ranks": comm.size, "warnings": warnings}
@@ -475,6 +523,36 @@ def _checked(state, ref, args):
 
 
 def traction_panel(ax, profile, ref):
+    """The tangential load against Cattaneo–Mindlin: the traction (2D) or the force inside
+    each radius (3D)."""
+    if args.model == "3d":
+        return sphere_traction_panel(ax, *profile)
+    cylinder_traction_panel(ax, profile, ref)
+
+
+def sphere_traction_panel(ax, rings, within):
+    """Q(r)/Q: the tangential force inside radius r, FE against Mindlin's."""
+    T, f = traction, args.friction
+    H = hertz.sphere_from_force(E, nu, R, T.normal_force)
+    a, p0 = H["contact_radius"], H["max_pressure"]
+    Q = T.tangential_force
+    ax.plot(rings / a, within / Q, "-", color="C0", lw=2, label="FE (sum of nodal forces)")
+    c = mindlin_checks.get("stick_radius_exact")
+    if c is not None:
+        ax.plot(rings / a, mindlin.sphere_tangential_force_within(rings, a, p0, f, c) / Q,
+                "k--", lw=1, label="Mindlin")
+        ax.axvline(c / a, color="k", ls=":", lw=0.8, label="stick radius c (Mindlin)")
+    ax.axvline(T.stick_radius / a, color="C0", ls=":", lw=0.8, label="outermost stick node")
+    ax.set_xlim(0, 1.5)
+    ax.set_xlabel("r / a (Hertz for the computed P)")
+    ax.set_ylabel("Q(r) / Q: tangential force inside r")
+    ax.set_title(f"f = {f:g}, Q = {Q / (f * T.normal_force):.3g} f P, {T.stick_nodes} nodes "
+                 f"stick, {T.slip_nodes} slip", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
+
+
+def cylinder_traction_panel(ax, profile, ref):
     """p/p0 and q/(f p0) along x through the axis: FE nodes (stick, slip) against
     Hertz and Cattaneo-Mindlin (a, p0 of Hertz for the computed P)."""
     x, p, q, status = profile
@@ -493,7 +571,7 @@ def traction_panel(ax, profile, ref):
         ax.plot(x[on] / a, q[on] / (f * p0), "o", ms=3, color=colour, label=f"FE q, {name}")
     ax.set_xlim(-1.5, 1.5)
     ax.set_ylim(-0.05, 1.25)
-    ax.set_xlabel("x / a (Hertz)" + (" on y = 0" if args.model == "3d" else ""))
+    ax.set_xlabel("x / a (Hertz)")
     ax.set_ylabel("traction / p0, f p0")
     ax.set_title(f"f = {f:g}, Q = {traction.tangential_force / (f * traction.normal_force):.3g}"
                  f" f P: stick zone |x| < c (dotted: c of Cattaneo-Mindlin)", fontsize=9)
@@ -574,8 +652,13 @@ def picture(punch, vm, state, ref, args):
 writers = []
 vm = punch.von_mises() if args.output or args.png else None  # once for both
 # gathered on every rank's call (rank 0 keeps it) before the writers run on rank 0
-traction_profile = (punch.traction_profile() if traction is not None and (args.png or args.plot)
-                    else None)
+traction_profile = None
+if traction is not None and (args.png or args.plot):  # collective: on every rank
+    if args.model == "3d":  # Q(r), the force inside r (see mindlin_check)
+        rings = np.linspace(0.0, 1.5, 301) * last.contact_radius
+        traction_profile = (rings, punch.tangential_force_within(rings))
+    else:
+        traction_profile = punch.traction_profile()
 if args.output:
     writers.append(lambda: write_fields(vm))
 if args.plot:

@@ -13,18 +13,27 @@ obstacle's. Each iteration solves (elimination) with
 
 then updates the statuses by the course's rules, extended to friction:
 
-* a closed node in tension (T_n > 0) opens; an open node that penetrates closes, sticking;
+* a closed node in tension (T_n > 0) opens; an open node that penetrates closes;
 * a sticking node whose tangential reaction exceeds f |T_n| slips, s along that reaction;
 * a slipping node whose slip increment goes along its friction force (Δg·s > 0, the
-  friction would drive it) sticks; in 3D, a node that keeps slipping takes s = −Δg/|Δg|;
+  friction would drive it) sticks;
+* a node that touches down within the step joins slipping (it cannot stick where it was at
+  the step's start), without friction until its first slip gives s = −Δg/|Δg|;
 
-and stops when no status changes and the friction forces agree with the normal forces of
-the same solve. The slip history lives in the committed tangential displacement; the driver
+In 3D the direction s of a slipping node is a unit vector, which the loop finds by Newton's
+method rather than by substitution (s ← −Δg/|Δg| chatters): the node carries f |T_n| s
+and a spring k (I − s sᵀ) against slip across s, k = f |T_n|/|Δg| from the last
+iterate (`NewtonSolver.set_nodal_springs`), the linearization of −f |T_n| Δg/|Δg|; s then
+turns to the node's total tangential force, and at the fixed point the slip is along −s.
+
+The loop stops when no status changes and the friction forces agree with the normal forces
+of the same solve. The slip history lives in the committed tangential displacement; the driver
 commits it after a converged step (`commit`) or goes back to it (`restore`).
 """
 
 from __future__ import annotations
 
+import collections
 import math
 import time
 
@@ -42,6 +51,10 @@ class FrictionalContact(ActiveSetContact):
     nodes that slip); `stick` = active and not slip. Everything else is ActiveSetContact's.
     """
 
+    # a status set may come back while the friction forces still move (they follow the
+    # normal forces of the last solve); a third return is a cycle
+    REVISITS = 2
+
     def __init__(self, *args, friction: float, **kwargs):
         if not (math.isfinite(friction) and friction >= 0):
             raise ValueError(f"the friction coefficient must be a finite number >= 0, got "
@@ -53,13 +66,12 @@ class FrictionalContact(ActiveSetContact):
         self.f = float(friction)
         S = self.surface
         self.axes = S.tangential_axes
-        if len(self.axes) > 1:
-            raise ValueError("friction is 2D for now (plane strain, axisymmetric): in 3D the "
-                             "slip directions of the status loop do not settle yet")
         n, m = len(S.dofs_n), len(self.axes)
         self.slip = np.zeros(n, dtype=bool)
         self.direction = np.zeros((n, m))  # s: the friction force's direction on the body
         self.slip_force = np.zeros((n, m))
+        # 3D: the stiffness k of a slipping node against slip across its force's direction
+        self.spring = np.zeros(n)
         self.motion = np.zeros(m)  # the obstacle's tangential displacement d
         # a component the body's own supports hold (a symmetry plane, the axis) is no
         # friction's: its reaction is the support's
@@ -78,7 +90,7 @@ class FrictionalContact(ActiveSetContact):
 
     def _state(self):
         return (self.active.copy(), self.slip.copy(), self.direction.copy(),
-                self.slip_force.copy())
+                self.slip_force.copy(), self.spring.copy())
 
     def commit(self) -> None:
         """The current state becomes the start of the next step's increments."""
@@ -92,7 +104,7 @@ class FrictionalContact(ActiveSetContact):
 
         The displacement is the caller's to restore (the driver keeps it).
         """
-        self.active, self.slip, self.direction, self.slip_force = (
+        self.active, self.slip, self.direction, self.slip_force, self.spring = (
             a.copy() for a in self._committed)
         self.motion = self.committed_motion.copy()
 
@@ -140,13 +152,30 @@ class FrictionalContact(ActiveSetContact):
                                for i, on in zip(self.axes, loaded, strict=True)])
         values = np.concatenate([self.slip_force[on, k] for k, on in enumerate(loaded)])
         self.system.newton.set_nodal_load(dofs, values)
+        if len(self.axes) > 1:
+            self._set_springs(target)
+
+    def _set_springs(self, target: np.ndarray) -> None:
+        """3D: k (I − s sᵀ) at each slipping node, against slip across its force.
+
+        The force f|T_n| s with s = −Δg/|Δg| linearized in Δg (Newton on the direction)
+        is f|T_n| s − k (I − s sᵀ) Δg with k = f|T_n|/|Δg|, from the last iterate.
+        """
+        S = self.surface
+        on = S.owned & self.slip & (self.spring > 0)
+        s = self.direction[on]
+        k = self.spring[on, None, None] * (np.eye(len(self.axes)) - s[:, :, None] * s[:, None, :])
+        free = self.free[on]
+        k *= free[:, :, None] * free[:, None, :]  # no spring on a component a support holds
+        dofs = np.column_stack([S.tangential(i)[0][on] for i in self.axes])
+        self.system.newton.set_nodal_springs(dofs, k, target[on])
 
     # -- the loop ----------------------------------------------------------------------
 
     def solve(self) -> SolveResult:
         """Statuses to a fixed point, friction forces consistent; ContactError if not."""
         t0 = time.perf_counter()
-        seen = set()
+        seen = collections.Counter()
         res = SolveResult(False, "frictional active set", 0, [], WorkCounts())
         S = self.surface
         changes = None
@@ -168,14 +197,27 @@ class FrictionalContact(ActiveSetContact):
             leave = self.active & (T_n > tol_T)
             join = ~self.active & (self.normal_gap() > tol_u)
             to_slip = self.stick & ~leave & (size > bound + tol_T)
-            back = self.slip & ~leave & (np.sum(g * self.direction, axis=1) > tol_u)
+            # (a node that slips with no friction force, f = 0 or T_n = 0, has no reason to)
+            back = (self.slip & ~leave & np.any(self.slip_force, axis=1)
+                    & (np.sum(g * self.direction, axis=1) > tol_u))
             active = S.sync((self.active & ~leave) | join)
-            slip = S.sync(((self.slip & ~back) | to_slip) & active)
+            # a node touching down within the step cannot stick where it was at the step's
+            # start: it joins slipping, with no friction until its first slip gives a sense
+            slip = S.sync(((self.slip & ~back) | to_slip | join) & active)
             direction = self.direction.copy()
+            sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
             direction[to_slip] = T_t[to_slip] / size[to_slip, None]
-            moving = slip & ~to_slip & (np.linalg.norm(g, axis=1) > tol_u)
-            if len(self.axes) > 1:  # in 3D a slipping node's force turns against its slip
-                direction[moving] = -g[moving] / np.linalg.norm(g[moving], axis=1)[:, None]
+            direction[join] = 0.0
+            slid = np.linalg.norm(g, axis=1)
+            first = slip & self.slip & ~sensed & (slid > tol_u)
+            direction[first] = -g[first] / slid[first, None]
+            spring = np.zeros_like(self.spring)
+            if len(self.axes) > 1:  # 3D: the force turns with the spring's share
+                kept = slip & self.slip & sensed & (size > tol_T)
+                direction[kept] = T_t[kept] / size[kept, None]
+                along = -np.sum(g * direction, axis=1)
+                moving = kept & (along > tol_u)
+                spring[moving] = bound[moving] / along[moving]
             slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
             drift = global_max(self.comm, np.abs(slip_force - self.slip_force))
             changes = S.count(active != self.active) + S.count(slip != self.slip)
@@ -189,7 +231,7 @@ class FrictionalContact(ActiveSetContact):
             log.info("status iteration %d: %d stick, %d slip, %d changes, friction force "
                      "change %.3e", k, n_stick, n_slip, changes, drift)
             self.active, self.slip, self.direction = active, slip, direction
-            self.slip_force = slip_force
+            self.slip_force, self.spring = slip_force, spring
             if changes == 0 and drift <= 1e-9 * self.f * scale_T:
                 self.force = self.total_force(T_n)
                 res.converged, res.reason = True, "statuses fixed"
@@ -198,8 +240,8 @@ class FrictionalContact(ActiveSetContact):
             if changes:  # a state: the closed set, the slipping set and its slip senses
                 key = (S.fingerprint(active), S.fingerprint(slip),
                        S.fingerprint(slip & (direction[:, 0] > 0)))
-                if key in seen:
+                seen[key] += 1
+                if seen[key] > self.REVISITS:
                     raise ContactError(f"statuses cycle (iteration {k}: {n_stick} stick, "
                                        f"{n_slip} slip)", res)
-                seen.add(key)
         raise ContactError(f"statuses did not settle in {self.max_iterations} iterations", res)

@@ -3,11 +3,13 @@
 The mesh comes from `bracket_geometry` (built on rank 0, distributed) or from a user's
 .msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
 a uniform traction of total force F along +x; the bolt holes are clamped, and with
-``support="contact"`` the base also rests on a rigid floor (frictionless, may lift off).
+``support="contact"`` the base also rests on a rigid floor (may lift off; frictionless, or
+with Coulomb friction).
 """
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import gmsh
@@ -18,6 +20,7 @@ from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.io import output
@@ -174,13 +177,17 @@ class Bracket:
         period: tangent rebuilt every `period` iterations (``periodic``).
         force_scale: the force of the absolute tolerance (default: the first residual).
         tolerance: ‖R‖ ≤ tolerance × force_scale ends Newton.
+        friction: Coulomb's coefficient between the base and the floor (support
+            ``contact``); None: frictionless.
     """
 
     def __init__(self, part: BracketPart, material, residual, *, newton: str = "full",
                  linear_solver: str = "lu", period: int = 3, force_scale: float | None = None,
-                 tolerance: float = 1e-9):
+                 tolerance: float = 1e-9, friction: float | None = None):
         if not 0 < tolerance < 1:
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+        if friction is not None and part.support != "contact":
+            raise ValueError("friction acts on the floor: it needs --support contact")
         if newton == "snes" and part.support == "contact":
             raise ValueError("--newton snes works with --support clamped only")
         self.part, self.material, self.residual = part, material, residual
@@ -206,7 +213,10 @@ class Bracket:
                 if part.mixed else material.modified_newton_tangent(self.u, "3d", part.dx))
         if part.support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
-            self.solver = ActiveSetContact(
+            # with friction each base node is open, sticking or slipping on the floor
+            contact = (ActiveSetContact if friction is None else
+                       partial(FrictionalContact, friction=friction))
+            self.solver = contact(
                 residual, self.u, self.bcs, part.base_facets, lambda x: np.zeros(x.shape[1]),
                 normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
                 newton_options={k: v for k, v in opts.items() if k != "linear_solver"},
@@ -222,6 +232,11 @@ class Bracket:
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
         return self.part.dofs
+
+    def commit(self) -> None:
+        """A converged load step: the start of the next one's slip increments (friction)."""
+        if isinstance(self.solver, FrictionalContact):
+            self.solver.commit()
 
     def contact_fields(self) -> list[fem.Function]:
         """Nodal floor pressure and active set (1/0) on the base (contact support only)."""

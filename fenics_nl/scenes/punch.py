@@ -103,7 +103,7 @@ class PunchBlock:
 
     `tangential=True` (a tangential load along x): the block spans both sides of the punch,
     x in [−L, L], and its bottom is clamped (u = 0) instead of sliding; the 3D model is
-    then the half y >= 0 (friction itself is 2D for now).
+    then the half y >= 0.
     """
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
@@ -314,8 +314,7 @@ class Punch:
                              "equilibrium under force control)")
         d_prev = float(c.committed_motion[0])
         q_prev = self.block.symmetry_factor * float(c.committed_tangential_force[0])
-        toward = 1.0 if force >= q_prev else -1.0
-        s1 = self.shift(d_prev + toward * 1e-6 * self.block.a)  # the full-stick slope
+        s1 = self._probe(1.0 if force >= q_prev else -1.0)  # the full-stick slope
         for k in range(max_it):
             if abs(s1.tangential_force - force) <= rtol * self.friction * P:
                 return s1, k + 1
@@ -327,6 +326,18 @@ class Punch:
             d_prev, q_prev = s1.tangential_displacement, s1.tangential_force
             s1 = self.shift(d_next)
         raise SolveError(f"tangential force {force:g} not reached in {max_it} positions")
+
+    def _probe(self, sense: float = 1.0) -> Traction:
+        """A move of 1e-6 a from the committed position: no node slips yet (full stick)."""
+        return self.shift(float(self.contact.committed_motion[0]) + sense * 1e-6 * self.block.a)
+
+    def bonded_compliance(self) -> float:
+        """dd/dQ at the committed state, before any slip (the statuses are left warm)."""
+        c = self._frictional()
+        s = self._probe()
+        q0 = self.block.symmetry_factor * float(c.committed_tangential_force[0])
+        return (s.tangential_displacement - float(c.committed_motion[0])) / (
+            s.tangential_force - q0)
 
     def _contact_radius(self) -> float:
         """Distance of the outermost active node from the axis (within h of the true edge)."""
@@ -370,14 +381,16 @@ class Punch:
         return r[order], p[order], active[order]
 
     def traction_profile(self):
-        """(x, p, q, status) of every S_C node along y = 0, on rank 0 sorted by x (else None).
+        """(x, p, q, status) of the S_C nodes on y = 0 (3D) or all (2D), on rank 0 sorted by x.
 
-        x is signed (the block spans both sides of the punch), p the contact pressure and q
-        the tangential traction along x (the punch's on the block), nodal forces over nodal
-        areas; status 0 open, 1 stick, 2 slip.
+        Else None. x is signed (the block spans both sides of the punch), p the contact
+        pressure and q the tangential traction along x (the punch's on the block), nodal
+        forces over nodal areas; status 0 open, 1 stick, 2 slip.
         """
         c = self._frictional()
         on = c.owned
+        if self.model == "3d":  # the line y = 0 of the symmetry plane
+            on = on & (np.abs(c.x[:, 1]) <= 1e-9 * self.block.h)
         areas = c.surface.nodal_areas(self.block.weight)
         status = np.where(c.slip, 2, np.where(c.active, 1, 0))
         rows = gather_rows(self.mesh.comm, c.x[on, 0], c.pressure(self.block.weight)[on],
@@ -386,6 +399,17 @@ class Punch:
             return None
         order = np.argsort(rows[0])
         return tuple(r[order] for r in rows)
+
+    def tangential_force_within(self, radii) -> np.ndarray:
+        """Q(r): the tangential force (along x, the whole body's) within each distance r.
+
+        A sum of the nodal forces of the S_C nodes at most r from the axis.
+        """
+        c = self._frictional()
+        r = self.block.radius_of(c.x.T)
+        T_x = np.where(c.owned, c.tangential_forces()[:, 0], 0.0)
+        inside = np.array([T_x[r <= rho].sum() for rho in radii])
+        return self.block.symmetry_factor * self.mesh.comm.allreduce(inside, op=MPI.SUM)
 
     def nodes_in_contact(self) -> int:
         """Global number of active S_C nodes."""

@@ -36,6 +36,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc
+from mpi4py import MPI
 from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
@@ -316,6 +317,7 @@ class NewtonSolver:
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
         self._nodal_load = None  # (dofs, values): point forces (`set_nodal_load`)
+        self._springs = None  # (dofs, stiffness, anchor): nodal springs (`set_nodal_springs`)
         self._M = None  # the block preconditioner of a mixed unknown's iterative solve
         if linear_solver == "gamg" and V.ufl_element().is_mixed:
             if preconditioner is None:
@@ -365,6 +367,25 @@ class NewtonSolver:
         contact node. Replaces the previous ones; the tangent does not depend on them.
         """
         self._nodal_load = (np.asarray(dofs, dtype=np.int32), np.asarray(values, dtype=float))
+
+    def set_nodal_springs(self, dofs: np.ndarray, stiffness: np.ndarray,
+                          anchor: np.ndarray) -> None:
+        """Nodal springs: R(u) + k (u − a) at each node's dofs, and k added to the tangent.
+
+        `dofs` (n, m): owned local indices of n nodes' m components, `stiffness` (n, m, m)
+        each node's symmetric spring, `anchor` (n, m) where it is unstretched. For a
+        slipping contact node in 3D: the Newton linearization of its friction force's
+        direction. Replaces the previous ones; the tangent is rebuilt.
+        """
+        dofs = np.asarray(dofs, dtype=np.int32)
+        # collective: every rank rebuilds the tangent if any rank has (or had) springs
+        comm = self.u.function_space.mesh.comm
+        if comm.allreduce(bool(dofs.size) or self._springs is not None, op=MPI.LOR):
+            self.policy.bcs_changed(small=False)
+            self._springs = (dofs, np.asarray(stiffness, dtype=float),
+                             np.asarray(anchor, dtype=float))
+        else:
+            self._springs = None
 
     # -- the loop --------------------------------------------------------------------
 
@@ -461,6 +482,10 @@ class NewtonSolver:
             if self._nodal_load is not None:
                 dofs, values = self._nodal_load
                 self.b.array[dofs] -= values
+            if self._springs is not None:
+                dofs, k, anchor = self._springs
+                stretch = self.u.x.array[dofs] - anchor
+                self.b.array[dofs] += np.einsum("nij,nj->ni", k, stretch)
             petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
             work.residual_assemblies += 1
             return self._force_norm()
@@ -487,6 +512,8 @@ class NewtonSolver:
                 petsc.assemble_matrix(self.A, self._K_used, bcs=self.bcs, diag=1.0)
                 self.A.assemble()
                 work.tangent_assemblies += 1
+            if self._springs is not None:
+                self._add_springs()
             if self._M is not None:  # its Dirichlet rows follow the tangent's
                 self._M.zeroEntries()
                 petsc.assemble_matrix(self._M, self._M_form, bcs=self.bcs, diag=1.0)
@@ -494,6 +521,17 @@ class NewtonSolver:
         if self.policy.needs_factorization():
             self._factorize(work)
         self.policy.assembled()
+
+    def _add_springs(self) -> None:
+        """A += each nodal spring's stiffness (owned rows; collective, as A.assemble())."""
+        dofs, k, _ = self._springs
+        bs = self.u.function_space.dofmap.index_map_bs
+        lg = self.u.function_space.dofmap.index_map.local_to_global
+        for node, block in zip(dofs, k, strict=True):
+            blocks = lg(np.asarray(node // bs, dtype=np.int32))
+            rows = (blocks * bs + node % bs).astype(PETSc.IntType)
+            self.A.setValues(rows, rows, block, addv=PETSc.InsertMode.ADD_VALUES)
+        self.A.assemble()
 
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
         """A = K with the Dirichlet rows and columns replaced by the identity (no assembly)."""
