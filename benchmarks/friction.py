@@ -10,6 +10,10 @@ then moved by D = 0.0023 along x (Q ≈ f P / 2). Same mesh, same two steps:
   distance to the active set's answer (Q, nodal traction) as k grows, and its cost;
 * force control (`Punch.pull`, Q = f P / 2): how many positions the secant steps need.
 
+And in 3D, the P1 sphere at ν = 0.3 (h = a/6, a block 10 a wide, f = 0.3) pressed by δ and
+moved by 0.002: the active set (slip directions by Newton, a spring across each slip)
+against the vector penalty peer at k = 10, 100, 1000 E/h.
+
     python benchmarks/friction.py [--quick] [--update-readme]
 """
 
@@ -103,6 +107,31 @@ def force_control(refine: int) -> dict:
             "tangential_force": moved.tangential_force, "force": moved.normal_force}
 
 
+def sphere(kappas) -> dict:
+    """The 3D rows: active set and penalty peers on the same P1 sphere."""
+    punch = build_punch("3d", LinearElastic(1.0, 0.3), R, math.sqrt(R * DELTA), refine=0,
+                        block=10.0, tangential=True, friction=F)
+    t0 = time.perf_counter()
+    pressed = punch.indent(DELTA)
+    punch.commit()
+    moved = punch.shift(0.002)
+    c = punch.contact
+    q = (c.tangential_forces()[:, 0] / c.surface.nodal_areas())[c.owned]
+    out = {"dofs": punch.dofs, "time_s": time.perf_counter() - t0,
+           "status_iterations": [pressed.active_set_iterations, moved.status_iterations],
+           "factorizations": pressed.factorizations + moved.factorizations,
+           "tangential_force": moved.tangential_force, "penalty": []}
+    for kappa in kappas:
+        r = solve_friction_penalty(punch, DELTA, 0.002, kappa / punch.block.h, F)
+        out["penalty"].append({
+            "kappa": kappa, "time_s": r["wall_time_s"], "newton_iterations": r["iterations"],
+            "factorizations": r["factorizations"],
+            "Q_vs_active_set": r["tangential_force"] / moved.tangential_force - 1,
+            "q_vs_active_set": float(np.abs(r["traction"] - q).max() / np.abs(q).max())})
+        print(out["penalty"][-1], flush=True)
+    return out
+
+
 def table(out: dict) -> str:
     a = out["active_set"]
     lines = [f"Cattaneo–Mindlin cylinder, ν = 1/2 (Taylor–Hood), f = {F}, D = {SHIFT} "
@@ -124,6 +153,18 @@ def table(out: dict) -> str:
               "of the stick–slip edges. Force control (Q = f P / 2) took "
               f"{fc['positions']} punch positions, {fc['time_s']:.1f} s after pressing. "
               "`python benchmarks/friction.py`"]
+    sp = out["sphere"]
+    lines += ["", f"3D: the P1 sphere, ν = 0.3, f = {F}, moved by 0.002 after pressing, "
+              f"{sp['dofs']} unknowns, 1 rank.", "",
+              "| method | time (s) | iterations | factorizations | Q vs active set | "
+              "q vs active set (/ largest) |", "|---|---|---|---|---|---|",
+              f"| active set | {sp['time_s']:.2f} | {sp['status_iterations'][0]} + "
+              f"{sp['status_iterations'][1]} status iterations | {sp['factorizations']} | — "
+              "| — |"]
+    for r in sp["penalty"]:
+        lines.append(f"| penalty k = {r['kappa']:g} E/h | {r['time_s']:.2f} | "
+                     f"{r['newton_iterations']} Newton | {r['factorizations']} | "
+                     f"{r['Q_vs_active_set']:+.1e} | {100 * r['q_vs_active_set']:.2f} % |")
     return "\n".join(lines)
 
 
@@ -138,6 +179,7 @@ def main():
         out["penalty"].append(penalty(punch, kappa, out["active_set"], x, q))
         print(out["penalty"][-1], flush=True)
     out["force_control"] = force_control(0)
+    out["sphere"] = sphere((10.0, 100.0) if args.quick else (10.0, 100.0, 1000.0))
     publish("friction", out, table, args)
 
 

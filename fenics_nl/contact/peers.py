@@ -107,34 +107,43 @@ def solve_friction_penalty(punch, delta: float, shift: float, stiffness: float,
 
     Press by δ, then move the punch by `shift` along x; k in force/length³. Normal:
     p_n = k ⟨u_n − γ⟩₊. Tangential, from the state after pressing: the elastic-plastic
-    law t = −clip(k Δg, −f p_n, f p_n) of the slip Δg = Δu_x − shift: stick is an elastic
-    spring, slip the Coulomb bound. Both conditions hold only as k → ∞, at the nodes (a
-    nodal rule on S_C), so the limit is the active set's discrete problem. Plane strain
-    (one tangential axis, x); the parabolic gap.
+    law of the slip Δg = Δu_t − (shift, 0): the trial t* = −k Δg returned to the disc
+    |t| ≤ f p_n (in 2D, the clip of one component): stick is an elastic spring, slip the
+    Coulomb bound. Both conditions hold only as k → ∞, at the nodes (a nodal rule on S_C:
+    P1 in 3D), so the limit is the active set's discrete problem. The parabolic gap.
     """
-    if punch.model != "plane-strain" or punch.gap_shape != "parabola":
+    if punch.model not in ("plane-strain", "3d") or punch.gap_shape != "parabola":
         raise ValueError("the friction penalty peer is written for the plane-strain "
-                         "cylinder with the parabolic gap")
+                         "cylinder and the 3D sphere, with the parabolic gap")
     u, c = punch.u, punch.contact
     u.x.array[:] = 0.0
     c.set_gap(punch.gap(delta))
     msh, s, axis = punch.mesh, c.surface.sign, c.surface.axis
     x = ufl.SpatialCoordinate(msh)
-    gamma = x[0] ** 2 / (2 * punch.R) - delta
+    axes = c.axes
+    gamma = sum(x[i] ** 2 for i in axes) / (2 * punch.R) - delta
     pressed = fem.Function(u.function_space)  # the state the slip is counted from
     d = fem.Constant(msh, 0.0)
     k = fem.Constant(msh, float(stiffness))
     p_n = k * ufl.max_value(s * u[axis] - gamma, 0.0)
     bound = friction * p_n
-    t = -ufl.max_value(ufl.min_value(k * (u[0] - pressed[0] - d), bound), -bound)
+    slip = ufl.as_vector([u[i] - pressed[i] - (d if i == 0 else 0.0) for i in axes])
+    if len(axes) == 1:
+        t = ufl.as_vector([-ufl.max_value(ufl.min_value(k * slip[0], bound), -bound)])
+    else:  # the return to the disc; the floor under the root keeps its derivative finite
+        trial = k * slip
+        size = ufl.sqrt(ufl.dot(trial, trial) + (1e-30 * stiffness) ** 2)
+        t = -trial * bound / ufl.max_value(size, bound)
     v = punch.residual.arguments()[0]
     # the nodal rule: the penalty acts at the nodes, as the active set's conditions do, so
     # its limit k → ∞ is the same discrete problem (and t at a node is its nodal traction)
+    fdim = msh.topology.dim - 1
     f_tags = np.sort(punch.block.contact_facets)
-    tags = mesh.meshtags(msh, 1, f_tags, np.ones(len(f_tags), dtype=np.int32))
-    rule = nodal_quadrature(c.surface.Vn.element.basix_element.degree, 1)
+    tags = mesh.meshtags(msh, fdim, f_tags, np.ones(len(f_tags), dtype=np.int32))
+    rule = nodal_quadrature(c.surface.Vn.element.basix_element.degree, fdim)
     ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=rule)(1)
-    R = punch.residual + (p_n * s * v[axis] - t * v[0]) * ds
+    v_t = ufl.as_vector([v[i] for i in axes])
+    R = punch.residual + (p_n * s * v[axis] - ufl.dot(t, v_t)) * ds
     solver = NewtonSolver(R, u, punch.bcs, method="full", line_search=True, prefix=prefix,
                           rtol=1e-10, atol=1e-12, max_it=200)
     t0 = time.perf_counter()
@@ -148,10 +157,10 @@ def solve_friction_penalty(punch, delta: float, shift: float, stiffness: float,
     wall = time.perf_counter() - t0
     comm, factor = msh.comm, punch.block.symmetry_factor
     force = comm.allreduce(fem.assemble_scalar(fem.form(p_n * ds))) * factor
-    tangential = comm.allreduce(fem.assemble_scalar(fem.form(t * ds))) * factor
+    tangential = comm.allreduce(fem.assemble_scalar(fem.form(t[0] * ds))) * factor
     S = c.surface
     traction = fem.Function(S.Vn)
-    traction.interpolate(fem.Expression(t, S.Vn.element.interpolation_points))
+    traction.interpolate(fem.Expression(t[0], S.Vn.element.interpolation_points))
     return {"force": force, "tangential_force": tangential, "wall_time_s": wall,
             "iterations": iterations, "factorizations": factorizations,
             "x": S.x[S.owned, 0], "traction": traction.x.array[S.dofs_n][S.owned],
