@@ -22,7 +22,7 @@ then updates the statuses by the course's rules, extended to friction:
 
 In 3D the direction s of a slipping node is a unit vector, which the loop finds by Newton's
 method rather than by substitution (s ← −Δg/|Δg| chatters): the node carries f |T_n| s
-and a spring k (I − s sᵀ) against slip across s, k = f |T_n|/|Δg| from the last
+and a spring k (I − s sᵀ) against slip across s, k = f |T_n|/(−Δg·s) from the last
 iterate (`NewtonSolver.set_nodal_springs`), the linearization of −f |T_n| Δg/|Δg|; s then
 turns to the node's total tangential force, and at the fixed point the slip is along −s.
 
@@ -52,7 +52,7 @@ class FrictionalContact(ActiveSetContact):
     """
 
     # a status set may come back while the friction forces still move (they follow the
-    # normal forces of the last solve); a third return is a cycle
+    # normal forces of the last solve); its third visit is a cycle
     REVISITS = 2
 
     def __init__(self, *args, friction: float, **kwargs):
@@ -159,7 +159,8 @@ class FrictionalContact(ActiveSetContact):
         """3D: k (I − s sᵀ) at each slipping node, against slip across its force.
 
         The force f|T_n| s with s = −Δg/|Δg| linearized in Δg (Newton on the direction)
-        is f|T_n| s − k (I − s sᵀ) Δg with k = f|T_n|/|Δg|, from the last iterate.
+        is f|T_n| s − k (I − s sᵀ) Δg with k = f|T_n|/(−Δg·s) (= f|T_n|/|Δg| at the fixed
+        point), from the last iterate.
         """
         S = self.surface
         on = S.owned & self.slip & (self.spring > 0)
@@ -216,7 +217,10 @@ class FrictionalContact(ActiveSetContact):
                 kept = slip & self.slip & sensed & (size > tol_T)
                 direction[kept] = T_t[kept] / size[kept, None]
                 along = -np.sum(g * direction, axis=1)
-                moving = kept & (along > tol_u)
+                # a node that barely slides (below 1e-6 of the largest slip) gets no spring:
+                # k = f|T_n|/slip would amplify round-off in u into the residual
+                floor = 1e-6 * global_max(self.comm, np.where(kept, along, 0.0))
+                moving = kept & (along > max(tol_u, floor))
                 spring[moving] = bound[moving] / along[moving]
             slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
             drift = global_max(self.comm, np.abs(slip_force - self.slip_force))

@@ -380,12 +380,11 @@ class NewtonSolver:
         dofs = np.asarray(dofs, dtype=np.int32)
         # collective: every rank rebuilds the tangent if any rank has (or had) springs
         comm = self.u.function_space.mesh.comm
-        if comm.allreduce(bool(dofs.size) or self._springs is not None, op=MPI.LOR):
+        had, has = self._springs is not None, comm.allreduce(bool(dofs.size), op=MPI.LOR)
+        if had or has:
             self.policy.bcs_changed(small=False)
-            self._springs = (dofs, np.asarray(stiffness, dtype=float),
-                             np.asarray(anchor, dtype=float))
-        else:
-            self._springs = None
+        self._springs = (dofs, np.asarray(stiffness, dtype=float),
+                         np.asarray(anchor, dtype=float)) if has else None
 
     # -- the loop --------------------------------------------------------------------
 
