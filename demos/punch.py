@@ -315,7 +315,7 @@ if len(loading) >= 2 and all(s.force > 0 for s in loading):
 # against Cattaneo–Mindlin (exact at ν = 1/2, where the normal and tangential problems
 # decouple): the stick half-width c = a √(1 − Q/(fP)) and the traction profile of the
 # cylinder (plane strain), and in 3D the sphere's stick radius c = a (1 − Q/(fP))^(1/3),
-# its traction along y = 0 and its tangential displacement δ_t(Q).
+# the tangential force inside each radius, Q(r), and its tangential displacement δ_t(Q).
 
 # +
 def mindlin_check(T, fP):
