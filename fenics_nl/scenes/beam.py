@@ -25,6 +25,7 @@ from fenics_nl.io import output
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean, StVenantKirchhoff
 from fenics_nl.materials.mixed import unknowns
+from fenics_nl.solvers.arclength import ArcLength, ContinuationPath
 from fenics_nl.solvers.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.solvers.loading import LoadPath, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
@@ -248,6 +249,29 @@ class Beam:
             if progress:
                 progress(f"branch switching failed: load path again with {steps} steps")
         raise SolveError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
+
+    def solve_arc_length(self, ratio: float, method: str = "full", *, arc_length: float = 0.2,
+                         max_steps: int = 1000, on_step=None, progress=None
+                         ) -> ContinuationPath:
+        """Arc-length continuation from 0 to ratio·P_Euler (λ = P/P_Euler).
+
+        The inertia of the tangent is counted at every state; where it changes while the
+        load keeps growing (a bifurcation: the straight beam past P_cr), the path leaves
+        along the tangent's critical mode, scaled by the arc length alone (no elastica).
+        With an imperfection there is no bifurcation: the path bends smoothly.
+        """
+        # atol 1e-8 of the reference load: bent past 90°, the internal forces' round-off
+        # reaches ~5e-9 of it (membrane forces ≫ the load), where modified Newton stalls
+        solver = NewtonSolver(self.residual, self.u, self.bcs, method=method, rtol=1e-8,
+                              atol=1e-8, max_it=30 if method == "full" else 500,
+                              prefix=f"beam_{method}_")
+        f = self.fields
+        arc = ArcLength(solver, lambda t: self.set_load(t * self.P_euler),
+                        arc_length=arc_length, switch=True, prefix="beam_continuation_",
+                        metric_dofs=f.displacement_dofs if f.mixed else None,
+                        mass=self._displacement_mass(), multipliers=f.pressure_dofs)
+        self.u.x.array[:] = 0.0
+        return arc.run(ratio, max_steps, on_step=on_step, progress=progress)
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""

@@ -105,11 +105,13 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
     return [values[i] for i in order][:n], [modes[i] for i in order][:n]
 
 
-def negative_eigenvalues(A: PETSc.Mat, prefix: str) -> int:
+def negative_eigenvalues(A: PETSc.Mat, prefix: str, rhs: PETSc.Vec | None = None,
+                         solution: PETSc.Vec | None = None) -> int:
     """The number of negative eigenvalues of the symmetric matrix A, from its inertia.
 
     Sylvester's law: A = L D Lᵀ (MUMPS) has as many negative eigenvalues as D has negative
-    pivots. One factorization, no eigensolver; `-{prefix}...` options reach its KSP.
+    pivots. One factorization, no eigensolver; `-{prefix}...` options reach its KSP. With
+    `rhs`, also `solution` = A⁻¹ rhs: one back-solve on the same factorization.
     """
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOptionsPrefix(prefix)
@@ -125,8 +127,25 @@ def negative_eigenvalues(A: PETSc.Mat, prefix: str) -> int:
     ksp.setFromOptions()
     ksp.setUp()
     negative = factor.getInertia()[0]
+    if rhs is not None:
+        ksp.solve(rhs, solution)
     ksp.destroy()
     return negative
+
+
+def unstable_directions(a_T: ufl.Form, bcs, prefix: str = "stability_",
+                        multipliers: int = 0, rhs: PETSc.Vec | None = None,
+                        solution: PETSc.Vec | None = None) -> int:
+    """The number of negative eigenvalues of the tangent K_T, less `multipliers`.
+
+    0 on a stable equilibrium; it changes by one where the path crosses a limit point or a
+    bifurcation. One assembly and one LDLᵀ factorization (`negative_eigenvalues`); with
+    `rhs` (zero on the Dirichlet rows), also `solution` = K_T⁻¹ rhs.
+    """
+    K = _stiffness(a_T, bcs)
+    count = negative_eigenvalues(K, f"{prefix}inertia_", rhs, solution) - multipliers
+    K.destroy()
+    return count
 
 
 def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "stability_",

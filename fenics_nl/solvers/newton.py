@@ -182,6 +182,10 @@ class InverseBFGS:
         s.scale(-alpha)
         y = b_old.copy()
         y.aypx(-1.0, b_new)
+        self.store_pair(s, y)
+
+    def store_pair(self, s: PETSc.Vec, y: PETSc.Vec) -> None:
+        """Keep the pair (s, y), which it now owns, if y·s > 0 (else destroy it)."""
         ys = y.dot(s)
         if not ys > 1e-12 * y.norm() * s.norm():
             s.destroy()
@@ -293,6 +297,7 @@ class NewtonSolver:
         self.period, self.bfgs_memory = period, bfgs_memory
         V = u.function_space
         J = ufl.derivative(residual, u) if tangent is None else tangent
+        self.tangent_form = J  # UFL, for a stability analysis of the current state
         self._R = fem.form(residual)
         self._K = fem.form(J)
         # A tangent with no coefficients (linear material) is assembled once; new Dirichlet

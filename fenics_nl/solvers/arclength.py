@@ -1,0 +1,577 @@
+"""Arc-length continuation (Crisfield): the load factor λ is an unknown beside u.
+
+Load control fixes λ and solves R(u, λ) = F_int(u) − λ q = 0 for u; at a limit point (λ at
+a maximum) no u exists beyond it and the steps are cut to nothing. Arc-length control adds
+one equation, the distance from the last converged state (u_n, λ_n):
+
+    ‖Δu‖²/u_ref² + ψ² Δλ² = Δs²,    Δu = u − u_n,  Δλ = λ − λ_n,
+
+so the path is followed by its length, through limit points and snap-backs. u_ref is the
+size of the linear response K₀⁻¹q to the reference load at the start: Δs is dimensionless
+(the same in any units) and, on a linear path, about √(1 + ψ²) load increments. ψ = 1 is
+Crisfield's spherical arc, ψ = 0 his cylindrical one.
+
+Each corrector iteration is a bordered solve on the tangent K of the chosen Newton variant,
+factorized as that variant says (every iteration, once per step, or BFGS-corrected):
+
+    K δu_R = −R,   K δu_q = q,   δu = δu_R + δλ δu_q,
+
+two back-solves and no factorization for the constraint; δλ is a root of the arc's
+quadratic, the one whose increment turns least from the current one (Crisfield's rule).
+
+Critical points: a limit point is where Δλ changes sign between steps. With `detect`, the
+number of negative eigenvalues of the tangent at each converged state (its inertia, from
+one MUMPS LDLᵀ factorization) tells the rest: a count that changes while λ keeps its sense is
+a bifurcation. With `switch`, the first bifurcation where the count grows is left along its
+critical mode, the tangent's eigenvector of the negative eigenvalue (SLEPc): the next step
+starts from u_n + Δs φ at the same λ, and the arc keeps it from falling back. Nothing of the
+problem's closed form is used: the size of the kick is the step's own arc length.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from petsc4py import PETSc
+
+from fenics_nl.errors import SolveError
+from fenics_nl.solvers.buckling import lowest_tangent_mode, unstable_directions
+from fenics_nl.solvers.newton import NewtonSolver, _LinearSolveFailed
+from fenics_nl.solvers.result import SolveResult, WorkCounts
+
+log = logging.getLogger(__name__)
+
+# the iterations a step should take, per variant: fewer and the arc grows, more and it shrinks
+DESIRED_ITERATIONS = {"full": 5, "periodic": 8, "bfgs": 12, "modified": 20}
+
+
+class ContinuationError(SolveError):
+    """The path could not be followed to the target; `reached` is the last load factor."""
+
+    def __init__(self, message: str, result=None, *, reached: float = 0.0):
+        super().__init__(message, result)
+        self.reached = reached
+
+
+class _StepFailed(Exception):
+    """A step did not converge (or turned back): cut the arc and try again."""
+
+
+def _at_round_off(norms: list[float], largest: float) -> bool:
+    """‖R‖ flat over the last 5 iterates, 1e6 below the largest of the run: round-off.
+
+    A slender body's internal forces are far larger than its load (membrane forces), and
+    near a critical point K is nearly singular and amplifies the round-off of each
+    correction: the residual then stops falling above a tolerance on the load.
+    """
+    last = norms[-5:]
+    return len(last) == 5 and max(last) < 1e-6 * largest and max(last) < 3 * min(last)
+
+
+@dataclass
+class CriticalPoint:
+    """A limit point or a bifurcation met between two converged steps."""
+
+    kind: str  # "limit" or "bifurcation"
+    factor: float  # λ there: the vertex of a parabola through the last 3 points (limit),
+    # or the middle of the step that crossed it (bifurcation)
+    step: int  # the first converged step past it
+    between: tuple[float, float]  # λ of the converged states either side
+
+
+@dataclass
+class ContinuationPath:
+    """Converged states along the arc: load factors, solve results, what was met."""
+
+    factors: list[float] = field(default_factory=list)
+    results: list[SolveResult] = field(default_factory=list)
+    arc_lengths: list[float] = field(default_factory=list)  # Δs of each converged step
+    unstable: list[int] = field(default_factory=list)  # negative eigenvalues (with `detect`)
+    critical_points: list[CriticalPoint] = field(default_factory=list)
+    switched: bool = False  # left a bifurcation along its mode
+    failures: int = 0  # steps cut
+    bracketing_steps: int = 0  # steps redone shorter to bracket a bifurcation
+    inertia_factorizations: int = 0  # the stability checks' (not in `work`)
+    work: WorkCounts = field(default_factory=WorkCounts)
+
+    @property
+    def iterations(self) -> int:
+        """Corrector iterations summed over converged steps."""
+        return sum(r.iterations for r in self.results)
+
+
+class ArcLength:
+    """Crisfield's arc-length method on the Newton family of a `NewtonSolver`.
+
+    Args:
+        solver: the Newton solver of R(u, λ) (its variant, tangent policy, linear solver and
+            tolerances are used; Dirichlet values must not depend on λ). Converged when
+            ‖R‖ ≤ max(rtol ‖R₀‖, atol ‖q‖); without a force scale of its own, it gets ‖q‖.
+        set_load: sets λ in the residual (as for `solve_incrementally`); R must be affine in
+            λ: q = R(u, λ) − R(u, λ + 1), taken at the start of each step (exact for dead
+            loads).
+        arc_length: the first step's Δs (dimensionless, see the module), > 0.
+        psi: weight of λ in the arc: 1 spherical, 0 cylindrical.
+        min_arc_length, max_arc_length: bounds of the adaptive Δs (default Δs/1e4 and no
+            bound); below the minimum the run stops with ContinuationError.
+        desired_iterations: corrector iterations a step should take (per variant by default).
+        detect: count the tangent's negative eigenvalues at each state (one LDLᵀ each).
+        switch: leave the first bifurcation along its critical mode (needs `detect`).
+        metric_dofs: local indices of the dofs the arc measures (default all): a mixed
+            unknown gives its displacement's, so that a pressure's units do not count.
+        mass: the stability eigenproblem's metric M in K φ = μ M φ (default the identity).
+        multipliers: negative eigenvalues a saddle-point tangent always has (its pressure
+            or multiplier dofs), not counted as unstable directions.
+        prefix: PETSc options prefix of the stability checks.
+        commit, restore: hooks after a converged step and after a cut (internal variables).
+    """
+
+    def __init__(self, solver: NewtonSolver, set_load: Callable[[float], None], *,
+                 arc_length: float = 0.1, psi: float = 1.0,
+                 min_arc_length: float | None = None, max_arc_length: float | None = None,
+                 desired_iterations: int | None = None, detect: bool = True,
+                 switch: bool = False, metric_dofs: np.ndarray | None = None, mass=None,
+                 multipliers: int = 0, prefix: str = "continuation_",
+                 commit: Callable[[], None] | None = None,
+                 restore: Callable[[], None] | None = None):
+        if not (arc_length > 0 and math.isfinite(arc_length)):
+            raise ValueError(f"arc length must be a finite number > 0, got {arc_length!r}")
+        if not (psi >= 0 and math.isfinite(psi)):
+            raise ValueError(f"psi must be >= 0, got {psi!r}")
+        if switch and not detect:
+            raise ValueError("branch switching needs the stability checks (detect=True)")
+        self.solver, self.set_load = solver, set_load
+        self.arc_length, self.psi = arc_length, psi
+        self.min_arc_length = arc_length * 1e-4 if min_arc_length is None else min_arc_length
+        self.max_arc_length = math.inf if max_arc_length is None else max_arc_length
+        if not 0 < self.min_arc_length <= arc_length <= self.max_arc_length:
+            raise ValueError("arc lengths must satisfy 0 < min <= first <= max, got "
+                             f"{self.min_arc_length}, {arc_length}, {self.max_arc_length}")
+        self.desired = desired_iterations or DESIRED_ITERATIONS[solver.method]
+        self.detect, self.switch = detect, switch
+        self.mass, self.multipliers, self.prefix = mass, multipliers, prefix
+        self.commit, self.restore = commit, restore
+        x = solver.u.x.petsc_vec
+        self._weights = None  # 1 on the metric's dofs, 0 elsewhere
+        if metric_dofs is not None:
+            self._weights = x.duplicate()
+            self._weights.set(0.0)
+            owned = metric_dofs[metric_dofs < x.getLocalSize()]
+            self._weights.array[owned] = 1.0
+        self._scale = None  # 1/u_ref², set on the first predictor
+        self._q = None  # the load vector q = −∂R/∂λ of the current step
+        self._largest = 0.0  # the largest first residual of a step: round-off's scale
+
+    # -- the metric --------------------------------------------------------------------
+
+    def _dot(self, a: PETSc.Vec, b: PETSc.Vec) -> float:
+        """a·b over the metric's dofs, times 1/u_ref²."""
+        if self._weights is None:
+            value = a.dot(b)
+        else:
+            w = a.copy()
+            w.pointwiseMult(w, self._weights)
+            value = w.dot(b)
+            w.destroy()
+        return value * (self._scale or 1.0)
+
+    def _solve(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
+        """out = K⁻¹ rhs with the variant's tangent (BFGS: its corrected inverse)."""
+        s = self.solver
+        if s.bfgs:
+            s.bfgs.direction(rhs, s.du, lambda b: s._linear_solve(b, work))
+        else:
+            s._linear_solve(rhs, work)
+        s.du.copy(out)
+
+    def _load_vector(self, lam: float, q: PETSc.Vec, work: WorkCounts) -> None:
+        """q = R(u, λ) − R(u, λ + 1); leaves R(u, λ) in the solver's b."""
+        s = self.solver
+        self.set_load(lam + 1.0)
+        s._residual(work)
+        s.b.copy(q)
+        self.set_load(lam)
+        s._residual(work)
+        q.aypx(-1.0, s.b)
+
+    # -- one step ----------------------------------------------------------------------
+
+    def _step(self, lam0: float, ds: float, previous, kick, work: WorkCounts, norms: list,
+              target: float | None = None):
+        """From the converged (u_n, λ_n) to the next state at arc length ds.
+
+        `previous`: the last step's (Δu, Δλ), for the predictor's sense and the root
+        choice; `kick`: a mode to leave along (branch switching); a predictor that passes
+        `target` is shortened to end there. Returns (Δu, Δλ, iterations, the arc used).
+        """
+        s = self.solver
+        x = s.u.x.petsc_vec
+        s.policy.start_solve()
+        if s.bfgs:
+            s.bfgs.clear()
+        if self._q is None:
+            self._q = x.duplicate()
+        q, dq = self._q, x.duplicate()
+        self._load_vector(lam0, q, work)
+        q_norm = q.norm()
+        if q_norm == 0:
+            raise ValueError("the load does not depend on the load factor (q = 0)")
+        if s.force_scale is None:  # the reference load: also the landing solve's scale
+            s.force_scale = q_norm
+        du = x.duplicate()
+        x0 = x.copy()
+        if kick is not None:
+            # along the critical mode, at the same λ; the tangent is taken there, not at
+            # u_n, where it is singular along that very mode (a constant tangent would
+            # amplify it without bound)
+            kick.copy(du)
+            du.scale(ds / math.sqrt(self._dot(kick, kick)))
+            dlam = 0.0
+            x.axpy(1.0, du)
+            x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        if s.policy.needs_tangent(0):
+            s._assemble_tangent(work)
+        self._solve(q, dq, work)
+        if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
+            self._scale = 1.0 / self._dot(dq, dq)
+        if kick is None:  # along the tangent (dq, 1), in the sense of the last step
+            sense = 1.0
+            if previous is not None:
+                sense = math.copysign(1.0, self._dot(previous[0], dq)
+                                      + self.psi**2 * previous[1])
+            dlam = sense * ds / math.sqrt(self._dot(dq, dq) + self.psi**2)
+            if target is not None and (target - lam0) * (target - lam0 - dlam) < 0:
+                # the predictor passes the target: aim at it, so that the landing is short
+                ds *= (target - lam0) / dlam
+                dlam = target - lam0
+            dq.copy(du)
+            du.scale(dlam)
+        try:
+            return (*self._correct(x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms), ds)
+        except _StepFailed:
+            self._back_to(x0, lam0)
+            du.destroy()
+            raise
+        finally:
+            for v in (dq, x0):
+                v.destroy()
+
+    def _correct(self, x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms):
+        """Corrector iterations on the arc: (Δu, Δλ, iterations), or _StepFailed.
+
+        `ds` None: at fixed λ (load control: no back-solve for q).
+        """
+        s = self.solver
+        x = s.u.x.petsc_vec
+        x0.copy(x)
+        x.axpy(1.0, du)
+        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        lam = lam0 + dlam
+        self.set_load(lam)
+        dr = x.duplicate()
+        b_old, ddu, ddlam = None, None, 0.0  # the last correction, for a BFGS pair
+        on_arc = True  # the predictor is on the arc
+        try:
+            for k in range(s.max_it + 1):
+                rnorm = s._residual(work)
+                norms.append(rnorm)
+                if b_old is not None:  # y = ΔF_int = ΔR + δλ q, s = δu
+                    y = s.b.copy()
+                    y.axpy(-1.0, b_old)
+                    y.axpy(ddlam, q)
+                    s.bfgs.store_pair(ddu, y)
+                    b_old.destroy()
+                    b_old = None
+                if not math.isfinite(rnorm) or rnorm > s.divergence_tol * max(norms[0], 1e-300):
+                    raise _StepFailed(f"residual {rnorm:.3e} at iteration {k}")
+                self._largest = max(self._largest, norms[0])
+                if on_arc and (rnorm <= max(s.rtol * norms[0], s.atol * q_norm)
+                               or _at_round_off(norms, self._largest)):
+                    return du, dlam, k
+                if k == s.max_it:
+                    raise _StepFailed(f"no convergence in {s.max_it} iterations "
+                                      f"(|R| = {rnorm:.3e})")
+                if s.policy.needs_tangent(k):
+                    s._assemble_tangent(work)
+                    if ds is not None:
+                        self._solve(q, dq, work)
+                elif s.bfgs and k > 0 and ds is not None:
+                    self._solve(q, dq, work)  # H changed with the last pair
+                if s.bfgs:
+                    b_old = s.b.copy()
+                self._solve(s.b, dr, work)  # the correction's part −K⁻¹R is −dr
+                ddlam, on_arc = (0.0, True) if ds is None else self._root(du, dlam, dr, dq,
+                                                                           ds)
+                step = dr.copy()
+                step.scale(-1.0)
+                if ddlam:
+                    step.axpy(ddlam, dq)  # δu = −dr + δλ dq
+                du.axpy(1.0, step)
+                x.axpy(1.0, step)
+                x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+                dlam += ddlam
+                lam = lam0 + dlam
+                self.set_load(lam)
+                if s.bfgs:
+                    ddu = step
+                else:
+                    step.destroy()
+        except _LinearSolveFailed as err:
+            raise _StepFailed(str(err)) from None
+        finally:
+            dr.destroy()
+            if b_old is not None:
+                b_old.destroy()
+
+    def _root(self, du, dlam, dr, dq, ds) -> tuple[float, bool]:
+        """δλ on the arc: the root of its quadratic that turns the increment the least.
+
+        Returns δλ and whether the corrected state is on the arc.
+        """
+        psi2 = self.psi**2
+        v = du.copy()
+        v.axpy(-1.0, dr)  # Δu + δu_R
+        a = self._dot(dq, dq) + psi2
+        b = 2 * (self._dot(v, dq) + psi2 * dlam)
+        c = self._dot(v, v) + psi2 * dlam**2 - ds**2
+        v_du, dq_du = self._dot(v, du), self._dot(dq, du)
+        v.destroy()
+        disc = b * b - 4 * a * c
+        if disc < 0:  # the linearized path misses the arc (a constant tangent often does):
+            return -b / (2 * a), False  # its point nearest the arc; the next iterations
+            # return to it
+        roots = [(-b + sign * math.sqrt(disc)) / (2 * a) for sign in (1.0, -1.0)]
+        turn = [v_du + r * dq_du + psi2 * (dlam + r) * dlam for r in roots]
+        return roots[int(np.argmax(turn))], True
+
+    # -- the path ----------------------------------------------------------------------
+
+    def run(self, target: float, max_steps: int = 100, *, start: float = 0.0,
+            on_step: Callable[[float, SolveResult], None] | None = None,
+            progress: Callable[[str], None] | None = None) -> ContinuationPath:
+        """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
+
+        The last state is then solved at λ = target exactly, by Newton under load control
+        from the interpolation of the two states either side. ContinuationError if the
+        target is not crossed within `max_steps` converged steps, if the arc is cut below
+        its minimum, or if the path turns back onto itself.
+        """
+        if not math.isfinite(target) or target == start:
+            raise ValueError(f"target load factor must be finite and differ from the start "
+                             f"{start}, got {target!r}")
+        if max_steps < 1:
+            raise ValueError(f"max_steps must be >= 1, got {max_steps}")
+        say = progress or (lambda message: None)
+        x = self.solver.u.x.petsc_vec
+        path = ContinuationPath()
+        lam, ds = start, self.arc_length
+        previous, kick = None, None  # the last step's (Δu, Δλ); a mode to leave along
+        bracket = None  # bracketing a bifurcation: (the arc short enough, the arc it had)
+        arc = [0.0]  # arc length along the path at each state
+        self.set_load(lam)
+        count, sense = self._stability(path) if self.detect else (0, 1.0)
+        last_dlam = None  # the last step's Δλ, for a change of sense (None past a switch)
+        before = x.copy()  # the last converged state
+        try:
+            while len(path.factors) < max_steps:
+                t0 = time.perf_counter()
+                work, norms = WorkCounts(), []
+                try:
+                    du, dlam, its, ds = self._step(lam, ds, previous, kick, work, norms,
+                                                   None if bracket else target)
+                    if kick is None and previous is not None and self._turns_back(
+                            du, dlam, previous):
+                        du.destroy()
+                        self._back_to(before, lam)
+                        raise _StepFailed("the step turned back onto the path it came along")
+                except _StepFailed as err:
+                    ds = self._cut(path, work, norms, ds, lam, err, say)
+                    continue
+                new, sense_new = (self._stability(path, du, dlam) if self.detect
+                                  else (count, sense))
+                # a change of inertia: a limit point if the path's tangent changed its sense
+                # of λ as well, else a bifurcation (a sense that flips with the inertia
+                # unchanged is a degenerate tangent's round-off: the symmetric beam's)
+                changed = self.detect and kick is None and new != count
+                turned = changed and sense * sense_new < 0
+                bifurcation = changed and not turned
+                leave = bifurcation and self.switch and not path.switched and new > count
+                if turned or leave:
+                    bracket = bracket or (ds / 32, ds)
+                    if ds > bracket[0]:  # bracket it closer: back, with half the arc
+                        du.destroy()
+                        self._back_to(before, lam)
+                        path.work.add(work)
+                        path.bracketing_steps += 1
+                        ds /= 2
+                        say(f"  {'limit point' if turned else 'bifurcation'} past λ = "
+                            f"{lam:.6g}: bracketing it, arc {ds:.3g}")
+                        continue
+                landed = False
+                if kick is None and not leave and (lam - target) * (lam + dlam - target) <= 0:
+                    # the step passes the target: solve there (or cut the arc if that fails)
+                    landing = self._land(target, before, lam, lam + dlam, work, norms)
+                    if landing is None:
+                        du.destroy()
+                        self._back_to(before, lam)
+                        ds = self._cut(path, work, norms, ds, lam, _StepFailed(
+                            f"Newton under load control failed at λ = {target:g}"), say)
+                        continue
+                    its, dlam, landed = its + landing, target - lam, True
+                if self.commit:
+                    self.commit()
+                lam_old, lam = lam, (target if landed else lam + dlam)
+                switched_now = kick is not None
+                if kick is not None:
+                    kick.destroy()
+                    kick = None
+                path.switched |= switched_now
+                result = SolveResult(True, "converged", its, norms, work,
+                                     time.perf_counter() - t0)
+                path.factors.append(lam)
+                path.results.append(result)
+                path.arc_lengths.append(ds)
+                path.unstable.append(new)
+                path.work.add(work)
+                arc.append(arc[-1] + ds)
+                say(f"step {len(path.factors)}: λ = {lam:.6g}, arc {ds:.3g}, {its} "
+                    f"iterations" + (", branch switched" if switched_now else ""))
+                if turned:  # the extremum of λ between the bracketing states
+                    peak = max(lam_old, lam) if sense > 0 else min(lam_old, lam)
+                    path.critical_points.append(CriticalPoint(
+                        "limit", peak, len(path.factors), (lam_old, lam)))
+                    say(f"  limit point at λ = {peak:.6g}")
+                    ds, bracket = bracket[1], None
+                elif (not self.detect and not switched_now and last_dlam is not None
+                        and dlam * last_dlam < 0
+                        and min(abs(dlam), abs(last_dlam)) > 1e-6 * ds):  # not round-off
+                    self._limit_point(path, arc, start)
+                last_dlam = None if switched_now else dlam
+                sense = sense_new
+                if previous is not None:
+                    previous[0].destroy()
+                previous = (du, dlam)
+                if bifurcation:
+                    path.critical_points.append(CriticalPoint(
+                        "bifurcation", (lam_old + lam) / 2, len(path.factors), (lam_old, lam)))
+                    say(f"  bifurcation between λ = {lam_old:.6g} and {lam:.6g} ({count} -> "
+                        f"{new} negative eigenvalues)")
+                if leave:
+                    kick = self._critical_mode()
+                    ds, bracket = bracket[1], None  # leave with the arc the path came with
+                count = new
+                if on_step:
+                    on_step(lam, result)
+                if landed:
+                    return path
+                x.copy(before)
+                if kick is None and bracket is None:
+                    ds = min(self.max_arc_length,
+                             ds * min(2.0, max(0.5, math.sqrt(self.desired / max(its, 1)))))
+        finally:
+            for v in (before, previous[0] if previous else None, kick, self._q):
+                if v is not None:
+                    v.destroy()
+            self._q = None
+        raise ContinuationError(f"load factor {target:g} not reached in {max_steps} steps "
+                                f"(the path is at λ = {lam:.6g})", reached=lam)
+
+    def _cut(self, path, work, norms, ds, lam, err, say) -> float:
+        """A failed step: restore, and half the arc; ContinuationError below its minimum."""
+        path.failures += 1
+        path.work.add(work)
+        if self.restore:
+            self.restore()
+        if ds / 2 < self.min_arc_length:
+            back = " (the path doubles back onto itself)" if "turned" in str(err) else ""
+            raise ContinuationError(
+                f"the path could not be followed beyond load factor {lam:.6g}: {err}{back}; "
+                f"arc length cut below {self.min_arc_length:g}",
+                SolveResult(False, "arc", len(norms), norms, work), reached=lam)
+        say(f"  step from λ = {lam:.4g} failed ({err}); arc cut to {ds / 2:.3g}")
+        return ds / 2
+
+    def _stability(self, path: ContinuationPath, du: PETSc.Vec | None = None,
+                   dlam: float = 0.0) -> tuple[int, float]:
+        """Negative eigenvalues of the tangent here, and the path's sense of λ here.
+
+        One LDLᵀ of K(u) and one back-solve t = K⁻¹q: the path's tangent is ±(t, 1),
+        oriented along the step (Δu, Δλ) just made; its λ-component's sign is the sense.
+        """
+        path.inertia_factorizations += 1
+        s = self.solver
+        if du is None:
+            return unstable_directions(s.tangent_form, s.bcs, self.prefix,
+                                       self.multipliers), 0.0
+        t = du.duplicate()
+        count = unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
+                                    rhs=self._q, solution=t)
+        sense = self._dot(du, t) + self.psi**2 * dlam
+        t.destroy()
+        return count, sense
+
+    def _back_to(self, state: PETSc.Vec, lam: float) -> None:
+        """u = state, λ = lam."""
+        x = self.solver.u.x.petsc_vec
+        state.copy(x)
+        x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        self.set_load(lam)
+
+    def _turns_back(self, du: PETSc.Vec, dlam: float, previous) -> bool:
+        """Whether the increment points against the last one (the path doubles back)."""
+        return self._dot(du, previous[0]) + self.psi**2 * dlam * previous[1] < 0
+
+    def _limit_point(self, path: ContinuationPath, arc: list[float], start: float) -> None:
+        """λ changed sense: a limit point, at the vertex of λ(s) through the last 3 states."""
+        lams = [start, *path.factors][-3:]
+        s = arc[-3:]
+        a, b, c = np.polyfit(s, lams, 2)
+        peak = c - b * b / (4 * a) if a != 0 else lams[1]
+        if not min(lams) - abs(lams[1]) <= peak <= max(lams) + abs(lams[1]):
+            peak = lams[1]
+        path.critical_points.append(CriticalPoint("limit", float(peak), len(path.factors),
+                                                  (lams[-2], lams[-1])))
+
+    def _critical_mode(self) -> PETSc.Vec:
+        """The tangent's eigenvector of its negative eigenvalue nearest 0 (SLEPc)."""
+        s = self.solver
+        _, mode = lowest_tangent_mode(s.tangent_form, s.bcs, s.u.function_space,
+                                      self.prefix, mass=self.mass,
+                                      multipliers=self.multipliers)
+        return mode.x.petsc_vec.copy()
+
+    def _land(self, target: float, before: PETSc.Vec, lam_old: float, lam: float,
+              work: WorkCounts, norms: list) -> int | None:
+        """Solve at λ = target under load control, from the nearer state; its iterations.
+
+        The same Newton variant and corrector as the arc, with δλ = 0. Not from the
+        interpolation of the two states: a chord between two rotated shapes of a slender
+        body stretches it, and its membrane stiffness makes that a large residual.
+        None (and u, λ as they were) if it fails.
+        """
+        s = self.solver
+        x = s.u.x.petsc_vec
+        end = x.copy()
+        start = before if abs(target - lam_old) < abs(lam - target) else end
+        self._back_to(start, target)
+        s.policy.start_solve()
+        if s.bfgs:
+            s.bfgs.clear()
+        self._load_vector(target, self._q, work)
+        du = x.duplicate()
+        du.set(0.0)
+        try:
+            return self._correct(start.copy(), target, du, 0.0, None, self._q,
+                                 self._q.norm(), None, work, norms)[2]
+        except _StepFailed as err:
+            log.info("landing at λ = %g failed: %s", target, err)
+            self._back_to(end, lam)
+            return None
+        finally:
+            du.destroy()
+            end.destroy()

@@ -1,0 +1,110 @@
+"""Arc-length continuation: the von Mises truss's exact curve, the beam's bifurcation."""
+
+import math
+
+import pytest
+from mpi4py import MPI
+
+from fenics_nl.scenes.beam import build_beam
+from fenics_nl.scenes.truss import VonMisesTruss
+from fenics_nl.solvers.arclength import ArcLength, ContinuationError
+from fenics_nl.theory import elastica
+from fenics_nl.theory import truss as exact
+
+A, H, EA = 1.0, 0.1, 1e6  # half-span, rise (a shallow truss: it snaps through), EA
+
+
+def trace(method, scale=1.0, target=1.5, comm=MPI.COMM_WORLD, max_steps=60, **options):
+    """The truss's path to λ = target (P_max units), lengths × `scale`; (truss, path, w, λ)."""
+    truss = VonMisesTruss(A * scale, H * scale, EA, exact.limit_load(EA, A, H), comm=comm)
+    solver = truss.newton(method=method, max_it=200, prefix=f"truss_{method}_")
+    options = {"arc_length": 0.2, **options}
+    arc = ArcLength(solver, truss.set_load, prefix="truss_arc_", **options)
+    states = []
+    path = arc.run(target, max_steps, on_step=lambda lam, r: states.append(
+        (truss.apex_deflection() / scale, lam)))
+    return truss, path, states
+
+
+@pytest.mark.parametrize("method", ["full", "modified", "periodic", "bfgs"])
+def test_the_truss_path_is_the_closed_form_through_both_limit_points(method):
+    P_max = exact.limit_load(EA, A, H)
+    _, path, states = trace(method)
+    # every converged state on P(w) to 1e-6 of P_max: the bars' P1 strain is exact, so
+    # this is the continuation's own accuracy (the Newton tolerance is 1e-10 of the load)
+    errors = [abs(lam * P_max - exact.load(w, EA, A, H)) / P_max for w, lam in states]
+    assert max(errors) < 1e-6
+    w1, w2 = exact.limit_displacements(H)
+    assert any(w1 < w < w2 for w, _ in states)  # on the unstable branch
+    assert states[-1][1] == 1.5 and states[-1][0] > H * (1 + 2 / math.sqrt(3))  # inverted
+    limits = [c for c in path.critical_points if c.kind == "limit"]
+    assert [round(c.factor) for c in limits] == [1, -1]
+    assert not [c for c in path.critical_points if c.kind == "bifurcation"]
+    # bracketed by the sense of λ along the tangent, to 1/32 of the arc: λ'' Δs² is small
+    assert abs(limits[0].factor - 1) < 1e-3 and abs(limits[1].factor + 1) < 1e-3
+    # between the limit points the tangent has one negative eigenvalue, else none
+    assert set(path.unstable) == {0, 1}
+    if method == "modified":  # one factorization per step tried (+ the landing's)
+        tried = len(path.results) + path.failures + path.bracketing_steps
+        assert path.work.factorizations == tried + 1
+    if method == "full":  # the constraint costs back-solves, not factorizations
+        assert path.work.linear_solves > path.work.factorizations
+
+
+def test_the_same_truss_in_millimetres_takes_the_same_steps():
+    _, metres, _ = trace("full")
+    _, millimetres, _ = trace("full", scale=1e3)
+    assert millimetres.factors == pytest.approx(metres.factors, rel=1e-8, abs=1e-10)
+    assert [r.iterations for r in millimetres.results] == [
+        r.iterations for r in metres.results]
+
+
+def test_bad_input_and_unreachable_targets_are_clear_errors():
+    truss = VonMisesTruss(A, H, EA, 1.0)
+    solver = truss.newton()
+    for bad in (0.0, -1.0, math.nan):
+        with pytest.raises(ValueError, match="arc length must be"):
+            ArcLength(solver, truss.set_load, arc_length=bad)
+    with pytest.raises(ContinuationError, match="not reached in 3 steps"):
+        trace("full", target=1e3, max_steps=3)
+    # modified Newton with arcs held at 8: the corrector lands behind where the path came
+    # from, so the step cannot be cut and the run stops
+    with pytest.raises(ContinuationError, match="doubles back onto itself"):
+        trace("modified", arc_length=8.0, min_arc_length=8.0, max_arc_length=8.0)
+
+
+def test_the_beam_leaves_the_straight_branch_at_its_bifurcation():
+    # a perfect beam (no imperfection): the straight path goes on past P_cr; the tangent's
+    # inertia changes there, the path is bracketed and left along the critical mode
+    beam = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
+    P_cr = beam.critical_loads(1)[0][0] / beam.P_euler  # SLEPc, not a closed form
+    path = beam.solve_arc_length(1.5)
+    assert path.switched
+    (bifurcation,) = path.critical_points
+    low, high = bifurcation.between
+    assert bifurcation.kind == "bifurcation" and low < P_cr < high and high - low < 0.05
+    tip = beam.tip()
+    alpha = math.degrees(abs(tip["rotation"]))
+    alpha_el = math.degrees(elastica.tip_rotation(1.5))
+    assert abs(alpha - alpha_el) < max(0.5, 0.01 * alpha_el)
+    assert abs(tip["lateral"]) == pytest.approx(elastica.tip_position(1.5)[0], rel=0.01)
+
+
+@pytest.mark.mpi
+def test_the_beam_path_on_two_ranks_is_the_serial_one():
+    assert MPI.COMM_WORLD.size > 1
+
+    def run(comm):
+        beam = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0, comm=comm)
+        path = beam.solve_arc_length(1.2)
+        return beam.tip(), path
+
+    (tp, pp), (ts, ps) = run(MPI.COMM_WORLD), run(MPI.COMM_SELF)
+    assert pp.switched and ps.switched
+    # the same states up to the switch (after it, a step's iteration count can differ by
+    # round-off, and with it the next arc); the mode's sign may differ: compare |α|
+    switch = pp.critical_points[0].step
+    assert pp.factors[:switch] == pytest.approx(ps.factors[:switch], rel=1e-8)
+    assert pp.critical_points[0].between == pytest.approx(ps.critical_points[0].between,
+                                                          rel=1e-8)
+    assert abs(tp["rotation"]) == pytest.approx(abs(ts["rotation"]), rel=1e-6)
