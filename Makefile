@@ -24,7 +24,8 @@ $(VENV)/.bench-installed: $(VENV)/.installed
 	$(PY) -m pip install --quiet --no-deps $(PEER)
 	@touch $@
 
-# the three scenes at small sizes and the scalar demo, pictures and JSON in results/
+# the three scenes at small sizes, the snap-through and the scalar demo, pictures and JSON
+# in results/
 # (about 1 min on 2 cores; the bracket runs on 2 ranks)
 demo: $(VENV)/.installed
 	@mkdir -p results
@@ -36,6 +37,8 @@ demo: $(VENV)/.installed
 	  --plot results/bracket_curve.png --json results/bracket.json
 	$(PY) demos/newton_scalar.py --plot results/newton_orders.png --json results/newton.json \
 	  > results/newton_scalar.txt
+	$(PY) demos/snap_through.py --plot results/snap_through.png --png results/snap_shapes.png \
+	  --json results/snap_through.json
 	$(PY) -m fenics_nl run cases/thick_cylinder.toml --png results/thick_cylinder.png \
 	  --json results/thick_cylinder.json
 	@echo "make demo: pictures (*.png) and results (*.json) in $(CURDIR)/results/"
@@ -52,7 +55,8 @@ test-mpi: $(VENV)/.installed
 # README tables and the "which method when" reading regenerated from them;
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
-BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed friction
+BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed friction \
+	continuation
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done

@@ -25,6 +25,13 @@
 # again (branch switching); if Newton cannot follow, the path is redone with 4 times the
 # steps (up to 256), and only then does the run stop with a clear message.
 #
+# With `--path arc-length` the load is an unknown beside $u$ (Crisfield's arc-length
+# continuation, `fenics_nl.solvers.arclength`) and no closed form is used: the number of
+# negative eigenvalues of the tangent (its inertia, from an $LDL^T$ factorization) is
+# counted at every state; where it changes while the load keeps growing, the path has
+# crossed a bifurcation, which is bracketed and left along the tangent's critical mode by
+# one arc length. With `--imperfection 0` the beam is perfect and this is how it buckles.
+#
 # ## Implementation
 
 # +
@@ -82,6 +89,14 @@ def parser():
                    help="equal load steps to the final load (a failed step is cut in half)")
     p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"], default="full",
                    help="Newton variant of each load step")
+    p.add_argument("--path", choices=["load", "arc-length"], default="load",
+                   help="load control (steps of P, end state checked and switched with the "
+                        "elastica's deflection if unstable) or arc-length continuation "
+                        "(bifurcation found by the tangent's inertia and left along its mode: "
+                        "no closed form)")
+    p.add_argument("--arc-length", type=cli.finite, default=0.2,
+                   help="with --path arc-length: the first arc length, > 0 (dimensionless, "
+                        "about one load step of Δs/√2 P_Euler on the straight branch) [-]")
     p.add_argument("--imperfection", type=cli.finite, default=1e-4,
                    help="lateral end load as a fraction of P [-], in [0, 0.1)")
     p.add_argument("--refine", type=cli.at_least(0), default=0,
@@ -103,6 +118,8 @@ if not 0 <= args.imperfection < 0.1:
     p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
 if args.material == "neo-hookean" and args.plane == "stress":
     p.error("neo-hookean is implemented in plane strain only (--plane strain)")
+if not args.arc_length > 0:
+    p.error(f"--arc-length must be > 0, got {args.arc_length}")
 if args.mixed and args.plane == "stress":
     p.error("--mixed needs --plane strain (in plane stress the out-of-plane strain takes "
             "the volume change: nothing locks)")
@@ -210,12 +227,22 @@ def record(t, result):
         shapes.append((r, centreline(beam)))
 
 
-say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
-path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                 on_step=record, progress=progress(args.steps))
-redone = [] if beam.path_steps == args.steps else [
-    f"the {args.steps}-step path ended on the straight (unstable) branch; it was redone "
-    f"with {beam.path_steps} steps"]
+redone, critical = [], []
+if args.path == "load":
+    say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
+    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
+                                     on_step=record, progress=progress(args.steps))
+    if beam.path_steps != args.steps:
+        redone.append(f"the {args.steps}-step path ended on the straight (unstable) branch; "
+                      f"it was redone with {beam.path_steps} steps")
+else:  # λ = P/P_Euler is an unknown of the arc-length path
+    say(f"arc-length path to P/P_cr = {args.load_ratio:g} (first arc {args.arc_length:g})")
+    path = beam.solve_arc_length(args.load_ratio, args.newton, arc_length=args.arc_length,
+                                 on_step=lambda lam, r: record(lam / args.load_ratio, r),
+                                 progress=progress(40))
+    switched = path.switched
+    critical = [{"kind": c.kind, "load_ratio": c.factor, "between": list(c.between)}
+                for c in path.critical_points]
 # -
 
 # ### Against the elastica
@@ -242,6 +269,8 @@ out = {
     "load_steps": len(path.factors), "step_cuts": path.failures,
     "newton_iterations": sum(r.iterations for r in path.results),
     "factorizations": path.work.factorizations, "branch_switched": switched,
+    "path_control": args.path, "critical_points": critical,
+    "inertia_factorizations": getattr(path, "inertia_factorizations", 0),
     "newton": args.newton, "mixed": args.mixed, "reactions": beam.reactions(),
     "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
     "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}

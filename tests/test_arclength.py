@@ -51,6 +51,21 @@ def test_the_truss_path_is_the_closed_form_through_both_limit_points(method):
         assert path.work.linear_solves > path.work.factorizations
 
 
+@pytest.mark.parametrize("method", ["full", "modified"])
+def test_the_constraint_costs_back_solves_not_factorizations(method):
+    # per converged step (the last one also lands, so it is left out): full Newton
+    # factorizes at u_n for the predictor, then once per iteration, and solves twice per
+    # iteration (−R and q: the bordered solve); modified factorizes once and back-solves q
+    # once per step, then −R once per iteration
+    _, path, _ = trace(method)
+    for r in path.results[:-1]:
+        k, w = r.iterations, r.work
+        if method == "full":
+            assert (w.factorizations, w.linear_solves) == (1 + k, 1 + 2 * k)
+        else:
+            assert (w.factorizations, w.linear_solves) == (1, 1 + k)
+
+
 def test_the_same_truss_in_millimetres_takes_the_same_steps():
     _, metres, _ = trace("full")
     _, millimetres, _ = trace("full", scale=1e3)
@@ -73,12 +88,15 @@ def test_bad_input_and_unreachable_targets_are_clear_errors():
         trace("modified", arc_length=8.0, min_arc_length=8.0, max_arc_length=8.0)
 
 
-def test_the_beam_leaves_the_straight_branch_at_its_bifurcation():
+@pytest.mark.parametrize("method", ["full", "modified", "bfgs"])
+def test_the_beam_leaves_the_straight_branch_at_its_bifurcation(method):
     # a perfect beam (no imperfection): the straight path goes on past P_cr; the tangent's
-    # inertia changes there, the path is bracketed and left along the critical mode
+    # inertia changes there, the path is bracketed and left along the critical mode (for
+    # modified Newton and BFGS the constant tangent is taken after the kick, not at the
+    # bifurcation, where it is singular along the mode)
     beam = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
     P_cr = beam.critical_loads(1)[0][0] / beam.P_euler  # SLEPc, not a closed form
-    path = beam.solve_arc_length(1.5)
+    path = beam.solve_arc_length(1.5, method)
     assert path.switched
     (bifurcation,) = path.critical_points
     low, high = bifurcation.between

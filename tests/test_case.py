@@ -361,3 +361,51 @@ def test_j2_bar_loaded_and_unloaded_keeps_its_permanent_strain(tmp_path, demo):
     assert [s["load_factor"] for s in d["steps"]] == [0.5, 1.0, 0.0]
     assert ux == pytest.approx([10 * 30.0 / 1000.0, 10 * loaded, 10 * permanent], rel=1e-9)
     assert d["reactions"]["x0"][0] == pytest.approx(0.0, abs=1e-9 * 60)
+
+
+def test_arc_length_control_follows_the_arch_through_its_snap(demo):
+    # load control stops at the limit point; the arc-length path goes through it, down the
+    # unstable branch and up the inverted one, to the target
+    d = demo.case(CASES / "shallow_arch.toml")
+    loads = [s["load_factor"] for s in d["steps"]]
+    assert d["load_factor"] == 3.0 and max(loads) < 3.0 + 1e-12
+    top = next(k for k in range(len(loads) - 1) if loads[k + 1] < loads[k])
+    assert min(loads[top:]) < 0.5 * loads[top]  # the load fell past the limit point
+    kinds = [c["kind"] for c in d["critical_points"]]
+    assert kinds.count("limit") == 2
+    crown = d["probes"]["crown"]["displacement"][1]
+    assert crown < -2 * 30.0  # inverted: below the chord, as far as it rose above it
+
+
+def test_arc_length_control_on_a_linear_problem_is_load_control(tmp_path, demo):
+    # no critical point on the thick cylinder: the arc lands on the same state
+    text = (CASES / "thick_cylinder.toml").read_text().replace(
+        "[loading]\nsteps = 1", '[loading]\ncontrol = "arc-length"\ntarget = 1.0')
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    arc = demo.case(write(tmp_path, "arc.toml", text))
+    load = demo.case(CASES / "thick_cylinder.toml")
+    assert arc["critical_points"] == []
+    for name in ("inner", "outer"):
+        assert arc["probes"][name]["displacement"] == pytest.approx(
+            load["probes"][name]["displacement"], rel=1e-8, abs=1e-15)
+
+
+@pytest.mark.parametrize("change,message", [
+    ("steps = 2\ncontrol = \"arc-length\"", 'loading.steps: not with control = "arc-length"'),
+    ('control = "arc-length"\narc_length = 0.0', "loading.arc_length: must be > 0"),
+    ('control = "arc-length"\ntarget = 0.0', "loading.target: must not be 0"),
+    ('control = "arc-length"\nmax_arc_length = 0.01', "loading.max_arc_length: must be >= "),
+    ("steps = 2\ntarget = 2.0", 'loading.target: only with control = "arc-length"'),
+])
+def test_arc_length_parameters_are_checked(tmp_path, demo, change, message):
+    write(tmp_path, "bar.geo", BAR_GEO)
+    lines = check(demo, tmp_path, BAR.replace("steps = 2", change))
+    assert any(message in line for line in lines), lines
+
+
+def test_arc_length_refuses_what_it_cannot_scale(tmp_path, demo):
+    lines = check(demo, tmp_path, SQUARE.replace(
+        "steps = 1", 'control = "arc-length"').replace(
+        'group = "middle"\ntraction = [1.0, 0.0]', 'group = "middle"\ndisplacement = [0.1, '
+                                                  '"free"]'), geo=SPLIT_GEO)
+    assert any("arc-length control scales loads only" in line for line in lines), lines

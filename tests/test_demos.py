@@ -51,13 +51,14 @@ def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
 
 
 @pytest.mark.parametrize("name", ["newton_scalar.py", "punch.py", "buckling_beam.py",
-                                  "pressure_vessel.py",
+                                  "pressure_vessel.py", "snap_through.py",
                                   "bracket.py"])
 def test_help_describes_the_demo_and_states_defaults_once(demo, name):
     text = demo.run([name, "--help"]).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
     prefix = {"punch.py": "-punch_axisymmetric_elim_ksp_view", "buckling_beam.py":
-              "-beam_buckling_", "bracket.py": "-bracket_elim_"}.get(name)
+              "-beam_buckling_", "bracket.py": "-bracket_elim_",
+              "snap_through.py": "-arch_continuation_"}.get(name)
     if prefix:  # the PETSc options prefixes are documented
         assert prefix in " ".join(text.split())
 
@@ -263,6 +264,57 @@ def test_beam_stress_cases_land_on_the_right_branch(args, demo, on_elastica):
     # One huge step converges to the unstable straight beam; the stability check sees it
     # and switches branch. r = 10 is deep in the post-buckling range (α ≈ 177°).
     on_elastica(demo.beam(*args))
+
+
+def test_beam_arc_length_buckles_the_perfect_beam_without_the_elastica(demo, on_elastica):
+    # no imperfection: the path stays straight past P_cr until the tangent's inertia
+    # changes; the bifurcation is bracketed there and left along the critical mode
+    d = demo.beam("--path", "arc-length", "--imperfection", "0", "--load-ratio", "1.2")
+    on_elastica(d)
+    assert d["branch_switched"] and d["path_control"] == "arc-length"
+    (c,) = d["critical_points"]
+    ratio = d["critical_load"] / d["euler_critical_load"]  # SLEPc's, in P_Euler
+    assert c["kind"] == "bifurcation" and c["between"][0] < ratio < c["between"][1]
+    assert d["inertia_factorizations"] >= d["load_steps"]
+
+
+def test_snap_through_follows_the_shallow_arch_through_both_limit_points(tmp_path, demo):
+    d = demo.json("snap_through.py", "--plot", "p.png", "--png", "s.png")
+    # the continuum against thin shallow-arch theory at L/h = 200: -0.48 % (it halves
+    # when L/h doubles: the theory's own error); 2 % is the bound
+    assert abs(d["limit_load_rel_error"]) < 0.02
+    assert d["path_max_error"] < 0.02  # every state, on the cubic at its own rise
+    assert [c["kind"] for c in d["critical_points"]] == ["limit", "limit"]
+    ref = d["limit_load_reference"] / d["load_unit"]
+    assert d["final_load_factor"] == pytest.approx(1.5 * ref, rel=1e-12)
+    assert d["final_rise"] < -d["rise"]  # inverted, past the second limit point
+    from fenics_nl.theory.arch import limit_rise
+
+    unstable = [p for p in d["path"] if abs(p["rise"]) < limit_rise(d["rise"])]
+    assert len(unstable) >= 5  # the branch between the limit points is traced
+    (lx, ly), (rx, ry) = d["reactions"]["left pin"], d["reactions"]["right pin"]
+    q_total = 2 / math.pi * 1.5 * d["limit_load_reference"]  # ∫ q0 sin(πx/L) dx, L = 1
+    assert ly + ry == pytest.approx(q_total, rel=1e-6) and lx == pytest.approx(-rx, rel=1e-6)
+    assert (tmp_path / "p.png").stat().st_size > 10_000 and (tmp_path / "s.png").exists()
+
+
+def test_snap_through_two_ranks_match_serial(demo):
+    args = ("--slenderness", "100", "--load-ratio", "1.1")
+    s, p = demo.json("snap_through.py", *args), demo.json("snap_through.py", *args, ranks=2)
+    assert p["ranks"] == 2
+    assert p["limit_load"] == pytest.approx(s["limit_load"], rel=1e-8)
+    assert p["final_rise"] == pytest.approx(s["final_rise"], rel=1e-6)
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--arc-length", "0"], "--arc-length must be > 0"), (["--rise", "1.5"], "--rise"),
+    (["--max-steps", "3"], "not reached in 3 steps"), (["--slenderness", "5"], "slenderness"),
+    (["-arch_full_ksp_veiw"], "was read by no solver"),
+])
+def test_snap_through_bad_input_one_clear_line(args, message, demo):
+    proc = demo.run(["snap_through.py", *args], check=False)
+    assert proc.returncode != 0
+    assert message in proc.stderr and "Traceback" not in proc.stderr
 
 
 def test_beam_two_ranks_match_serial(demo):

@@ -9,6 +9,7 @@ from fenics_nl.case.problem import CaseProblem
 from fenics_nl.io import output
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
+from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
@@ -32,7 +33,10 @@ def solve_case(problem: CaseProblem) -> dict:
         if not message.startswith("step "):
             say("  " + message)
 
-    if case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
+    critical = None
+    if case.arc is not None:  # the load factor is an unknown: through limit points
+        critical = _follow_path(problem, solver, steps, work, commit, show)
+    elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
         path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
                                    max_step=1.0 / n, progress=show, commit=commit,
@@ -59,10 +63,32 @@ def solve_case(problem: CaseProblem) -> dict:
            "factorizations": work.factorizations, "tangent_assemblies": work.tangent_assemblies,
            "probes": last["probes"], "reactions": last["reactions"],
            "warnings": warnings(problem)}
+    if critical is not None:
+        out["critical_points"] = critical
     if problem.contact is not None:
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
         out["contact_force"] = last["contact_force"]
     return out
+
+
+def _follow_path(problem: CaseProblem, solver, steps: list, work: WorkCounts, commit,
+                 show) -> list[dict]:
+    """`loading.control = "arc-length"`: the path to the target; its critical points."""
+    arc = problem.case.arc
+    mixed = problem.mixed
+    continuation = ArcLength(
+        solver, problem.set_load, arc_length=arc["arc_length"],
+        max_arc_length=arc["max_arc_length"], commit=commit, prefix="case_continuation_",
+        metric_dofs=mixed.displacement_dofs if mixed else None,
+        multipliers=mixed.pressure_dofs if mixed else 0)
+    path = continuation.run(arc["target"], arc["max_steps"], progress=show,
+                            on_step=lambda t, r: steps.append(step_record(problem, t, r)))
+    work.add(path.work)
+    for c in path.critical_points:
+        say(f"  {c.kind} point at load factor {c.factor:.6g} (between {c.between[0]:.6g} "
+            f"and {c.between[1]:.6g})")
+    return [{"kind": c.kind, "load_factor": c.factor, "between": list(c.between)}
+            for c in path.critical_points]
 
 
 def step_record(problem: CaseProblem, t: float, result) -> dict:

@@ -56,6 +56,13 @@ contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
 steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
+# or path following through limit points (loads only: no prescribed displacement, no
+# contact; the load factor is an unknown, and the tangent's inertia is checked each step):
+# control = "arc-length"
+# target = 1.0           # the load factor to reach (the path may pass it going down first)
+# arc_length = 0.1       # the first arc length, > 0 (dimensionless: about one load step)
+# max_arc_length = 1.0   # optional: the largest (default: no bound)
+# max_steps = 100        # optional: steps before the run stops short of the target
 
 [solver]                 # every key optional
 newton = "full"          # full | modified | periodic | quasi-newton | snes
@@ -125,6 +132,8 @@ class Case:
     factors: list[float]  # the load factors to reach, in order
     adaptive: bool
     equal_steps: bool  # factors are k/n (loading.steps = n)
+    arc: dict | None = None  # control = "arc-length": target, arc_length, max_arc_length,
+    # max_steps
     newton: str = "full"
     linear: str = "direct"
     tolerance: float = 1e-9
@@ -264,7 +273,7 @@ def read_case(path: str | Path) -> Case:
     if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"):
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
-    factors, adaptive = _loading(r, data)
+    factors, adaptive, arc = _loading(r, data)
     s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
                 required=False)
     newton = r.get(s, "newton", "solver", str, default="full", choices=NEWTON)
@@ -276,12 +285,20 @@ def read_case(path: str | Path) -> Case:
     if newton == "snes" and any(c.kind == "contact" for c in conditions):
         r.fail("solver.newton", '"snes" cannot run the contact active-set loop: use full, '
                                 "modified, periodic or quasi-newton")
+    if arc is not None:
+        if newton == "snes":
+            r.fail("solver.newton", '"snes" has no arc-length control: use full, modified, '
+                                    "periodic or quasi-newton")
+        for c in conditions:
+            if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
+                r.fail(f"{c.key}", "arc-length control scales loads only: a contact or a "
+                                   "prescribed non-zero displacement cannot take part")
     probes = _probes(r, data, dim)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
-                adaptive, equal, newton, linear, tolerance, max_it, probes, formulation)
+                adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation)
 
 
 def _material(r: _Reader, data: dict, model: str | None):
@@ -405,28 +422,57 @@ def _obstacle(r: _Reader, table, key: str, dim: int):
 
 
 def _loading(r: _Reader, data: dict):
-    t = r.table(data, "loading", ("steps", "adaptive"))
+    t = r.table(data, "loading", ("steps", "adaptive", "control", *ARC_KEYS))
+    control = r.get(t, "control", "loading", str, default="load",
+                    choices=("load", "arc-length"))
+    if control == "arc-length":
+        return [], True, _arc_length(r, t)
+    for k in ARC_KEYS:
+        if k in t:
+            r.fail(f"loading.{k}", 'only with control = "arc-length"')
     adaptive = r.get(t, "adaptive", "loading", bool, default=True)
     steps = t.get("steps")
     if steps is None:
         if t:
             r.fail("loading.steps", "missing")
-        return [], adaptive
+        return [], adaptive, None
     if isinstance(steps, int) and not isinstance(steps, bool):
         if steps < 1:
             r.fail("loading.steps", f"must be >= 1, got {steps}")
-            return [], adaptive
-        return [k / steps for k in range(1, steps + 1)], adaptive
+            return [], adaptive, None
+        return [k / steps for k in range(1, steps + 1)], adaptive, None
     factors = r.vector(steps, "loading.steps", len(steps)) if isinstance(steps, list) else None
     if factors is None:
         if not isinstance(steps, list):
             r.fail("loading.steps", f"must be an integer or a list of load factors, got "
                                     f"{steps!r}")
-        return [], adaptive
+        return [], adaptive, None
     if not factors or any(a == b for a, b in zip([0.0, *factors], factors, strict=False)):
         r.fail("loading.steps", "load factors must be a non-empty list, each different from "
                                 "the one before (the first from 0)")
-    return factors, adaptive
+    return factors, adaptive, None
+
+
+ARC_KEYS = ("target", "arc_length", "max_arc_length", "max_steps")
+
+
+def _arc_length(r: _Reader, t: dict) -> dict | None:
+    """The parameters of control = "arc-length" (`solvers.arclength.ArcLength`)."""
+    for k in ("steps", "adaptive"):
+        if k in t:
+            r.fail(f"loading.{k}", 'not with control = "arc-length" (the arc adapts itself; '
+                                   "give target, arc_length, max_arc_length, max_steps)")
+    arc = {"target": r.get(t, "target", "loading", float, default=1.0),
+           "arc_length": r.get(t, "arc_length", "loading", float, default=0.1, positive=True),
+           "max_arc_length": r.get(t, "max_arc_length", "loading", float, default=None,
+                                   positive=True),
+           "max_steps": r.get(t, "max_steps", "loading", int, default=100, minimum=1)}
+    if arc["target"] == 0:
+        r.fail("loading.target", "must not be 0 (the path starts there)")
+    top, first = arc["max_arc_length"], arc["arc_length"]
+    if top is not None and first is not None and top < first:
+        r.fail("loading.max_arc_length", f"must be >= arc_length ({first}), got {top}")
+    return arc
 
 
 def _probes(r: _Reader, data: dict, dim: int) -> list[Probe]:

@@ -46,6 +46,11 @@ from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
+# eigenvalues of the tangent within this fraction of its largest diagonal entry count as
+# zero: near a bifurcation point round-off puts them on either side, and the inertia
+# would flicker (the critical load is then found later by about this fraction of the
+# critical mode's eigenvalue at rest)
+INERTIA_MARGIN = 1e-12
 # the iterations a step should take, per variant: fewer and the arc grows, more and it shrinks
 DESIRED_ITERATIONS = {"full": 5, "periodic": 8, "bfgs": 12, "modified": 20}
 
@@ -371,7 +376,8 @@ class ArcLength:
         path = ContinuationPath()
         lam, ds = start, self.arc_length
         previous, kick = None, None  # the last step's (Δu, Δλ); a mode to leave along
-        bracket = None  # bracketing a bifurcation: (the arc short enough, the arc it had)
+        bracket = None  # bracketing an event: (the arc short enough, the arc it had, the
+        # steps taken since without meeting it)
         arc = [0.0]  # arc length along the path at each state
         self.set_load(lam)
         count, sense = self._stability(path) if self.detect else (0, 1.0)
@@ -402,7 +408,7 @@ class ArcLength:
                 bifurcation = changed and not turned
                 leave = bifurcation and self.switch and not path.switched and new > count
                 if turned or leave:
-                    bracket = bracket or (ds / 32, ds)
+                    bracket = bracket or (ds / 32, ds, 0)
                     if ds > bracket[0]:  # bracket it closer: back, with half the arc
                         du.destroy()
                         self._back_to(before, lam)
@@ -470,6 +476,10 @@ class ArcLength:
                 if landed:
                     return path
                 x.copy(before)
+                if bracket is not None and not (turned or leave):
+                    bracket = (bracket[0], bracket[1], bracket[2] + 1)
+                    if bracket[2] > 3:  # the event did not come back: it was not there
+                        ds, bracket = bracket[1], None
                 if kick is None and bracket is None:
                     ds = min(self.max_arc_length,
                              ds * min(2.0, max(0.5, math.sqrt(self.desired / max(its, 1)))))
@@ -506,11 +516,11 @@ class ArcLength:
         path.inertia_factorizations += 1
         s = self.solver
         if du is None:
-            return unstable_directions(s.tangent_form, s.bcs, self.prefix,
-                                       self.multipliers), 0.0
+            return unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
+                                       margin=INERTIA_MARGIN), 0.0
         t = du.duplicate()
         count = unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
-                                    rhs=self._q, solution=t)
+                                    rhs=self._q, solution=t, margin=INERTIA_MARGIN)
         sense = self._dot(du, t) + self.psi**2 * dlam
         t.destroy()
         return count, sense

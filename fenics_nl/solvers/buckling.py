@@ -135,14 +135,19 @@ def negative_eigenvalues(A: PETSc.Mat, prefix: str, rhs: PETSc.Vec | None = None
 
 def unstable_directions(a_T: ufl.Form, bcs, prefix: str = "stability_",
                         multipliers: int = 0, rhs: PETSc.Vec | None = None,
-                        solution: PETSc.Vec | None = None) -> int:
-    """The number of negative eigenvalues of the tangent K_T, less `multipliers`.
+                        solution: PETSc.Vec | None = None, margin: float = 0.0) -> int:
+    """The number of eigenvalues of K_T below −margin·max diag K_T, less `multipliers`.
 
     0 on a stable equilibrium; it changes by one where the path crosses a limit point or a
     bifurcation. One assembly and one LDLᵀ factorization (`negative_eigenvalues`); with
-    `rhs` (zero on the Dirichlet rows), also `solution` = K_T⁻¹ rhs.
+    `rhs` (zero on the Dirichlet rows), also `solution` = (K_T + margin·max diag)⁻¹ rhs.
+    A small `margin` counts an eigenvalue that round-off puts on either side of 0 as 0.
     """
     K = _stiffness(a_T, bcs)
+    if margin:
+        diagonal = K.getDiagonal()
+        K.shift(margin * diagonal.max()[1])
+        diagonal.destroy()
     count = negative_eigenvalues(K, f"{prefix}inertia_", rhs, solution) - multipliers
     K.destroy()
     return count

@@ -1,0 +1,270 @@
+# # Snap-through of a shallow arch: arc-length continuation through a limit point
+#
+# A shallow pinned arch under a downward load can carry it only up to a *limit point*; past
+# it the equilibrium path turns back (the load falls while the arch flattens), goes through
+# the flat and inverted shapes, and rises again once the arch hangs. Load control stops at
+# the limit point: no state beyond it carries a larger load. Arc-length control follows
+# the path by its length and traces the whole of it, the unstable branch included.
+#
+# ## Problem definition
+#
+# The arch of span $L$ and thickness $h$ follows $y_0 = e \sin(\pi x/L)$ and carries
+# $q(x) = q_0 \sin(\pi x/L)$ per unit span. Shallow-arch theory (Fung & Kaplan 1952,
+# NACA TN 2840; Simitses 1976, ch. 7) gives the midspan rise $a$ in closed form: with
+# $k = \pi/L$, $r = h/\sqrt{12}$, $\bar a = a/r$, $\bar e = e/r$,
+#
+# $$ \frac{q_0}{EI k^4 r} = (\bar e - \bar a) + \frac{(\bar e^2 - \bar a^2)\,\bar a}{4}, $$
+#
+# a cubic whose maximum, at $\bar a = \sqrt{(\bar e^2 - 4)/3}$, is the limit load, for
+# $2 < \bar e < \sqrt{22}$ (beyond it an antisymmetric bifurcation comes first). The model
+# here is a 2D continuum (Q2, plane stress, St Venant–Kirchhoff at finite strain), pinned
+# at the centreline of each end.
+#
+# Arc-length (Crisfield): the load factor $\lambda$ becomes an unknown with the constraint
+# $\|\Delta u\|^2/u_{ref}^2 + \psi^2 \Delta\lambda^2 = \Delta s^2$; each corrector iteration
+# is a bordered solve (two back-solves on the tangent of the chosen Newton variant). Limit
+# points are told by the sign of $\lambda$ along the path's tangent, and bracketed.
+#
+# ## Implementation
+
+# +
+import sys
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+from mpi4py import MPI
+
+from fenics_nl.io import cli, output, pictures
+from fenics_nl.io.cli import say
+from fenics_nl.scenes.arch import ShallowArch
+from fenics_nl.solvers.arclength import ArcLength
+from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.theory import arch as theory
+
+if __name__ == "__main__":  # `python demos/snap_through.py [options]`: the cells below,
+    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
+
+comm = MPI.COMM_WORLD
+# -
+
+# ### Parameters
+#
+# From the command line (`python demos/snap_through.py --help`); in a notebook, the
+# defaults. PETSc options take the prefix `-arch_` (`-arch_full_ksp_view`, ...).
+
+# +
+def parser():
+    """Every parameter of the scene, with its unit and default."""
+    p = cli.parser(
+        "Snap-through of a shallow sinusoidal arch under a sinusoidal load, traced by "
+        "arc-length continuation and checked against the shallow-arch closed form. Units "
+        "are the user's, consistent (e.g. N, m, Pa).",
+        epilog="PETSc options take the prefix -arch_<newton>_ (Newton's KSP, e.g. "
+               "-arch_full_ksp_view) and -arch_continuation_ (the stability checks' "
+               "factorizations and eigensolver).")
+    p.add_argument("--span", type=cli.positive, default=1.0, help="span L [length]")
+    p.add_argument("--slenderness", type=cli.positive, default=200.0,
+                   help="L/h, at least 20 (the closed form is a thin-arch theory)")
+    p.add_argument("--rise", type=cli.positive, default=3.0,
+                   help="e/r: the rise over the section's radius of gyration r = h/√12, "
+                        "in (2, 4.69) for a symmetric snap-through [-]")
+    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
+    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
+    p.add_argument("--load-ratio", type=cli.finite, default=1.5,
+                   help="the path is followed until q0 = ratio × the limit load [-]")
+    p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"],
+                   default="full", help="Newton variant of the corrector")
+    p.add_argument("--arc-length", type=cli.finite, default=0.2,
+                   help="first arc length Δs, > 0 (dimensionless: about one load step of "
+                        "Δs/√(1+ψ²) on a linear path) [-]")
+    p.add_argument("--max-arc-length", type=cli.finite, default=1.0,
+                   help="largest arc length (the adaptive Δs grows after easy steps) [-]")
+    p.add_argument("--psi", type=cli.finite, default=1.0,
+                   help="weight of the load factor in the arc: 1 spherical, 0 cylindrical")
+    p.add_argument("--max-steps", type=cli.at_least(1), default=300,
+                   help="steps before the run stops short of its target")
+    p.add_argument("--elements", type=cli.at_least(2), default=2,
+                   help="Q2 elements through the thickness (even)")
+    p.add_argument("--aspect", type=cli.positive, default=4.0,
+                   help="element length over element height along the span")
+    cli.add_outputs(p, output="the final displacement",
+                    png="the deformed arch at states along the path",
+                    plot="load against midspan rise, FE and closed form")
+    return p
+
+
+p = parser()
+args = cli.arguments(p, prefixes={"arch_": "Newton and the stability checks"})
+if args.slenderness < 20:
+    p.error(f"--slenderness must be >= 20, got {args.slenderness}")
+if not 2 < args.rise:
+    p.error(f"--rise must be > 2 for a snap-through (e/r <= 2 never snaps), got {args.rise}")
+if not args.arc_length > 0:
+    p.error(f"--arc-length must be > 0, got {args.arc_length}")
+if not args.max_arc_length >= args.arc_length:
+    p.error(f"--max-arc-length must be >= --arc-length, got {args.max_arc_length}")
+if args.psi < 0:
+    p.error(f"--psi must be >= 0, got {args.psi}")
+if args.load_ratio == 0:
+    p.error("--load-ratio must not be 0 (the path starts there)")
+# -
+
+# ### The arch
+#
+# Q2 quadrilaterals on the strip around $y_0$, pinned at the centreline of each end; the
+# load on the top face, per unit span.
+
+arch = ShallowArch(args.span, args.span / args.slenderness, args.rise, args.E, args.nu,
+                   elements=args.elements, aspect=args.aspect)
+q_limit = theory.limit_load(args.rise)  # in units of EI k⁴ r, the scene's load factor
+say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {arch.dofs} unknowns; limit "
+    f"load (closed form) q0 = {q_limit:.5g} EI k^4 r at rise a/r = "
+    f"{theory.limit_rise(args.rise):.4g}")
+
+# ### The path
+#
+# Arc-length continuation until $q_0$ reaches the target, with a stability check at each
+# state (the tangent's inertia) that tells limit points from bifurcations.
+
+# +
+# atol 1e-8: the arch's membrane forces are ~1e5 times its load, and their round-off is
+# what the residual can reach
+solver = NewtonSolver(arch.residual, arch.u, arch.bcs, method=args.newton, rtol=1e-8,
+                      atol=1e-8, max_it=30 if args.newton == "full" else 300,
+                      prefix=f"arch_{args.newton}_")
+continuation = ArcLength(solver, arch.set_load, arc_length=args.arc_length, psi=args.psi,
+                         max_arc_length=args.max_arc_length, prefix="arch_continuation_")
+history = [(0.0, args.rise)]  # (q0 / (EI k⁴ r), a/r)
+shapes = [(0.0, arch.centreline())] if args.png else []
+
+
+def record(lam, result):
+    history.append((lam, arch.midspan_rise()))
+    if args.png:
+        shapes.append((lam, arch.centreline()))
+
+
+def progress(message):
+    if not message.startswith("step ") or int(message.split()[1].rstrip(":")) % 10 == 0:
+        say("  " + message)
+
+
+target = args.load_ratio * q_limit
+say(f"arc-length path to q0 = {args.load_ratio:g} x the limit load ({args.newton} Newton)")
+path = continuation.run(target, args.max_steps, on_step=record, progress=progress)
+# -
+
+# ### Against the closed form
+#
+# The limit load, and the load at every computed state against the cubic at the same rise.
+
+# +
+limits = [c for c in path.critical_points if c.kind == "limit"]
+h = np.array(history)
+reference = np.array([theory.load(a, args.rise) for a in h[:, 1]])
+path_error = float(np.max(np.abs(h[:, 0] - reference)) / q_limit)
+warnings = []
+if not theory.symmetric_snap(args.rise):
+    warnings.append(f"e/r = {args.rise:g} > √22: an antisymmetric bifurcation precedes the "
+                    "limit point; the closed form is the symmetric path only")
+if args.slenderness < 100:
+    warnings.append("the closed form is a thin-arch theory: at L/h < 100 the continuum "
+                    "differs from it by about 1 % or more")
+first = limits[0].factor if limits else None
+if first is None:
+    warnings.append("no limit point was met before the target (is the target below it?)")
+    say("no limit point met")
+else:
+    say(f"limit load q0 = {first:.5g} EI k^4 r (closed form {q_limit:.5g}, "
+        f"{100 * (first / q_limit - 1):+.2f} %)")
+say(f"{len(path.factors)} steps, {path.iterations} iterations, {path.work.factorizations} "
+    f"factorizations (+{path.inertia_factorizations} for the stability checks), "
+    f"{path.failures} cuts; largest gap to the closed form along the path "
+    f"{100 * path_error:.2f} % of the limit load")
+load_unit = arch.q0  # q0 per unit load factor, in force/length²
+out = {
+    "limit_load": first * load_unit if first is not None else None,
+    "limit_load_reference": q_limit * load_unit,
+    "limit_load_rel_error": first / q_limit - 1 if first is not None else None,
+    "load_unit": load_unit, "rise": args.rise, "slenderness": args.slenderness,
+    "newton": args.newton, "critical_points": [
+        {"kind": c.kind, "load_factor": c.factor, "step": c.step,
+         "between": list(c.between)} for c in path.critical_points],
+    "path_max_error": path_error, "load_steps": len(path.factors),
+    "iterations": path.iterations, "factorizations": path.work.factorizations,
+    "inertia_factorizations": path.inertia_factorizations, "step_cuts": path.failures,
+    "final_load_factor": path.factors[-1], "final_rise": history[-1][1],
+    "reactions": arch.reactions(),
+    "reactions_of": "the pins on the arch, per unit width", "dofs": arch.dofs,
+    "ranks": comm.size,
+    "path": [{"load_factor": x, "rise": a} for x, a in history],
+    "warnings": warnings,
+}
+# -
+
+# ## Outputs
+#
+# The JSON (above), and when asked the final displacement for ParaView, the path against the
+# closed form and the deformed shapes.
+
+
+def plot():
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    fig, ax = plt.subplots(figsize=(7, 5))
+    a = np.linspace(min(h[:, 1].min(), -args.rise) * 1.05, args.rise * 1.02, 400)
+    ax.plot(a, [theory.load(x, args.rise) / q_limit for x in a], "-", color="k", lw=1,
+            label="shallow-arch closed form")
+    ax.plot(h[:, 1], h[:, 0] / q_limit, "o", ms=3, color="tab:blue",
+            label=f"FE, arc-length ({args.newton} Newton)")
+    for c in limits:
+        ax.axhline(c.factor / q_limit, color="tab:red", lw=0.6, ls=":")
+    if limits:
+        ax.plot([], [], color="tab:red", lw=0.6, ls=":", label="limit points found")
+    ax.axhline(0, color="gray", lw=0.5)
+    ax.invert_xaxis()  # the arch flattens and inverts as the load grows: read left to right
+    ax.set_xlabel("midspan rise a / r (e/r at rest)")
+    ax.set_ylabel("load q0 / q_limit (closed form)")
+    err = f"{100 * (first / q_limit - 1):+.2f} %" if first is not None else "not met"
+    ax.set_title(f"shallow arch e/r = {args.rise:g}, L/h = {args.slenderness:g}: limit load "
+                 f"{err} from the closed form", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    pictures.save_figure(fig, args.plot)
+
+
+def picture():
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    fig, ax = plt.subplots(figsize=(9.5, 3.5))
+    picks = shapes[:: max(1, len(shapes) // 8)] + shapes[-1:]
+    cmap = plt.get_cmap("viridis")
+    for i, (lam, pts) in enumerate(picks):
+        ax.plot(pts[:, 0], pts[:, 1], color=cmap(i / max(1, len(picks) - 1)), lw=1.5,
+                label=f"q0 = {lam / q_limit:+.2f} q_limit")
+    ax.plot([0, args.span], [0, 0], "k^", ms=8, label="pins")
+    ax.set_xlabel("x [length]")
+    ax.set_ylabel("y [length] (vertical scale exaggerated)")
+    ax.set_title(f"the arch's centreline along the path, downward load q0 sin(πx/L) "
+                 f"(e/r = {args.rise:g}, L/h = {args.slenderness:g})", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    pictures.save_figure(fig, args.png)
+
+
+writers = []
+if args.output:
+    def fields():
+        paths = output.write_fields(args.output, [arch.u])
+        say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
+    writers.append(fields)
+if args.plot:
+    writers.append(plot)
+if args.png:
+    writers.append(picture)
+cli.results(out, writers)
