@@ -19,13 +19,16 @@ factorized as that variant says (every iteration, once per step, or BFGS-correct
 two back-solves and no factorization for the constraint; δλ is a root of the arc's
 quadratic, the one whose increment turns least from the current one (Crisfield's rule).
 
-Critical points: a limit point is where Δλ changes sign between steps. With `detect`, the
-number of negative eigenvalues of the tangent at each converged state (its inertia, from
-one MUMPS LDLᵀ factorization) tells the rest: a count that changes while λ keeps its sense is
-a bifurcation. With `switch`, the first bifurcation where the count grows is left along its
-critical mode, the tangent's eigenvector of the negative eigenvalue (SLEPc): the next step
-starts from u_n + Δs φ at the same λ, and the arc keeps it from falling back. Nothing of the
-problem's closed form is used: the size of the kick is the step's own arc length.
+Critical points (`detect`): at each converged state one MUMPS LDLᵀ factorization of the
+tangent gives the number of its negative eigenvalues (its inertia) and, by one back-solve,
+the path's tangent (K⁻¹q, 1), whose λ-component tells the sense of the load there. Where the
+inertia changes, the path crossed a limit point if that sense changed too (the load passed
+an extremum), else a bifurcation. Either is bracketed: the step is redone with half the arc
+until it is 1/32 of its arc. With `switch`, the first bifurcation where the count grows is
+left along its critical mode, the tangent's eigenvector of the negative eigenvalue (SLEPc):
+the next step starts from u_n + Δs φ at the same λ, and the arc keeps it from falling back.
+Nothing of the problem's closed form is used: the size of the kick is the arc length the
+path had. Without `detect`, limit points are where Δλ changes sign between steps.
 """
 
 from __future__ import annotations
@@ -108,6 +111,47 @@ class ContinuationPath:
     def iterations(self) -> int:
         """Corrector iterations summed over converged steps."""
         return sum(r.iterations for r in self.results)
+
+
+@dataclass
+class _Walk:
+    """Where the path is: its last converged state and what the next step needs."""
+
+    lam: float
+    ds: float  # the next arc length
+    state: PETSc.Vec  # u there
+    count: int = 0  # negative eigenvalues of the tangent there
+    sense: float = 1.0  # the sign of λ along the path's tangent there
+    previous: tuple | None = None  # the last step's (Δu, Δλ)
+    last_dlam: float | None = None  # its Δλ (None past a branch switch)
+    kick: PETSc.Vec | None = None  # a critical mode to leave along
+    bracket: list | None = None  # [the arc short enough, the arc before, steps since]
+    arc: list[float] = field(default_factory=lambda: [0.0])  # arc length at each state
+
+    def destroy(self) -> None:
+        """Destroy its vectors (collective)."""
+        for v in (self.state, self.previous[0] if self.previous else None, self.kick):
+            if v is not None:
+                v.destroy()
+
+
+@dataclass
+class _Step:
+    """A converged step, classified, before it is accepted."""
+
+    du: PETSc.Vec
+    dlam: float
+    lam: float  # where it ends
+    its: int
+    work: WorkCounts
+    norms: list[float]
+    t0: float
+    count: int  # negative eigenvalues of the tangent at its end
+    sense: float  # the sign of λ along the path's tangent there
+    turned: bool  # a limit point inside it
+    bifurcation: bool  # a bifurcation inside it
+    leave: bool  # ... to be left along its mode
+    landed: bool = False  # it ends on the target
 
 
 class ArcLength:
@@ -361,10 +405,10 @@ class ArcLength:
             progress: Callable[[str], None] | None = None) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
 
-        The last state is then solved at λ = target exactly, by Newton under load control
-        from the interpolation of the two states either side. ContinuationError if the
-        target is not crossed within `max_steps` converged steps, if the arc is cut below
-        its minimum, or if the path turns back onto itself.
+        The step that crosses it is then solved at λ = target exactly (Newton at fixed λ,
+        from the nearer of its two ends). ContinuationError if the target is not crossed
+        within `max_steps` converged steps, or if the arc is cut below its minimum (a step
+        that does not converge, or turns back onto the path it came along).
         """
         if not math.isfinite(target) or target == start:
             raise ValueError(f"target load factor must be finite and differ from the start "
@@ -372,124 +416,146 @@ class ArcLength:
         if max_steps < 1:
             raise ValueError(f"max_steps must be >= 1, got {max_steps}")
         say = progress or (lambda message: None)
-        x = self.solver.u.x.petsc_vec
         path = ContinuationPath()
-        lam, ds = start, self.arc_length
-        previous, kick = None, None  # the last step's (Δu, Δλ); a mode to leave along
-        bracket = None  # bracketing an event: (the arc short enough, the arc it had, the
-        # steps taken since without meeting it)
-        arc = [0.0]  # arc length along the path at each state
-        self.set_load(lam)
+        self.set_load(start)
         count, sense = self._stability(path) if self.detect else (0, 1.0)
-        last_dlam = None  # the last step's Δλ, for a change of sense (None past a switch)
-        before = x.copy()  # the last converged state
+        walk = _Walk(start, self.arc_length, self.solver.u.x.petsc_vec.copy(), count, sense)
         try:
             while len(path.factors) < max_steps:
-                t0 = time.perf_counter()
-                work, norms = WorkCounts(), []
-                try:
-                    du, dlam, its, ds = self._step(lam, ds, previous, kick, work, norms,
-                                                   None if bracket else target)
-                    if kick is None and previous is not None and self._turns_back(
-                            du, dlam, previous):
-                        du.destroy()
-                        self._back_to(before, lam)
-                        raise _StepFailed("the step turned back onto the path it came along")
-                except _StepFailed as err:
-                    ds = self._cut(path, work, norms, ds, lam, err, say)
+                step = self._attempt(walk, path, target, say)
+                if step is None:  # cut, or redone shorter to bracket a critical point
                     continue
-                new, sense_new = (self._stability(path, du, dlam) if self.detect
-                                  else (count, sense))
-                # a change of inertia: a limit point if the path's tangent changed its sense
-                # of λ as well, else a bifurcation (a sense that flips with the inertia
-                # unchanged is a degenerate tangent's round-off: the symmetric beam's)
-                changed = self.detect and kick is None and new != count
-                turned = changed and sense * sense_new < 0
-                bifurcation = changed and not turned
-                leave = bifurcation and self.switch and not path.switched and new > count
-                if turned or leave:
-                    bracket = bracket or (ds / 32, ds, 0)
-                    if ds > bracket[0]:  # bracket it closer: back, with half the arc
-                        du.destroy()
-                        self._back_to(before, lam)
-                        path.work.add(work)
-                        path.bracketing_steps += 1
-                        ds /= 2
-                        say(f"  {'limit point' if turned else 'bifurcation'} past λ = "
-                            f"{lam:.6g}: bracketing it, arc {ds:.3g}")
-                        continue
-                landed = False
-                if kick is None and not leave and (lam - target) * (lam + dlam - target) <= 0:
-                    # the step passes the target: solve there (or cut the arc if that fails)
-                    landing = self._land(target, before, lam, lam + dlam, work, norms)
-                    if landing is None:
-                        du.destroy()
-                        self._back_to(before, lam)
-                        ds = self._cut(path, work, norms, ds, lam, _StepFailed(
-                            f"Newton under load control failed at λ = {target:g}"), say)
-                        continue
-                    its, dlam, landed = its + landing, target - lam, True
-                if self.commit:
-                    self.commit()
-                lam_old, lam = lam, (target if landed else lam + dlam)
-                switched_now = kick is not None
-                if kick is not None:
-                    kick.destroy()
-                    kick = None
-                path.switched |= switched_now
-                result = SolveResult(True, "converged", its, norms, work,
-                                     time.perf_counter() - t0)
-                path.factors.append(lam)
-                path.results.append(result)
-                path.arc_lengths.append(ds)
-                path.unstable.append(new)
-                path.work.add(work)
-                arc.append(arc[-1] + ds)
-                say(f"step {len(path.factors)}: λ = {lam:.6g}, arc {ds:.3g}, {its} "
-                    f"iterations" + (", branch switched" if switched_now else ""))
-                if turned:  # the extremum of λ between the bracketing states
-                    peak = max(lam_old, lam) if sense > 0 else min(lam_old, lam)
-                    path.critical_points.append(CriticalPoint(
-                        "limit", peak, len(path.factors), (lam_old, lam)))
-                    say(f"  limit point at λ = {peak:.6g}")
-                    ds, bracket = bracket[1], None
-                elif (not self.detect and not switched_now and last_dlam is not None
-                        and dlam * last_dlam < 0
-                        and min(abs(dlam), abs(last_dlam)) > 1e-6 * ds):  # not round-off
-                    self._limit_point(path, arc, start)
-                last_dlam = None if switched_now else dlam
-                sense = sense_new
-                if previous is not None:
-                    previous[0].destroy()
-                previous = (du, dlam)
-                if bifurcation:
-                    path.critical_points.append(CriticalPoint(
-                        "bifurcation", (lam_old + lam) / 2, len(path.factors), (lam_old, lam)))
-                    say(f"  bifurcation between λ = {lam_old:.6g} and {lam:.6g} ({count} -> "
-                        f"{new} negative eigenvalues)")
-                if leave:
-                    kick = self._critical_mode()
-                    ds, bracket = bracket[1], None  # leave with the arc the path came with
-                count = new
+                result = self._accept(walk, path, step, start, say)
                 if on_step:
-                    on_step(lam, result)
-                if landed:
+                    on_step(walk.lam, result)
+                if step.landed:
                     return path
-                x.copy(before)
-                if bracket is not None and not (turned or leave):
-                    bracket = (bracket[0], bracket[1], bracket[2] + 1)
-                    if bracket[2] > 3:  # the event did not come back: it was not there
-                        ds, bracket = bracket[1], None
-                if kick is None and bracket is None:
-                    ds = min(self.max_arc_length,
-                             ds * min(2.0, max(0.5, math.sqrt(self.desired / max(its, 1)))))
+                self._next_arc(walk, step)
         finally:
-            for v in (before, previous[0] if previous else None, kick, self._q):
-                if v is not None:
-                    v.destroy()
-            self._q = None
+            walk.destroy()
+            if self._q is not None:
+                self._q.destroy()
+                self._q = None
         raise ContinuationError(f"load factor {target:g} not reached in {max_steps} steps "
-                                f"(the path is at λ = {lam:.6g})", reached=lam)
+                                f"(the path is at λ = {walk.lam:.6g})", reached=walk.lam)
+
+    def _attempt(self, walk: _Walk, path: ContinuationPath, target: float, say
+                 ) -> _Step | None:
+        """One step from the walk's state, classified; None if it was undone."""
+        t0 = time.perf_counter()
+        work, norms = WorkCounts(), []
+        try:
+            du, dlam, its, walk.ds = self._step(walk.lam, walk.ds, walk.previous, walk.kick,
+                                                work, norms, None if walk.bracket else target)
+            if walk.kick is None and walk.previous is not None and self._turns_back(
+                    du, dlam, walk.previous):
+                du.destroy()
+                self._back_to(walk.state, walk.lam)
+                raise _StepFailed("the step turned back onto the path it came along")
+        except _StepFailed as err:
+            walk.ds = self._cut(path, work, norms, walk.ds, walk.lam, err, say)
+            return None
+        count, sense = (self._stability(path, du, dlam) if self.detect
+                        else (walk.count, walk.sense))
+        # a change of inertia: a limit point if the path's tangent changed its sense of λ
+        # as well, else a bifurcation (a sense that flips with the inertia unchanged is a
+        # degenerate tangent's round-off: the symmetric beam's)
+        changed = self.detect and walk.kick is None and count != walk.count
+        turned = changed and walk.sense * sense < 0
+        bifurcation = changed and not turned
+        leave = bifurcation and self.switch and not path.switched and count > walk.count
+        if (turned or leave) and self._bracket(walk, path, work, du, turned, say):
+            return None
+        step = _Step(du, dlam, walk.lam + dlam, its, work, norms, t0, count, sense, turned,
+                     bifurcation, leave)
+        if walk.kick is None and not leave and (walk.lam - target) * (step.lam - target) <= 0:
+            # the step passes the target: solve there (or cut the arc if that fails)
+            landing = self._land(target, walk.state, walk.lam, step.lam, work, norms)
+            if landing is None:
+                du.destroy()
+                self._back_to(walk.state, walk.lam)
+                walk.ds = self._cut(path, work, norms, walk.ds, walk.lam, _StepFailed(
+                    f"Newton at fixed λ failed at λ = {target:g}"), say)
+                return None
+            step.its += landing
+            step.dlam, step.lam, step.landed = target - walk.lam, target, True
+        return step
+
+    def _bracket(self, walk: _Walk, path: ContinuationPath, work: WorkCounts,
+                 du: PETSc.Vec, turned: bool, say) -> bool:
+        """A critical point inside this step: undo it, halve the arc; whether it was undone.
+
+        The arc is halved until the step that crosses the point is 1/32 of its first arc.
+        """
+        if walk.bracket is None:
+            walk.bracket = [walk.ds / 32, walk.ds, 0]
+        if walk.ds <= walk.bracket[0]:
+            return False
+        du.destroy()
+        self._back_to(walk.state, walk.lam)
+        path.work.add(work)
+        path.bracketing_steps += 1
+        walk.ds /= 2
+        say(f"  {'limit point' if turned else 'bifurcation'} past λ = {walk.lam:.6g}: "
+            f"bracketing it, arc {walk.ds:.3g}")
+        return True
+
+    def _accept(self, walk: _Walk, path: ContinuationPath, step: _Step, start: float,
+                say) -> SolveResult:
+        """Record a converged step and the critical point it crossed; move the walk on."""
+        if self.commit:
+            self.commit()
+        between = (walk.lam, step.lam)
+        walk.lam = step.lam
+        switched = walk.kick is not None
+        if switched:
+            walk.kick.destroy()
+            walk.kick, path.switched = None, True
+        result = SolveResult(True, "converged", step.its, step.norms, step.work,
+                             time.perf_counter() - step.t0)
+        path.factors.append(step.lam)
+        path.results.append(result)
+        path.arc_lengths.append(walk.ds)
+        path.unstable.append(step.count)
+        path.work.add(step.work)
+        walk.arc.append(walk.arc[-1] + walk.ds)
+        say(f"step {len(path.factors)}: λ = {step.lam:.6g}, arc {walk.ds:.3g}, {step.its} "
+            f"iterations" + (", branch switched" if switched else ""))
+        if step.turned:  # the extremum of λ lies between the bracketing states
+            peak = max(between) if walk.sense > 0 else min(between)
+            path.critical_points.append(CriticalPoint("limit", peak, len(path.factors),
+                                                      between))
+            say(f"  limit point at λ = {peak:.6g}")
+            walk.ds, walk.bracket = walk.bracket[1], None
+        elif (not self.detect and not switched and walk.last_dlam is not None
+              and step.dlam * walk.last_dlam < 0
+              and min(abs(step.dlam), abs(walk.last_dlam)) > 1e-6 * walk.ds):  # not noise
+            self._limit_point(path, walk.arc, start)
+        if step.bifurcation:
+            path.critical_points.append(CriticalPoint(
+                "bifurcation", sum(between) / 2, len(path.factors), between))
+            say(f"  bifurcation between λ = {between[0]:.6g} and {between[1]:.6g} "
+                f"({walk.count} -> {step.count} negative eigenvalues)")
+        if step.leave:  # along the critical mode, with the arc the path came with
+            walk.kick = self._critical_mode()
+            walk.ds, walk.bracket = walk.bracket[1], None
+        walk.last_dlam = None if switched else step.dlam
+        walk.count, walk.sense = step.count, step.sense
+        if walk.previous is not None:
+            walk.previous[0].destroy()
+        walk.previous = (step.du, step.dlam)
+        return result
+
+    def _next_arc(self, walk: _Walk, step: _Step) -> None:
+        """The converged state becomes the walk's; the next arc from this step's effort."""
+        self.solver.u.x.petsc_vec.copy(walk.state)
+        if walk.bracket is not None:
+            walk.bracket[2] += 1
+            if walk.bracket[2] > 3:  # the critical point did not come back: not there
+                walk.ds, walk.bracket = walk.bracket[1], None
+        if walk.kick is None and walk.bracket is None:
+            growth = math.sqrt(self.desired / max(step.its, 1))
+            walk.ds = min(self.max_arc_length, walk.ds * min(2.0, max(0.5, growth)))
 
     def _cut(self, path, work, norms, ds, lam, err, say) -> float:
         """A failed step: restore, and half the arc; ContinuationError below its minimum."""
