@@ -43,10 +43,12 @@ def say(msg):
         print(msg, flush=True)
 
 
-def row(problem, control, method, t0, path=None, error=None, note=""):
-    """One table row from a path (ContinuationPath or LoadPath) and its error."""
+def row(problem, control, method, t0, path=None, end_error=None, unstable=0, note=""):
+    """One table row from a path (ContinuationPath or LoadPath): its work, the critical
+    points it found, its states on unstable branches and its end state's error."""
     r = {"problem": problem, "control": control, "newton": method,
-         "time_s": time.perf_counter() - t0, "error": error, "note": note}
+         "time_s": time.perf_counter() - t0, "end_error": end_error, "unstable_states": unstable,
+         "note": note}
     if path is not None:
         r.update(steps=len(path.factors), iterations=path.iterations,
                  factorizations=path.work.factorizations, cuts=path.failures,
@@ -55,102 +57,102 @@ def row(problem, control, method, t0, path=None, error=None, note=""):
                            for c in getattr(path, "critical_points", [])])
     say(f"{problem:5s} {control:10s} {method:8s} {r['time_s']:7.2f} s "
         + (f"{r['steps']} steps, {r['iterations']} its, {r['factorizations']} fact. "
-           if path is not None else "") + f"error {error} {note}")
+           if path is not None else "") + f"end error {end_error} {note}")
     return r
 
 
 def arch_runs(slenderness):
+    """The arch to 1.5 limit loads; errors in limit loads (closed form)."""
     rows = []
-    q_lim = arch_theory.limit_load(RISE)
+    q_lim, a_lim = arch_theory.limit_load(RISE), arch_theory.limit_rise(RISE)
+    for control in ("arc-length", "load"):
+        for method in VARIANTS:
+            a = ShallowArch(1.0, 1.0 / slenderness, RISE, 1e3, 0.3)
+            solver = NewtonSolver(a.residual, a.u, a.bcs, method=method, rtol=1e-8, atol=1e-8,
+                                  max_it=30 if method == "full" else 300,
+                                  prefix=f"b_{method}_")
+            rises = []
 
-    def arch():
-        return ShallowArch(1.0, 1.0 / slenderness, RISE, 1e3, 0.3)
+            def record(lam, result, a=a, rises=rises):
+                rises.append(a.midspan_rise())
 
-    for method in VARIANTS:
-        a = arch()
-        solver = NewtonSolver(a.residual, a.u, a.bcs, method=method, rtol=1e-8, atol=1e-8,
-                              max_it=30 if method == "full" else 300, prefix=f"b_{method}_")
-        t0 = time.perf_counter()
-        try:
-            path = ArcLength(solver, a.set_load, arc_length=0.2, max_arc_length=1.0,
-                             prefix="b_arc_").run(TARGET * q_lim, 500)
-        except SolveError as err:
-            rows.append(row("arch", "arc-length", method, t0, note=str(err)[:80]))
-            continue
-        limit = next(c.factor for c in path.critical_points if c.kind == "limit")
-        rows.append(row("arch", "arc-length", method, t0, path, limit / q_lim - 1,
-                        "limit load error"))
-    for method in VARIANTS:
-        a = arch()
-        solver = NewtonSolver(a.residual, a.u, a.bcs, method=method, rtol=1e-8, atol=1e-8,
-                              max_it=30 if method == "full" else 300, prefix=f"b_{method}_")
-        t0 = time.perf_counter()
-        try:
-            path = solve_incrementally(solver, lambda t, a=a: a.set_load(t * TARGET * q_lim),
-                                       20)
-            rise = a.midspan_rise()
-            error = (arch_theory.load(rise, RISE) - TARGET * q_lim) / q_lim
-            rows.append(row("arch", "load", method, t0, path, error,
-                            "reached the target by a jump past the limit point (no path "
-                            "between): error of the end state"))
-        except SolveError as err:
-            rows.append(row("arch", "load", method, t0, note=f"stopped: {str(err)[:90]}"))
+            t0 = time.perf_counter()
+            try:
+                if control == "arc-length":
+                    path = ArcLength(solver, a.set_load, arc_length=0.2, max_arc_length=1.0,
+                                     prefix="b_arc_").run(TARGET * q_lim, 500, on_step=record)
+                else:
+                    path = solve_incrementally(
+                        solver, lambda t, a=a: a.set_load(t * TARGET * q_lim), 20,
+                        on_step=record)
+            except SolveError as err:
+                rows.append(row("arch", control, method, t0, note=f"stopped: {str(err)[:90]}"))
+                continue
+            end = (arch_theory.load(rises[-1], RISE) - TARGET * q_lim) / q_lim
+            on_unstable = sum(abs(x) < a_lim for x in rises)
+            rows.append(row("arch", control, method, t0, path, end, on_unstable))
     return rows
 
 
 def beam_runs():
+    """The perfect beam to 1.5 P_cr; the end state's tip rotation error [deg]."""
     rows = []
-    for method in VARIANTS:
-        b = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
-        t0 = time.perf_counter()
-        try:
-            path = b.solve_arc_length(TARGET, method)
-        except SolveError as err:
-            rows.append(row("beam", "arc-length", method, t0, note=str(err)[:80]))
-            continue
-        error = math.degrees(abs(b.tip()["rotation"]) - elastica.tip_rotation(TARGET))
-        switched = "switched at its bifurcation" if path.switched else "no bifurcation met"
-        rows.append(row("beam", "arc-length", method, t0, path, error,
-                        f"tip rotation error [deg]; {switched}"))
-    for method in VARIANTS:
-        b = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
-        t0 = time.perf_counter()
-        try:
-            path, switched = b.solve_path(TARGET, 40, method)
-        except SolveError as err:
-            rows.append(row("beam", "load", method, t0, note=str(err)[:80]))
-            continue
-        error = math.degrees(abs(b.tip()["rotation"]) - elastica.tip_rotation(TARGET))
-        rows.append(row("beam", "load", method, t0, path, error,
-                        "tip rotation error [deg]; "
-                        + ("kicked by the elastica" if switched else "no kick")))
+    for control in ("arc-length", "load"):
+        for method in VARIANTS:
+            b = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
+            t0 = time.perf_counter()
+            try:
+                if control == "arc-length":
+                    path = b.solve_arc_length(TARGET, method)
+                    note = ("left the bifurcation along its mode" if path.switched
+                            else "met no bifurcation")
+                else:
+                    path, switched = b.solve_path(TARGET, 40, method)
+                    note = "kicked by the elastica's deflection" if switched else "no kick"
+            except SolveError as err:
+                rows.append(row("beam", control, method, t0, note=f"stopped: {str(err)[:90]}"))
+                continue
+            error = math.degrees(abs(b.tip()["rotation"]) - elastica.tip_rotation(TARGET))
+            rows.append(row("beam", control, method, t0, path, error, note=note))
     return rows
 
 
 def table(out):
-    lines = ["| problem | control | Newton | steps | iterations | factorizations (+ inertia) "
-             "| time (s) | error | critical points found |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = [f"Shallow arch e/r = {out['rise']:g}, L/h = {out['slenderness']:g} (Q2, plane "
+             f"stress), to {out['target']:g} limit loads (closed form: "
+             f"{arch_theory.limit_load(out['rise']):.4f} EI k⁴ r); end error: the closed "
+             "form's load at the computed end rise, less the target, in limit loads. Perfect "
+             "beam L/h = "
+             f"50 (Q2) to {out['target']:g} P_cr; end error: tip rotation less the "
+             "elastica's [deg]. Unstable states: converged states between the arch's limit "
+             "points.", "",
+             "| problem | control | Newton | steps (cuts) | iterations | factorizations "
+             "(+ inertia checks) | time (s) | critical points found | unstable states | "
+             "end error | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in out["rows"]:
-        crit = ", ".join(f"{k} {f:g}" for k, f in r.get("critical", [])) or "—"
-        err = "—" if r["error"] is None else f"{r['error']:+.2e}"
-        if "steps" in r:
-            lines.append(f"| {r['problem']} | {r['control']} | {r['newton']} | {r['steps']} | "
-                         f"{r['iterations']} | {r['factorizations']} (+{r['inertia']}) | "
-                         f"{r['time_s']:.2f} | {err} | {crit} |")
-        else:
+        if "steps" not in r:
             lines.append(f"| {r['problem']} | {r['control']} | {r['newton']} | — | — | — | "
-                         f"{r['time_s']:.2f} | — | {r['note']} |")
+                         f"{r['time_s']:.2f} | — | — | — | {r['note']} |")
+            continue
+        crit = ", ".join(f"{k} {f:g}" for k, f in r["critical"]) or "—"
+        unstable = r["unstable_states"] if r["problem"] == "arch" else "—"
+        lines.append(f"| {r['problem']} | {r['control']} | {r['newton']} | {r['steps']} "
+                     f"({r['cuts']}) | {r['iterations']} | {r['factorizations']} "
+                     f"(+{r['inertia']}) | {r['time_s']:.2f} | {crit} | {unstable} | "
+                     f"{r['end_error']:+.2e} | {r['note']} |")
     return "\n".join(lines)
 
 
 def main():
     args = options(__doc__, "a coarse arch (L/h = 100) and the beam, fewer variants")
-    out = {"machine": machine(comm.size), "rise": RISE, "target": TARGET}
     global VARIANTS
     if args.quick:
         VARIANTS = ("full", "bfgs")
-    out["rows"] = arch_runs(100 if args.quick else 200) + beam_runs()
+    slenderness = 100 if args.quick else 200
+    out = {"machine": machine(comm.size), "rise": RISE, "target": TARGET,
+           "slenderness": slenderness}
+    out["rows"] = arch_runs(slenderness) + beam_runs()
     publish("continuation", out, table, args, say)
 
 

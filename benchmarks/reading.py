@@ -320,6 +320,40 @@ def friction(x: dict) -> str:
             "accuracy for Newton iterations.")
 
 
+def continuation(x: dict) -> str:
+    """Arc-length against load control on the arch (limit points) and the beam
+    (bifurcation)."""
+    rows = x["rows"]
+
+    def done(problem, control):
+        return [r for r in rows if r["problem"] == problem and r["control"] == control
+                and "steps" in r]
+
+    def names(rs):
+        return ", ".join(r["newton"] for r in rs) or "none"
+
+    arc_arch, load_arch = done("arch", "arc-length"), done("arch", "load")
+    arc_beam, load_beam = done("beam", "arc-length"), done("beam", "load")
+    cheapest = min(arc_arch, key=lambda r: r["time_s"]) if arc_arch else None
+    text = (f"* **Through limit points and bifurcations** (shallow arch to {x['target']:g} "
+            f"limit loads, perfect beam to {x['target']:g} P_cr): arc-length continuation "
+            f"traces the arch's whole path with {names(arc_arch)} Newton")
+    if cheapest:
+        text += (f" ({cheapest['newton']} the fastest, {cheapest['time_s']:.1f} s, "
+                 f"{cheapest['factorizations']} factorizations for "
+                 f"{cheapest['iterations']} iterations, "
+                 f"{cheapest['unstable_states']} states on the unstable branch)")
+    text += (f"; load control reaches the target with {names(load_arch)} only by jumping "
+             "over the snap (no state between the limit points, none of them found)")
+    text += (f". On the perfect beam arc-length finds the bifurcation by the tangent's "
+             f"inertia and leaves it along its mode with {names(arc_beam)}, where load control "
+             f"gets there with {names(load_beam)} and only by a kick sized by the elastica. "
+             "Pick arc-length for a path with limit points or a bifurcation to find; full or "
+             "periodic Newton for it on a beam, whose flat post-buckling branch takes the "
+             "constant-tangent variants many short steps.")
+    return text
+
+
 def run_times(names) -> str:
     parts = [(n, d["benchmark_time_s"]) for n in names
              if (d := load(n)) and "benchmark_time_s" in d]
@@ -348,8 +382,10 @@ def reading() -> str:
         lines.append(near_incompressible(x))
     if f := load("friction"):
         lines.append(friction(f))
+    if c := load("continuation"):
+        lines.append(continuation(c))
     lines += ["", run_times(["newton", "contact", "buckling", "bracket", "plasticity",
-                             "plasticity_peer", "mixed", "friction"])]
+                             "plasticity_peer", "mixed", "friction", "continuation"])]
     return "\n".join(lines)
 
 
