@@ -53,15 +53,18 @@ def test_the_truss_path_is_the_closed_form_through_both_limit_points(method):
 
 @pytest.mark.parametrize("method", ["full", "modified"])
 def test_the_constraint_costs_back_solves_not_factorizations(method):
-    # per converged step (the last one also lands, so it is left out): full Newton
-    # factorizes at u_n for the predictor, then once per iteration, and solves twice per
-    # iteration (−R and q: the bordered solve); modified factorizes once and back-solves q
-    # once per step, then −R once per iteration
+    # per converged step (the last one also lands, so it is left out): full Newton takes
+    # the predictor's direction K(u_n)⁻¹q from the stability check at u_n (its LDLᵀ,
+    # counted apart), except on the first step, then factorizes once per iteration and
+    # solves twice (−R and q: the bordered solve); modified factorizes K(u_n) once per
+    # step, back-solves q once and −R once per iteration
     _, path, _ = trace(method)
-    for r in path.results[:-1]:
+    assert path.inertia_factorizations == len(path.results) + path.bracketing_steps + 1
+    for n, r in enumerate(path.results[:-1]):
         k, w = r.iterations, r.work
         if method == "full":
-            assert (w.factorizations, w.linear_solves) == (1 + k, 1 + 2 * k)
+            first = int(n == 0)  # its predictor factorizes and solves
+            assert (w.factorizations, w.linear_solves) == (k + first, 2 * k + first)
         else:
             assert (w.factorizations, w.linear_solves) == (1, 1 + k)
 

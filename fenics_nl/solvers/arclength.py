@@ -125,12 +125,14 @@ class _Walk:
     previous: tuple | None = None  # the last step's (Δu, Δλ)
     last_dlam: float | None = None  # its Δλ (None past a branch switch)
     kick: PETSc.Vec | None = None  # a critical mode to leave along
+    tangent: PETSc.Vec | None = None  # K⁻¹q there, from the stability check
     bracket: list | None = None  # [the arc short enough, the arc before, steps since]
     arc: list[float] = field(default_factory=lambda: [0.0])  # arc length at each state
 
     def destroy(self) -> None:
         """Destroy its vectors (collective)."""
-        for v in (self.state, self.previous[0] if self.previous else None, self.kick):
+        for v in (self.state, self.previous[0] if self.previous else None, self.kick,
+                  self.tangent):
             if v is not None:
                 v.destroy()
 
@@ -151,6 +153,7 @@ class _Step:
     turned: bool  # a limit point inside it
     bifurcation: bool  # a bifurcation inside it
     leave: bool  # ... to be left along its mode
+    tangent: PETSc.Vec | None = None  # K⁻¹q at its end (with `detect`)
     landed: bool = False  # it ends on the target
 
 
@@ -251,12 +254,16 @@ class ArcLength:
     # -- one step ----------------------------------------------------------------------
 
     def _step(self, lam0: float, ds: float, previous, kick, work: WorkCounts, norms: list,
-              target: float | None = None):
+              target: float | None = None, tangent: PETSc.Vec | None = None):
         """From the converged (u_n, λ_n) to the next state at arc length ds.
 
         `previous`: the last step's (Δu, Δλ), for the predictor's sense and the root
         choice; `kick`: a mode to leave along (branch switching); a predictor that passes
-        `target` is shortened to end there. Returns (Δu, Δλ, iterations, the arc used).
+        `target` is shortened to end there; `tangent`: K(u_n)⁻¹q if the stability check
+        made it: full and periodic Newton, which build a new tangent at the first corrector
+        iteration, then need no factorization for the predictor (modified Newton and BFGS
+        factorize K(u_n) here anyway: it is their tangent for the step). Returns (Δu, Δλ,
+        iterations, the arc used).
         """
         s = self.solver
         x = s.u.x.petsc_vec
@@ -283,9 +290,12 @@ class ArcLength:
             dlam = 0.0
             x.axpy(1.0, du)
             x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        if s.policy.needs_tangent(0):
-            s._assemble_tangent(work)
-        self._solve(q, dq, work)
+        if kick is None and tangent is not None and s.method in ("full", "periodic"):
+            tangent.copy(dq)  # the corrector's first iteration builds its own tangent
+        else:
+            if s.policy.needs_tangent(0):
+                s._assemble_tangent(work)
+            self._solve(q, dq, work)
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)
         if kick is None:  # along the tangent (dq, 1), in the sense of the last step
@@ -418,7 +428,7 @@ class ArcLength:
         say = progress or (lambda message: None)
         path = ContinuationPath()
         self.set_load(start)
-        count, sense = self._stability(path) if self.detect else (0, 1.0)
+        count, sense, _ = self._stability(path) if self.detect else (0, 1.0, None)
         walk = _Walk(start, self.arc_length, self.solver.u.x.petsc_vec.copy(), count, sense)
         try:
             while len(path.factors) < max_steps:
@@ -446,7 +456,8 @@ class ArcLength:
         work, norms = WorkCounts(), []
         try:
             du, dlam, its, walk.ds = self._step(walk.lam, walk.ds, walk.previous, walk.kick,
-                                                work, norms, None if walk.bracket else target)
+                                                work, norms, None if walk.bracket else target,
+                                                walk.tangent)
             if walk.kick is None and walk.previous is not None and self._turns_back(
                     du, dlam, walk.previous):
                 du.destroy()
@@ -455,8 +466,8 @@ class ArcLength:
         except _StepFailed as err:
             walk.ds = self._cut(path, work, norms, walk.ds, walk.lam, err, say)
             return None
-        count, sense = (self._stability(path, du, dlam) if self.detect
-                        else (walk.count, walk.sense))
+        count, sense, tangent = (self._stability(path, du, dlam) if self.detect
+                                 else (walk.count, walk.sense, None))
         # a change of inertia: a limit point if the path's tangent changed its sense of λ
         # as well, else a bifurcation (a sense that flips with the inertia unchanged is a
         # degenerate tangent's round-off: the symmetric beam's)
@@ -465,14 +476,18 @@ class ArcLength:
         bifurcation = changed and not turned
         leave = bifurcation and self.switch and not path.switched and count > walk.count
         if (turned or leave) and self._bracket(walk, path, work, du, turned, say):
+            if tangent is not None:
+                tangent.destroy()
             return None
         step = _Step(du, dlam, walk.lam + dlam, its, work, norms, t0, count, sense, turned,
-                     bifurcation, leave)
+                     bifurcation, leave, tangent)
         if walk.kick is None and not leave and (walk.lam - target) * (step.lam - target) <= 0:
             # the step passes the target: solve there (or cut the arc if that fails)
             landing = self._land(target, walk.state, walk.lam, step.lam, work, norms)
             if landing is None:
-                du.destroy()
+                for v in (du, tangent):
+                    if v is not None:
+                        v.destroy()
                 self._back_to(walk.state, walk.lam)
                 walk.ds = self._cut(path, work, norms, walk.ds, walk.lam, _StepFailed(
                     f"Newton at fixed λ failed at λ = {target:g}"), say)
@@ -541,6 +556,9 @@ class ArcLength:
             walk.ds, walk.bracket = walk.bracket[1], None
         walk.last_dlam = None if switched else step.dlam
         walk.count, walk.sense = step.count, step.sense
+        if walk.tangent is not None:
+            walk.tangent.destroy()
+        walk.tangent = step.tangent
         if walk.previous is not None:
             walk.previous[0].destroy()
         walk.previous = (step.du, step.dlam)
@@ -573,23 +591,22 @@ class ArcLength:
         return ds / 2
 
     def _stability(self, path: ContinuationPath, du: PETSc.Vec | None = None,
-                   dlam: float = 0.0) -> tuple[int, float]:
-        """Negative eigenvalues of the tangent here, and the path's sense of λ here.
+                   dlam: float = 0.0) -> tuple[int, float, PETSc.Vec | None]:
+        """Negative eigenvalues of the tangent here, the path's sense of λ here, and t.
 
         One LDLᵀ of K(u) and one back-solve t = K⁻¹q: the path's tangent is ±(t, 1),
         oriented along the step (Δu, Δλ) just made; its λ-component's sign is the sense.
+        t is also the next step's predictor direction.
         """
         path.inertia_factorizations += 1
         s = self.solver
         if du is None:
             return unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
-                                       margin=INERTIA_MARGIN), 0.0
+                                       margin=INERTIA_MARGIN), 0.0, None
         t = du.duplicate()
         count = unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
                                     rhs=self._q, solution=t, margin=INERTIA_MARGIN)
-        sense = self._dot(du, t) + self.psi**2 * dlam
-        t.destroy()
-        return count, sense
+        return count, self._dot(du, t) + self.psi**2 * dlam, t
 
     def _back_to(self, state: PETSc.Vec, lam: float) -> None:
         """u = state, λ = lam."""
