@@ -23,9 +23,11 @@ Critical points (`detect`): at each converged state one MUMPS LDLᵀ factorizati
 tangent gives the number of its negative eigenvalues (its inertia) and, by one back-solve,
 the path's tangent (K⁻¹q, 1), whose λ-component tells the sense of the load there. Where the
 inertia changes, the path crossed a limit point if that sense changed too (the load passed
-an extremum), else a bifurcation. Either is bracketed: the step is redone with half the arc
-until it is 1/32 of its arc. With `switch`, the first bifurcation where the count grows is
-left along its critical mode, the tangent's eigenvector of the negative eigenvalue (SLEPc):
+an extremum), else a bifurcation. A limit point, and a bifurcation to be left, are
+bracketed: the step is redone with half the arc until it is 1/32 of its arc (a bifurcation
+that is passed is reported between the ends of the step that crossed it). With `switch`,
+the first bifurcation where the count grows is left along its critical mode, the tangent's
+eigenvector of its eigenvalue nearest 0 (SLEPc):
 the next step starts from u_n + Δs φ at the same λ, and the arc keeps it from falling back.
 Nothing of the problem's closed form is used: the size of the kick is the arc length the
 path had. Without `detect`, limit points are where Δλ changes sign between steps.
@@ -40,19 +42,21 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.errors import SolveError
-from fenics_nl.solvers.buckling import lowest_tangent_mode, unstable_directions
+from fenics_nl.solvers.buckling import mode_nearest_zero, unstable_directions
 from fenics_nl.solvers.newton import NewtonSolver, _LinearSolveFailed
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 log = logging.getLogger(__name__)
 
-# eigenvalues of the tangent within this fraction of its largest diagonal entry count as
-# zero: near a bifurcation point round-off puts them on either side, and the inertia
-# would flicker (the critical load is then found later by about this fraction of the
-# critical mode's eigenvalue at rest)
+# eigenvalues of the tangent (on the displacement dofs) above −this fraction of its largest
+# diagonal entry count as positive: near a bifurcation point round-off puts them on either
+# side, and the inertia would flicker. A critical point is then found later by Δλ/λ ≈
+# margin · max diag K / μ₀ (μ₀: the critical mode's eigenvalue at rest): 1e-12 is far below
+# the beam's bifurcation bracket, and far above the pivots' round-off
 INERTIA_MARGIN = 1e-12
 # the iterations a step should take, per variant: fewer and the arc grows, more and it shrinks
 DESIRED_ITERATIONS = {"full": 5, "periodic": 8, "bfgs": 12, "modified": 20}
@@ -70,15 +74,22 @@ class _StepFailed(Exception):
     """A step did not converge (or turned back): cut the arc and try again."""
 
 
-def _at_round_off(norms: list[float], largest: float) -> bool:
-    """‖R‖ flat over the last 5 iterates, 1e6 below the largest of the run: round-off.
+class _TurnedBack(_StepFailed):
+    """The step went back along the path it came by."""
+
+
+def _at_round_off(norms: list[float], largest: float, threshold: float) -> bool:
+    """‖R‖ has stopped falling, 1e6 below the run's largest and within 1e4 of the tolerance.
 
     A slender body's internal forces are far larger than its load (membrane forces), and
     near a critical point K is nearly singular and amplifies the round-off of each
-    correction: the residual then stops falling above a tolerance on the load.
+    correction: the residual then stops falling just above a tolerance on the load. "Stopped":
+    the last 5 within a factor 3 and the last not below half the one 4 iterations earlier
+    (a steady linear rate, even 0.85, halves it in 4 iterations).
     """
     last = norms[-5:]
-    return len(last) == 5 and max(last) < 1e-6 * largest and max(last) < 3 * min(last)
+    return (len(last) == 5 and max(last) < min(1e-6 * largest, 1e4 * threshold)
+            and max(last) < 3 * min(last) and last[-1] > 0.5 * last[0])
 
 
 @dataclass
@@ -86,8 +97,9 @@ class CriticalPoint:
     """A limit point or a bifurcation met between two converged steps."""
 
     kind: str  # "limit" or "bifurcation"
-    factor: float  # λ there: the vertex of a parabola through the last 3 points (limit),
-    # or the middle of the step that crossed it (bifurcation)
+    factor: float  # λ there: a limit point's, the extremum of λ over the bracketing states
+    # (without `detect`: the vertex of a parabola through the last 3); a bifurcation's, the
+    # middle of the step that crossed it
     step: int  # the first converged step past it
     between: tuple[float, float]  # λ of the converged states either side
 
@@ -99,7 +111,9 @@ class ContinuationPath:
     factors: list[float] = field(default_factory=list)
     results: list[SolveResult] = field(default_factory=list)
     arc_lengths: list[float] = field(default_factory=list)  # Δs of each converged step
-    unstable: list[int] = field(default_factory=list)  # negative eigenvalues (with `detect`)
+    # negative eigenvalues at each state (with `detect`; the last: at the end of the step that
+    # crossed the target, before the landing on it)
+    unstable: list[int] = field(default_factory=list)
     critical_points: list[CriticalPoint] = field(default_factory=list)
     switched: bool = False  # left a bifurcation along its mode
     failures: int = 0  # steps cut
@@ -111,6 +125,15 @@ class ContinuationPath:
     def iterations(self) -> int:
         """Corrector iterations summed over converged steps."""
         return sum(r.iterations for r in self.results)
+
+
+@dataclass
+class _Bracket:
+    """A critical point being bracketed: the step that crosses it is redone shorter."""
+
+    short: float  # the arc short enough to accept the crossing step
+    arc: float  # the arc the path had: it goes on with it
+    since: int = 0  # steps accepted since the last halving without meeting it
 
 
 @dataclass
@@ -126,7 +149,7 @@ class _Walk:
     last_dlam: float | None = None  # its Δλ (None past a branch switch)
     kick: PETSc.Vec | None = None  # a critical mode to leave along
     tangent: PETSc.Vec | None = None  # K⁻¹q there, from the stability check
-    bracket: list | None = None  # [the arc short enough, the arc before, steps since]
+    bracket: _Bracket | None = None  # while a critical point is being bracketed
     arc: list[float] = field(default_factory=lambda: [0.0])  # arc length at each state
 
     def destroy(self) -> None:
@@ -162,8 +185,9 @@ class ArcLength:
 
     Args:
         solver: the Newton solver of R(u, λ) (its variant, tangent policy, linear solver and
-            tolerances are used; Dirichlet values must not depend on λ). Converged when
-            ‖R‖ ≤ max(rtol ‖R₀‖, atol ‖q‖); without a force scale of its own, it gets ‖q‖.
+            tolerances are used; Dirichlet values must not depend on λ). A step has
+            converged when ‖R‖ ≤ max(rtol ‖R₀‖, atol ‖q‖) (the reference load's ‖q‖), or
+            when ‖R‖ stopped falling at the round-off of a nearly singular tangent.
         set_load: sets λ in the residual (as for `solve_incrementally`); R must be affine in
             λ: q = R(u, λ) − R(u, λ + 1), taken at the start of each step (exact for dead
             loads).
@@ -208,16 +232,12 @@ class ArcLength:
         self.detect, self.switch = detect, switch
         self.mass, self.multipliers, self.prefix = mass, multipliers, prefix
         self.commit, self.restore = commit, restore
-        x = solver.u.x.petsc_vec
-        self._weights = None  # 1 on the metric's dofs, 0 elsewhere
-        if metric_dofs is not None:
-            self._weights = x.duplicate()
-            self._weights.set(0.0)
-            owned = metric_dofs[metric_dofs < x.getLocalSize()]
-            self._weights.array[owned] = 1.0
+        self.metric_dofs = metric_dofs
+        self._weights = None  # during a run: 1 on the metric's dofs, 0 elsewhere
         self._scale = None  # 1/u_ref², set on the first predictor
         self._q = None  # the load vector q = −∂R/∂λ of the current step
         self._largest = 0.0  # the largest first residual of a step: round-off's scale
+        self._sense0 = 1.0  # the first step's sense of λ (towards the target)
 
     # -- the metric --------------------------------------------------------------------
 
@@ -277,8 +297,6 @@ class ArcLength:
         q_norm = q.norm()
         if q_norm == 0:
             raise ValueError("the load does not depend on the load factor (q = 0)")
-        if s.force_scale is None:  # the reference load: also the landing solve's scale
-            s.force_scale = q_norm
         du = x.duplicate()
         x0 = x.copy()
         if kick is not None:
@@ -299,7 +317,7 @@ class ArcLength:
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)
         if kick is None:  # along the tangent (dq, 1), in the sense of the last step
-            sense = 1.0
+            sense = self._sense0
             if previous is not None:
                 sense = math.copysign(1.0, self._dot(previous[0], dq)
                                       + self.psi**2 * previous[1])
@@ -349,8 +367,9 @@ class ArcLength:
                 if not math.isfinite(rnorm) or rnorm > s.divergence_tol * max(norms[0], 1e-300):
                     raise _StepFailed(f"residual {rnorm:.3e} at iteration {k}")
                 self._largest = max(self._largest, norms[0])
-                if on_arc and (rnorm <= max(s.rtol * norms[0], s.atol * q_norm)
-                               or _at_round_off(norms, self._largest)):
+                threshold = max(s.rtol * norms[0], s.atol * q_norm)
+                if on_arc and (rnorm <= threshold
+                               or _at_round_off(norms, self._largest, threshold)):
                     return du, dlam, k
                 if k == s.max_it:
                     raise _StepFailed(f"no convergence in {s.max_it} iterations "
@@ -372,6 +391,8 @@ class ArcLength:
                     step.axpy(ddlam, dq)  # δu = −dr + δλ dq
                 du.axpy(1.0, step)
                 x.axpy(1.0, step)
+                # U = g on the Dirichlet dofs exactly, whatever the linear solver's accuracy
+                petsc.set_bc(x, s.bcs)
                 x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
                 dlam += ddlam
                 lam = lam0 + dlam
@@ -428,7 +449,15 @@ class ArcLength:
         say = progress or (lambda message: None)
         path = ContinuationPath()
         self.set_load(start)
-        count, sense, _ = self._stability(path) if self.detect else (0, 1.0, None)
+        self._largest = 0.0
+        self._sense0 = math.copysign(1.0, target - start)  # the first step heads for it
+        if self.metric_dofs is not None:
+            x = self.solver.u.x.petsc_vec
+            self._weights = x.duplicate()
+            self._weights.set(0.0)
+            self._weights.array[self.metric_dofs[self.metric_dofs < x.getLocalSize()]] = 1.0
+        count = self._stability(path)[0] if self.detect else 0
+        sense = self._sense0
         walk = _Walk(start, self.arc_length, self.solver.u.x.petsc_vec.copy(), count, sense)
         try:
             while len(path.factors) < max_steps:
@@ -443,9 +472,10 @@ class ArcLength:
                 self._next_arc(walk, step)
         finally:
             walk.destroy()
-            if self._q is not None:
-                self._q.destroy()
-                self._q = None
+            for v in (self._q, self._weights):
+                if v is not None:
+                    v.destroy()
+            self._q = self._weights = None
         raise ContinuationError(f"load factor {target:g} not reached in {max_steps} steps "
                                 f"(the path is at λ = {walk.lam:.6g})", reached=walk.lam)
 
@@ -462,7 +492,7 @@ class ArcLength:
                     du, dlam, walk.previous):
                 du.destroy()
                 self._back_to(walk.state, walk.lam)
-                raise _StepFailed("the step turned back onto the path it came along")
+                raise _TurnedBack("the step turned back onto the path it came along")
         except _StepFailed as err:
             walk.ds = self._cut(path, work, norms, walk.ds, walk.lam, err, say)
             return None
@@ -503,9 +533,10 @@ class ArcLength:
         The arc is halved until the step that crosses the point is 1/32 of its first arc.
         """
         if walk.bracket is None:
-            walk.bracket = [walk.ds / 32, walk.ds, 0]
-        if walk.ds <= walk.bracket[0]:
+            walk.bracket = _Bracket(walk.ds / 32, walk.ds)
+        if walk.ds <= walk.bracket.short:
             return False
+        walk.bracket.since = 0
         du.destroy()
         self._back_to(walk.state, walk.lam)
         path.work.add(work)
@@ -541,7 +572,7 @@ class ArcLength:
             path.critical_points.append(CriticalPoint("limit", peak, len(path.factors),
                                                       between))
             say(f"  limit point at λ = {peak:.6g}")
-            walk.ds, walk.bracket = walk.bracket[1], None
+            walk.ds, walk.bracket = walk.bracket.arc, None
         elif (not self.detect and not switched and walk.last_dlam is not None
               and step.dlam * walk.last_dlam < 0
               and min(abs(step.dlam), abs(walk.last_dlam)) > 1e-6 * walk.ds):  # not noise
@@ -553,7 +584,7 @@ class ArcLength:
                 f"({walk.count} -> {step.count} negative eigenvalues)")
         if step.leave:  # along the critical mode, with the arc the path came with
             walk.kick = self._critical_mode()
-            walk.ds, walk.bracket = walk.bracket[1], None
+            walk.ds, walk.bracket = walk.bracket.arc, None
         walk.last_dlam = None if switched else step.dlam
         walk.count, walk.sense = step.count, step.sense
         if walk.tangent is not None:
@@ -568,9 +599,9 @@ class ArcLength:
         """The converged state becomes the walk's; the next arc from this step's effort."""
         self.solver.u.x.petsc_vec.copy(walk.state)
         if walk.bracket is not None:
-            walk.bracket[2] += 1
-            if walk.bracket[2] > 3:  # the critical point did not come back: not there
-                walk.ds, walk.bracket = walk.bracket[1], None
+            walk.bracket.since += 1
+            if walk.bracket.since > 3:  # the critical point did not come back: not there
+                walk.ds, walk.bracket = walk.bracket.arc, None
         if walk.kick is None and walk.bracket is None:
             growth = math.sqrt(self.desired / max(step.its, 1))
             walk.ds = min(self.max_arc_length, walk.ds * min(2.0, max(0.5, growth)))
@@ -582,7 +613,7 @@ class ArcLength:
         if self.restore:
             self.restore()
         if ds / 2 < self.min_arc_length:
-            back = " (the path doubles back onto itself)" if "turned" in str(err) else ""
+            back = " (the path doubles back onto itself)" if isinstance(err, _TurnedBack) else ""
             raise ContinuationError(
                 f"the path could not be followed beyond load factor {lam:.6g}: {err}{back}; "
                 f"arc length cut below {self.min_arc_length:g}",
@@ -602,10 +633,11 @@ class ArcLength:
         s = self.solver
         if du is None:
             return unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
-                                       margin=INERTIA_MARGIN), 0.0, None
+                                       margin=INERTIA_MARGIN, rows=self._weights), 0.0, None
         t = du.duplicate()
         count = unstable_directions(s.tangent_form, s.bcs, self.prefix, self.multipliers,
-                                    rhs=self._q, solution=t, margin=INERTIA_MARGIN)
+                                    rhs=self._q, solution=t, margin=INERTIA_MARGIN,
+                                    rows=self._weights)
         return count, self._dot(du, t) + self.psi**2 * dlam, t
 
     def _back_to(self, state: PETSc.Vec, lam: float) -> None:
@@ -624,19 +656,20 @@ class ArcLength:
         lams = [start, *path.factors][-3:]
         s = arc[-3:]
         a, b, c = np.polyfit(s, lams, 2)
-        peak = c - b * b / (4 * a) if a != 0 else lams[1]
-        if not min(lams) - abs(lams[1]) <= peak <= max(lams) + abs(lams[1]):
-            peak = lams[1]
+        # the vertex if it lies between the three states, else the middle one
+        peak = c - b * b / (4 * a) if a != 0 and s[0] <= -b / (2 * a) <= s[2] else lams[1]
         path.critical_points.append(CriticalPoint("limit", float(peak), len(path.factors),
                                                   (lams[-2], lams[-1])))
 
     def _critical_mode(self) -> PETSc.Vec:
-        """The tangent's eigenvector of its negative eigenvalue nearest 0 (SLEPc)."""
+        """The tangent's eigenvector of its eigenvalue nearest 0 (SLEPc).
+
+        Just past the bifurcation, that is the one that has just turned negative (not an
+        older, more negative one, if the path was already unstable).
+        """
         s = self.solver
-        _, mode = lowest_tangent_mode(s.tangent_form, s.bcs, s.u.function_space,
-                                      self.prefix, mass=self.mass,
-                                      multipliers=self.multipliers)
-        return mode.x.petsc_vec.copy()
+        return mode_nearest_zero(s.tangent_form, s.bcs, s.u.function_space, self.prefix,
+                                 mass=self.mass)
 
     def _land(self, target: float, before: PETSc.Vec, lam_old: float, lam: float,
               work: WorkCounts, norms: list) -> int | None:
@@ -658,13 +691,16 @@ class ArcLength:
         self._load_vector(target, self._q, work)
         du = x.duplicate()
         du.set(0.0)
+        origin = start.copy()
+        own = []  # its own residual history: its rtol and round-off tests start from it
         try:
-            return self._correct(start.copy(), target, du, 0.0, None, self._q,
-                                 self._q.norm(), None, work, norms)[2]
+            return self._correct(origin, target, du, 0.0, None, self._q, self._q.norm(),
+                                 None, work, own)[2]
         except _StepFailed as err:
             log.info("landing at λ = %g failed: %s", target, err)
             self._back_to(end, lam)
             return None
         finally:
-            du.destroy()
-            end.destroy()
+            norms.extend(own)
+            for v in (du, end, origin):
+                v.destroy()

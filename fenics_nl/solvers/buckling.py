@@ -135,18 +135,27 @@ def negative_eigenvalues(A: PETSc.Mat, prefix: str, rhs: PETSc.Vec | None = None
 
 def unstable_directions(a_T: ufl.Form, bcs, prefix: str = "stability_",
                         multipliers: int = 0, rhs: PETSc.Vec | None = None,
-                        solution: PETSc.Vec | None = None, margin: float = 0.0) -> int:
+                        solution: PETSc.Vec | None = None, margin: float = 0.0,
+                        rows: PETSc.Vec | None = None) -> int:
     """The number of eigenvalues of K_T below −margin·max diag K_T, less `multipliers`.
 
     0 on a stable equilibrium; it changes by one where the path crosses a limit point or a
     bifurcation. One assembly and one LDLᵀ factorization (`negative_eigenvalues`); with
     `rhs` (zero on the Dirichlet rows), also `solution` = (K_T + margin·max diag)⁻¹ rhs.
-    A small `margin` counts an eigenvalue that round-off puts on either side of 0 as 0.
+    A small `margin` counts an eigenvalue that round-off puts on either side of 0 as 0; it is
+    added where `rows` is 1 (a mixed unknown's displacement dofs: a pressure block scales
+    otherwise, and would change sign in some units), everywhere by default.
     """
     K = _stiffness(a_T, bcs)
     if margin:
         diagonal = K.getDiagonal()
-        K.shift(margin * diagonal.max()[1])
+        shift = margin * diagonal.max()[1]
+        if rows is None:
+            K.shift(shift)
+        else:
+            rows.copy(diagonal)
+            diagonal.scale(shift)
+            K.setDiagonal(diagonal, addv=PETSc.InsertMode.ADD_VALUES)
         diagonal.destroy()
     count = negative_eigenvalues(K, f"{prefix}inertia_", rhs, solution) - multipliers
     K.destroy()
@@ -180,20 +189,39 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     lam, mode = _eigenpair_nearest(comm, prefix, K, M, 0.0, V)
     if unstable:  # shift below the smallest eigenvalue (counted), then find it there
         shift = -1.01 * max(abs(lam), 1e-12 * K.norm(PETSc.NormType.INFINITY))
+        eye = _identity(K) if M is None else None
         for _ in range(60):
             shifted = K.duplicate(copy=True)
-            shifted.axpy(-shift, M if M is not None else _identity(K),
+            shifted.axpy(-shift, M if M is not None else eye,
                          PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             below = negative_eigenvalues(shifted, f"{prefix}inertia_") - multipliers
             shifted.destroy()
             if below == 0:  # no eigenvalue below the shift: the nearest is the smallest
                 break
             shift *= 4
+        if eye is not None:
+            eye.destroy()
         lam, mode = _eigenpair_nearest(comm, prefix, K, M, shift, V)
     for obj in (K, M):
         if obj is not None:
             obj.destroy()
     return lam, mode
+
+
+def mode_nearest_zero(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "stability_",
+                      mass: ufl.Form | None = None) -> PETSc.Vec:
+    """The eigenvector of K_T φ = λ M φ (or K_T φ = λ φ) with λ nearest 0 (SLEPc)."""
+    K = _stiffness(a_T, bcs)
+    M = None
+    if mass is not None:
+        M = petsc.assemble_matrix(fem.form(mass), bcs=bcs, diag=0.0)
+        M.assemble()
+    _, mode = _eigenpair_nearest(V.mesh.comm, prefix, K, M, 0.0, V)
+    vector = mode.x.petsc_vec.copy()
+    for obj in (K, M):
+        if obj is not None:
+            obj.destroy()
+    return vector
 
 
 def _identity(K: PETSc.Mat) -> PETSc.Mat:

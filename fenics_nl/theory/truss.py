@@ -8,6 +8,10 @@ a downward apex load P, with w the apex's downward displacement and z = h − w:
 
 a cubic with a maximum P_max = 2 EA h³/(3√3 L³) at z = h/√3 (the limit point), a minimum
 −P_max at z = −h/√3, and P = P_max again at z = −2h/√3, on the inverted branch.
+
+This is the symmetric path. With the apex free to sway, its horizontal stiffness
+(EA/L³)(2a² + z² − h²) stays positive up to the limit point only for h < √3 a: a steeper
+truss sways (an antisymmetric bifurcation) before it snaps.
 """
 
 from __future__ import annotations
