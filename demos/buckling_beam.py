@@ -236,7 +236,7 @@ if args.path == "load":
         redone.append(f"the {args.steps}-step path ended on the straight (unstable) branch; "
                       f"it was redone with {beam.path_steps} steps")
 else:  # λ = P/P_Euler is an unknown of the arc-length path
-    say(f"arc-length path to P/P_cr = {args.load_ratio:g} (first arc {args.arc_length:g})")
+    say(f"arc-length path to P/P_Euler = {args.load_ratio:g} (first arc {args.arc_length:g})")
     path = beam.solve_arc_length(args.load_ratio, args.newton, arc_length=args.arc_length,
                                  on_step=lambda lam, r: record(lam / args.load_ratio, r),
                                  progress=progress(40))

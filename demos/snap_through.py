@@ -28,6 +28,7 @@
 # ## Implementation
 
 # +
+import math
 import sys
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
@@ -67,29 +68,31 @@ def parser():
                "factorizations and eigensolver).")
     p.add_argument("--span", type=cli.positive, default=1.0, help="span L [length]")
     p.add_argument("--slenderness", type=cli.positive, default=200.0,
-                   help="L/h, at least 20 (the closed form is a thin-arch theory)")
+                   help="L/h, at least 20 (the closed form is a thin-arch theory) [-]")
     p.add_argument("--rise", type=cli.positive, default=3.0,
                    help="e/r: the rise over the section's radius of gyration r = h/√12, "
-                        "in (2, 4.69) for a symmetric snap-through [-]")
+                        "in (2, √22 = 4.69): a symmetric snap-through [-]")
     p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
     p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
     p.add_argument("--load-ratio", type=cli.finite, default=1.5,
-                   help="the path is followed until q0 = ratio × the limit load [-]")
+                   help="the path is followed until q0 = ratio × the closed form's limit "
+                        "load [-]")
     p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"],
                    default="full", help="Newton variant of the corrector")
     p.add_argument("--arc-length", type=cli.finite, default=0.2,
-                   help="first arc length Δs, > 0 (dimensionless: about one load step of "
-                        "Δs/√(1+ψ²) on a linear path) [-]")
+                   help="first arc length Δs, > 0: dimensionless, on a linear path a load "
+                        "increment of Δs/√(1+ψ²) in units of EI k⁴ r (k = π/L) [-]")
     p.add_argument("--max-arc-length", type=cli.finite, default=1.0,
                    help="largest arc length (the adaptive Δs grows after easy steps) [-]")
     p.add_argument("--psi", type=cli.finite, default=1.0,
-                   help="weight of the load factor in the arc: 1 spherical, 0 cylindrical")
+                   help="weight of the load factor in the arc, >= 0: 1 spherical, 0 "
+                        "cylindrical [-]")
     p.add_argument("--max-steps", type=cli.at_least(1), default=300,
                    help="steps before the run stops short of its target")
     p.add_argument("--elements", type=cli.at_least(2), default=2,
-                   help="Q2 elements through the thickness (even)")
+                   help="Q2 elements through the thickness, even (a node on the centreline)")
     p.add_argument("--aspect", type=cli.positive, default=4.0,
-                   help="element length over element height along the span")
+                   help="element length over element height along the span [-]")
     cli.add_outputs(p, output="the final displacement",
                     png="the deformed arch at states along the path",
                     plot="load against midspan rise, FE and closed form")
@@ -100,8 +103,12 @@ p = parser()
 args = cli.arguments(p, prefixes={"arch_": "Newton and the stability checks"})
 if args.slenderness < 20:
     p.error(f"--slenderness must be >= 20, got {args.slenderness}")
-if not 2 < args.rise:
-    p.error(f"--rise must be > 2 for a snap-through (e/r <= 2 never snaps), got {args.rise}")
+if not 2 < args.rise < math.sqrt(22):
+    p.error(f"--rise must be in (2, √22 = 4.69), got {args.rise}: at e/r <= 2 the arch never "
+            "snaps, beyond √22 it buckles antisymmetrically before its limit point, where the "
+            "closed form does not hold")
+if args.elements % 2:
+    p.error(f"--elements must be even (a node on the centreline), got {args.elements}")
 if not args.arc_length > 0:
     p.error(f"--arc-length must be > 0, got {args.arc_length}")
 if not args.max_arc_length >= args.arc_length:
@@ -121,7 +128,7 @@ arch = ShallowArch(args.span, args.span / args.slenderness, args.rise, args.E, a
                    elements=args.elements, aspect=args.aspect)
 q_limit = theory.limit_load(args.rise)  # in units of EI k⁴ r, the scene's load factor
 say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {arch.dofs} unknowns; limit "
-    f"load (closed form) q0 = {q_limit:.5g} EI k^4 r at rise a/r = "
+    f"load (closed form) q0 = {q_limit:.5g} EI k^4 r (k = π/L) at rise a/r = "
     f"{theory.limit_rise(args.rise):.4g}")
 
 # ### The path
@@ -166,10 +173,11 @@ limits = [c for c in path.critical_points if c.kind == "limit"]
 h = np.array(history)
 reference = np.array([theory.load(a, args.rise) for a in h[:, 1]])
 path_error = float(np.max(np.abs(h[:, 0] - reference)) / q_limit)
+a_limit = theory.limit_rise(args.rise)
+# the cubic's maximum, then its minimum: the limit points in the order the path meets them
+limits_reference = [q_limit, theory.load(-a_limit, args.rise)]
+unstable = int(np.sum(np.abs(h[:, 1]) < a_limit))  # states between the limit points
 warnings = []
-if not theory.symmetric_snap(args.rise):
-    warnings.append(f"e/r = {args.rise:g} > √22: an antisymmetric bifurcation precedes the "
-                    "limit point; the closed form is the symmetric path only")
 if args.slenderness < 100:
     warnings.append("the closed form is a thin-arch theory: at L/h < 100 the continuum "
                     "differs from it by about 1 % or more")
@@ -177,30 +185,37 @@ first = limits[0].factor if limits else None
 if first is None:
     warnings.append("no limit point was met before the target (is the target below it?)")
     say("no limit point met")
-else:
-    say(f"limit load q0 = {first:.5g} EI k^4 r (closed form {q_limit:.5g}, "
-        f"{100 * (first / q_limit - 1):+.2f} %)")
-say(f"{len(path.factors)} steps, {path.iterations} iterations, {path.work.factorizations} "
-    f"factorizations (+{path.inertia_factorizations} for the stability checks), "
-    f"{path.failures} cuts; largest gap to the closed form along the path "
-    f"{100 * path_error:.2f} % of the limit load")
+for c, ref in zip(limits, limits_reference, strict=False):
+    say(f"limit point: q0 = {c.factor:.5g} EI k^4 r (closed form {ref:.5g}, "
+        f"{100 * (c.factor / ref - 1):+.2f} %)")
+say(f"{len(path.factors)} steps ({unstable} between the limit points), {path.iterations} "
+    f"iterations, {path.work.factorizations} factorizations (+{path.inertia_factorizations} "
+    f"for the stability checks), {path.failures} cuts; largest gap to the closed form along "
+    f"the path {100 * path_error:.2f} % of the limit load")
 load_unit = arch.q0  # q0 per unit load factor, in force/length²
 out = {
     "limit_load": first * load_unit if first is not None else None,
     "limit_load_reference": q_limit * load_unit,
     "limit_load_rel_error": first / q_limit - 1 if first is not None else None,
-    "load_unit": load_unit, "rise": args.rise, "slenderness": args.slenderness,
-    "newton": args.newton, "critical_points": [
+    "limit_loads": [c.factor * load_unit for c in limits],
+    "limit_loads_reference": [r * load_unit for r in limits_reference[:len(limits)]],
+    "limit_loads_rel_error": [c.factor / r - 1 for c, r in zip(limits, limits_reference,
+                                                              strict=False)],
+    "load_unit": load_unit, "load_unit_is": "EI k^4 r, k = pi/L, r = h/sqrt(12): q0 per "
+    "unit load factor [force/length^2]", "initial_rise": args.rise,
+    "slenderness": args.slenderness, "newton": args.newton, "critical_points": [
         {"kind": c.kind, "load_factor": c.factor, "step": c.step,
          "between": list(c.between)} for c in path.critical_points],
-    "path_max_error": path_error, "load_steps": len(path.factors),
-    "iterations": path.iterations, "factorizations": path.work.factorizations,
+    "path_max_error": path_error, "unstable_states": unstable,
+    "load_steps": len(path.factors), "iterations": path.iterations,
+    "factorizations": path.work.factorizations,
     "inertia_factorizations": path.inertia_factorizations, "step_cuts": path.failures,
     "final_load_factor": path.factors[-1], "final_rise": history[-1][1],
     "reactions": arch.reactions(),
     "reactions_of": "the pins on the arch, per unit width", "dofs": arch.dofs,
     "ranks": comm.size,
-    "path": [{"load_factor": x, "rise": a} for x, a in history],
+    "path": [{"load_factor": x, "rise": a, "negative_eigenvalues": n}
+             for (x, a), n in zip(history, [0, *path.unstable], strict=True)],
     "warnings": warnings,
 }
 # -
@@ -221,10 +236,12 @@ def plot():
             label="shallow-arch closed form")
     ax.plot(h[:, 1], h[:, 0] / q_limit, "o", ms=3, color="tab:blue",
             label=f"FE, arc-length ({args.newton} Newton)")
+    at = {round(x, 12): a for x, a in history}  # the rise of each state, by its load
     for c in limits:
-        ax.axhline(c.factor / q_limit, color="tab:red", lw=0.6, ls=":")
+        ax.plot(at.get(round(c.factor, 12), np.nan), c.factor / q_limit, "s", ms=9,
+                mfc="none", color="tab:red")
     if limits:
-        ax.plot([], [], color="tab:red", lw=0.6, ls=":", label="limit points found")
+        ax.plot([], [], "s", ms=9, mfc="none", color="tab:red", label="limit points found")
     ax.axhline(0, color="gray", lw=0.5)
     ax.invert_xaxis()  # the arch flattens and inverts as the load grows: read left to right
     ax.set_xlabel("midspan rise a / r (e/r at rest)")
@@ -244,9 +261,13 @@ def picture():
     fig, ax = plt.subplots(figsize=(9.5, 3.5))
     picks = shapes[:: max(1, len(shapes) // 8)] + shapes[-1:]
     cmap = plt.get_cmap("viridis")
+    rise_at = dict(history)
     for i, (lam, pts) in enumerate(picks):
+        a = rise_at[lam]
+        where = "unstable" if abs(a) < a_limit else "stable"
         ax.plot(pts[:, 0], pts[:, 1], color=cmap(i / max(1, len(picks) - 1)), lw=1.5,
-                label=f"q0 = {lam / q_limit:+.2f} q_limit")
+                ls="--" if where == "unstable" else "-",
+                label=f"q0 = {lam / q_limit:.2f} q_limit, a/r = {a:.2f} ({where})")
     ax.plot([0, args.span], [0, 0], "k^", ms=8, label="pins")
     ax.set_xlabel("x [length]")
     ax.set_ylabel("y [length] (vertical scale exaggerated)")

@@ -62,7 +62,9 @@ def main(argv=None) -> int:
             cli.error(line)
         return 2
     say(f"{case.path.name}: {case.model}, P{case.degree}, {problem.dofs} unknowns, "
-        f"{case.law}, {len(case.factors)} load factors, {MPI.COMM_WORLD.size} rank(s)")
+        f"{case.law}, " + (f"arc-length to load factor {case.arc['target']:g}" if case.arc
+                            else f"{len(case.factors)} load factors")
+        + f", {MPI.COMM_WORLD.size} rank(s)")
     if args.command == "check":
         say("check: the case is complete and consistent with its mesh")
         return 0

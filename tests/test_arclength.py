@@ -86,10 +86,12 @@ def test_bad_input_and_unreachable_targets_are_clear_errors():
             ArcLength(solver, truss.set_load, arc_length=bad)
     with pytest.raises(ContinuationError, match="not reached in 3 steps"):
         trace("full", target=1e3, max_steps=3)
-    # modified Newton with arcs held at 8: the corrector lands behind where the path came
-    # from, so the step cannot be cut and the run stops
+    # modified Newton with arcs held at 8, far from the target: past the second limit point
+    # the corrector lands behind where the path came from; the step cannot be cut, the run
+    # stops
     with pytest.raises(ContinuationError, match="doubles back onto itself"):
-        trace("modified", arc_length=8.0, min_arc_length=8.0, max_arc_length=8.0)
+        trace("modified", target=1e3, arc_length=8.0, min_arc_length=8.0,
+              max_arc_length=8.0)
 
 
 @pytest.mark.parametrize("method", ["full", "modified", "bfgs"])

@@ -378,6 +378,11 @@ def test_arc_length_control_follows_the_arch_through_its_snap(demo):
     assert limits[1]["load_factor"] <= min(loads[top:]) + 1e-12
     crown = d["probes"]["crown"]["displacement"][1]
     assert crown < -2 * 30.0  # inverted: below the chord, as far as it rose above it
+    # an antisymmetric bifurcation comes first: passed on the symmetric branch, and said
+    assert d["critical_points"][0]["kind"] == "bifurcation"
+    assert any("bifurcation" in w for w in d["warnings"]) and d["control"] == "arc-length"
+    assert d["steps"][0]["negative_eigenvalues"] == 0 == d["steps"][-1]["negative_eigenvalues"]
+    assert max(s["negative_eigenvalues"] for s in d["steps"]) >= 1
 
 
 def test_arc_length_control_on_a_linear_problem_is_load_control(tmp_path, demo):

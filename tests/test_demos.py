@@ -289,11 +289,20 @@ def test_snap_through_follows_the_shallow_arch_through_both_limit_points(tmp_pat
     assert [c["kind"] for c in d["critical_points"]] == ["limit", "limit"]
     ref = d["limit_load_reference"] / d["load_unit"]
     assert d["final_load_factor"] == pytest.approx(1.5 * ref, rel=1e-12)
-    assert d["final_rise"] < -d["rise"]  # inverted, past the second limit point
+    assert d["final_rise"] < -d["initial_rise"]  # inverted, past the second limit point
     from fenics_nl.theory.arch import limit_rise
 
-    unstable = [p for p in d["path"] if abs(p["rise"]) < limit_rise(d["rise"])]
-    assert len(unstable) >= 5  # the branch between the limit points is traced
+    a_lim = limit_rise(d["initial_rise"])
+    unstable = [p for p in d["path"] if abs(p["rise"]) < a_lim]
+    assert len(unstable) == d["unstable_states"] >= 5  # the branch between the limit points
+    # the tangent has one negative eigenvalue there, none elsewhere (within 0.05 r of the
+    # closed form's limit rises: the continuum's own limit points are a little off them)
+    counts = {abs(p["rise"]) < a_lim - 0.05: set() for p in d["path"]}
+    for p in d["path"]:
+        if abs(abs(p["rise"]) - a_lim) > 0.05:
+            counts[abs(p["rise"]) < a_lim].add(p["negative_eigenvalues"])
+    assert counts == {True: {1}, False: {0}}
+    assert all(abs(e) < 0.02 for e in d["limit_loads_rel_error"])  # the minimum too
     (lx, ly), (rx, ry) = d["reactions"]["left pin"], d["reactions"]["right pin"]
     q_total = 2 / math.pi * 1.5 * d["limit_load_reference"]  # ∫ q0 sin(πx/L) dx, L = 1
     assert ly + ry == pytest.approx(q_total, rel=1e-6) and lx == pytest.approx(-rx, rel=1e-6)
@@ -310,6 +319,7 @@ def test_snap_through_two_ranks_match_serial(demo):
 
 @pytest.mark.parametrize("args,message", [
     (["--arc-length", "0"], "--arc-length must be > 0"), (["--rise", "1.5"], "--rise"),
+    (["--rise", "5"], "antisymmetrically"), (["--elements", "3"], "--elements must be even"),
     (["--max-steps", "3"], "not reached in 3 steps"), (["--slenderness", "5"], "slenderness"),
     (["-arch_full_ksp_veiw"], "was read by no solver"),
 ])

@@ -64,7 +64,15 @@ def solve_case(problem: CaseProblem) -> dict:
            "probes": last["probes"], "reactions": last["reactions"],
            "warnings": warnings(problem)}
     if critical is not None:
+        out["control"] = "arc-length"
         out["critical_points"] = critical
+        passed = [c for c in critical if c["kind"] == "bifurcation"]
+        if passed:  # the case runner does not switch branches
+            out["warnings"].append(
+                f"the path passed {len(passed)} bifurcation(s) (the first at load factor "
+                f"{passed[0]['load_factor']:.4g}) and stayed on its branch (the case runner "
+                "does not switch): its states with negative_eigenvalues > 0 are unstable, "
+                "the structure would leave them for another branch")
     if problem.contact is not None:
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
         out["contact_force"] = last["contact_force"]
@@ -84,11 +92,13 @@ def _follow_path(problem: CaseProblem, solver, steps: list, work: WorkCounts, co
     path = continuation.run(arc["target"], arc["max_steps"], progress=show,
                             on_step=lambda t, r: steps.append(step_record(problem, t, r)))
     work.add(path.work)
+    for record, negative in zip(steps, path.unstable, strict=True):
+        record["negative_eigenvalues"] = negative  # of the tangent: 0 where stable
     for c in path.critical_points:
         say(f"  {c.kind} point at load factor {c.factor:.6g} (between {c.between[0]:.6g} "
-            f"and {c.between[1]:.6g})")
-    return [{"kind": c.kind, "load_factor": c.factor, "between": list(c.between)}
-            for c in path.critical_points]
+            f"and {c.between[1]:.6g}, step {c.step})")
+    return [{"kind": c.kind, "load_factor": c.factor, "between": list(c.between),
+             "step": c.step} for c in path.critical_points]
 
 
 def step_record(problem: CaseProblem, t: float, result) -> dict:

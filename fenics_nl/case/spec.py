@@ -57,7 +57,9 @@ steps = 10               # equal steps to the load factor 1 (cut in half on fail
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
 # or path following through limit points (loads only: no prescribed displacement, no
-# contact; the load factor is an unknown, and the tangent's inertia is checked each step):
+# contact, not snes; the load factor is an unknown, and the tangent's inertia is checked
+# each step: the JSON lists the limit points and bifurcations met in "critical_points"; a
+# bifurcation is passed on the same branch, not left, and warned about):
 # control = "arc-length"
 # target = 1.0           # the load factor to reach (the path may pass it going down first)
 # arc_length = 0.1       # the first arc length, > 0 (dimensionless: about one load step)

@@ -97,7 +97,7 @@ class CriticalPoint:
     """A limit point or a bifurcation met between two converged steps."""
 
     kind: str  # "limit" or "bifurcation"
-    factor: float  # λ there: a limit point's, the extremum of λ over the bracketing states
+    factor: float  # λ there: a limit point's, the extremum of λ over the last 3 states
     # (without `detect`: the vertex of a parabola through the last 3); a bifurcation's, the
     # middle of the step that crossed it
     step: int  # the first converged step past it
@@ -283,7 +283,7 @@ class ArcLength:
         made it: full and periodic Newton, which build a new tangent at the first corrector
         iteration, then need no factorization for the predictor (modified Newton and BFGS
         factorize K(u_n) here anyway: it is their tangent for the step). Returns (Δu, Δλ,
-        iterations, the arc used).
+        iterations, the arc used, whether it was aimed at the target).
         """
         s = self.solver
         x = s.u.x.petsc_vec
@@ -316,6 +316,7 @@ class ArcLength:
             self._solve(q, dq, work)
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)
+        aimed = False
         if kick is None:  # along the tangent (dq, 1), in the sense of the last step
             sense = self._sense0
             if previous is not None:
@@ -325,11 +326,12 @@ class ArcLength:
             if target is not None and (target - lam0) * (target - lam0 - dlam) < 0:
                 # the predictor passes the target: aim at it, so that the landing is short
                 ds *= (target - lam0) / dlam
-                dlam = target - lam0
+                dlam, aimed = target - lam0, True
             dq.copy(du)
             du.scale(dlam)
         try:
-            return (*self._correct(x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms), ds)
+            return (*self._correct(x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms), ds,
+                    aimed)
         except _StepFailed:
             self._back_to(x0, lam0)
             du.destroy()
@@ -485,9 +487,9 @@ class ArcLength:
         t0 = time.perf_counter()
         work, norms = WorkCounts(), []
         try:
-            du, dlam, its, walk.ds = self._step(walk.lam, walk.ds, walk.previous, walk.kick,
-                                                work, norms, None if walk.bracket else target,
-                                                walk.tangent)
+            du, dlam, its, walk.ds, aimed = self._step(
+                walk.lam, walk.ds, walk.previous, walk.kick, work, norms,
+                None if walk.bracket else target, walk.tangent)
             if walk.kick is None and walk.previous is not None and self._turns_back(
                     du, dlam, walk.previous):
                 du.destroy()
@@ -511,8 +513,11 @@ class ArcLength:
             return None
         step = _Step(du, dlam, walk.lam + dlam, its, work, norms, t0, count, sense, turned,
                      bifurcation, leave, tangent)
-        if walk.kick is None and not leave and (walk.lam - target) * (step.lam - target) <= 0:
-            # the step passes the target: solve there (or cut the arc if that fails)
+        if walk.kick is None and not leave and (
+                aimed or (walk.lam - target) * (step.lam - target) <= 0):
+            # the step passes the target, or was aimed at it (the arc's corrector may stop
+            # just short of it, and aiming again would shrink the arc without end): solve
+            # there (or cut the arc if that fails)
             landing = self._land(target, walk.state, walk.lam, step.lam, work, norms)
             if landing is None:
                 for v in (du, tangent):
@@ -542,8 +547,8 @@ class ArcLength:
         path.work.add(work)
         path.bracketing_steps += 1
         walk.ds /= 2
-        say(f"  {'limit point' if turned else 'bifurcation'} past λ = {walk.lam:.6g}: "
-            f"bracketing it, arc {walk.ds:.3g}")
+        say(f"  {'limit point' if turned else 'bifurcation'} within the step from λ = "
+            f"{walk.lam:.6g}: bracketing it, arc {walk.ds:.3g}")
         return True
 
     def _accept(self, walk: _Walk, path: ContinuationPath, step: _Step, start: float,
@@ -567,8 +572,9 @@ class ArcLength:
         walk.arc.append(walk.arc[-1] + walk.ds)
         say(f"step {len(path.factors)}: λ = {step.lam:.6g}, arc {walk.ds:.3g}, {step.its} "
             f"iterations" + (", branch switched" if switched else ""))
-        if step.turned:  # the extremum of λ lies between the bracketing states
-            peak = max(between) if walk.sense > 0 else min(between)
+        if step.turned:  # the extremum of λ over the states around the bracketed step
+            near = [start, *path.factors][-3:]
+            peak = max(near) if walk.sense > 0 else min(near)
             path.critical_points.append(CriticalPoint("limit", peak, len(path.factors),
                                                       between))
             say(f"  limit point at λ = {peak:.6g}")
