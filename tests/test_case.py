@@ -380,6 +380,9 @@ def test_arc_length_control_follows_the_arch_through_its_snap(demo):
     assert crown < -2 * 30.0  # inverted: below the chord, as far as it rose above it
     # an antisymmetric bifurcation comes first: passed on the symmetric branch, and said
     assert d["critical_points"][0]["kind"] == "bifurcation"
+    # every critical point is bracketed (to 1/32 of the arc it was met with)
+    assert all(abs(c["between"][1] - c["between"][0]) < 0.02 * max(loads)
+               for c in d["critical_points"])
     assert any("bifurcation" in w for w in d["warnings"]) and d["control"] == "arc-length"
     assert d["steps"][0]["negative_eigenvalues"] == 0 == d["steps"][-1]["negative_eigenvalues"]
     assert max(s["negative_eigenvalues"] for s in d["steps"]) >= 1

@@ -23,9 +23,8 @@ Critical points (`detect`): at each converged state one MUMPS LDLᵀ factorizati
 tangent gives the number of its negative eigenvalues (its inertia) and, by one back-solve,
 the path's tangent (K⁻¹q, 1), whose λ-component tells the sense of the load there. Where the
 inertia changes, the path crossed a limit point if that sense changed too (the load passed
-an extremum), else a bifurcation. A limit point, and a bifurcation to be left, are
-bracketed: the step is redone with half the arc until it is 1/32 of its arc (a bifurcation
-that is passed is reported between the ends of the step that crossed it). With `switch`,
+an extremum), else a bifurcation. Either is bracketed: the step is redone with half the
+arc until it is 1/32 of its arc. With `switch`,
 the first bifurcation where the count grows is left along its critical mode, the tangent's
 eigenvector of its eigenvalue nearest 0 (SLEPc):
 the next step starts from u_n + Δs φ at the same λ, and the arc keeps it from falling back.
@@ -99,7 +98,7 @@ class CriticalPoint:
     kind: str  # "limit" or "bifurcation"
     factor: float  # λ there: a limit point's, the extremum of λ over the last 3 states
     # (without `detect`: the vertex of a parabola through the last 3); a bifurcation's, the
-    # middle of the step that crossed it
+    # middle of the (bracketed) step that crossed it
     step: int  # the first converged step past it
     between: tuple[float, float]  # λ of the converged states either side
 
@@ -117,7 +116,7 @@ class ContinuationPath:
     critical_points: list[CriticalPoint] = field(default_factory=list)
     switched: bool = False  # left a bifurcation along its mode
     failures: int = 0  # steps cut
-    bracketing_steps: int = 0  # steps redone shorter to bracket a bifurcation
+    bracketing_steps: int = 0  # steps redone shorter to bracket a critical point
     inertia_factorizations: int = 0  # the stability checks' (not in `work`)
     work: WorkCounts = field(default_factory=WorkCounts)
 
@@ -507,7 +506,7 @@ class ArcLength:
         turned = changed and walk.sense * sense < 0
         bifurcation = changed and not turned
         leave = bifurcation and self.switch and not path.switched and count > walk.count
-        if (turned or leave) and self._bracket(walk, path, work, du, turned, say):
+        if changed and self._bracket(walk, path, work, du, turned, say):
             if tangent is not None:
                 tangent.destroy()
             return None
@@ -583,14 +582,14 @@ class ArcLength:
               and step.dlam * walk.last_dlam < 0
               and min(abs(step.dlam), abs(walk.last_dlam)) > 1e-6 * walk.ds):  # not noise
             self._limit_point(path, walk.arc, start)
-        if step.bifurcation:
+        if step.bifurcation:  # bracketed: the path goes on with the arc it came with
             path.critical_points.append(CriticalPoint(
                 "bifurcation", sum(between) / 2, len(path.factors), between))
             say(f"  bifurcation between λ = {between[0]:.6g} and {between[1]:.6g} "
                 f"({walk.count} -> {step.count} negative eigenvalues)")
-        if step.leave:  # along the critical mode, with the arc the path came with
-            walk.kick = self._critical_mode()
             walk.ds, walk.bracket = walk.bracket.arc, None
+        if step.leave:  # along the critical mode
+            walk.kick = self._critical_mode()
         walk.last_dlam = None if switched else step.dlam
         walk.count, walk.sense = step.count, step.sense
         if walk.tangent is not None:
