@@ -70,6 +70,17 @@ def test_the_constraint_costs_back_solves_not_factorizations(method):
             assert (w.factorizations, w.linear_solves) == (1, 1 + k)
 
 
+def test_without_stability_checks_limit_points_come_from_the_load_factor():
+    # detect=False: no LDLᵀ per state; a limit point is where Δλ changes sign, at the
+    # vertex of the parabola λ(s) through the last 3 states (arcs held at 0.1: 1e-5 here)
+    _, path, _ = trace("full", detect=False, arc_length=0.1, max_arc_length=0.1,
+                       max_steps=200)
+    assert path.inertia_factorizations == 0
+    limits = [c.factor for c in path.critical_points if c.kind == "limit"]
+    assert len(limits) == len(path.critical_points) == 2
+    assert abs(limits[0] - 1) < 1e-3 and abs(limits[1] + 1) < 1e-3
+
+
 def test_the_same_truss_in_millimetres_takes_the_same_steps():
     _, metres, _ = trace("full")
     _, millimetres, _ = trace("full", scale=1e3)

@@ -149,7 +149,6 @@ class _Walk:
     kick: PETSc.Vec | None = None  # a critical mode to leave along
     tangent: PETSc.Vec | None = None  # K⁻¹q there, from the stability check
     bracket: _Bracket | None = None  # while a critical point is being bracketed
-    arc: list[float] = field(default_factory=lambda: [0.0])  # arc length at each state
 
     def destroy(self) -> None:
         """Destroy its vectors (collective)."""
@@ -568,7 +567,6 @@ class ArcLength:
         path.arc_lengths.append(walk.ds)
         path.unstable.append(step.count)
         path.work.add(step.work)
-        walk.arc.append(walk.arc[-1] + walk.ds)
         say(f"step {len(path.factors)}: λ = {step.lam:.6g}, arc {walk.ds:.3g}, {step.its} "
             f"iterations" + (", branch switched" if switched else ""))
         if step.turned:  # the extremum of λ over the states around the bracketed step
@@ -581,7 +579,7 @@ class ArcLength:
         elif (not self.detect and not switched and walk.last_dlam is not None
               and step.dlam * walk.last_dlam < 0
               and min(abs(step.dlam), abs(walk.last_dlam)) > 1e-6 * walk.ds):  # not noise
-            self._limit_point(path, walk.arc, start)
+            self._limit_point(path, start)
         if step.bifurcation:  # bracketed: the path goes on with the arc it came with
             path.critical_points.append(CriticalPoint(
                 "bifurcation", sum(between) / 2, len(path.factors), between))
@@ -656,10 +654,10 @@ class ArcLength:
         """Whether the increment points against the last one (the path doubles back)."""
         return self._dot(du, previous[0]) + self.psi**2 * dlam * previous[1] < 0
 
-    def _limit_point(self, path: ContinuationPath, arc: list[float], start: float) -> None:
+    def _limit_point(self, path: ContinuationPath, start: float) -> None:
         """λ changed sense: a limit point, at the vertex of λ(s) through the last 3 states."""
         lams = [start, *path.factors][-3:]
-        s = arc[-3:]
+        s = np.concatenate([[0.0], np.cumsum(path.arc_lengths)])[-3:]  # s of each state
         a, b, c = np.polyfit(s, lams, 2)
         # the vertex if it lies between the three states, else the middle one
         peak = c - b * b / (4 * a) if a != 0 and s[0] <= -b / (2 * a) <= s[2] else lams[1]
