@@ -280,10 +280,9 @@ def test_beam_arc_length_buckles_the_perfect_beam_without_the_elastica(demo, on_
 
 def test_snap_through_follows_the_shallow_arch_through_both_limit_points(tmp_path, demo):
     d = demo.json("snap_through.py", "--plot", "p.png", "--png", "s.png")
-    # the continuum against thin shallow-arch theory at L/h = 200: -0.48 %; it halves when
-    # L/h doubles (-1.06 % at 100, -0.23 % at 400), an O(h/L) difference between the
-    # continuum model (pinned at one node, loaded on its top face) and the theory; 2 % is
-    # the bound
+    # the continuum against thin shallow-arch theory at L/h = 200: -0.48 % (-1.06 % at 100,
+    # -0.45 % at 400): the continuum model (pinned at one node, loaded on its top face)
+    # against the theory; 2 % is the bound
     assert abs(d["limit_load_rel_error"]) < 0.02
     assert d["path_max_error"] < 0.02  # every state, on the cubic at its own rise
     assert [c["kind"] for c in d["critical_points"]] == ["limit", "limit"]
