@@ -15,6 +15,8 @@ $(VENV)/.installed: pyproject.toml
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[test]"
+	@# `import dolfinx` first works in this venv too (see the file)
+	cp fenics_nl/_import_order.pth "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/fenics_nl_import_order.pth"
 	@touch $@
 
 # the benchmarks' extra: numba and the J2 peer (see pyproject.toml's bench extra)
@@ -45,8 +47,11 @@ demo: $(VENV)/.installed
 
 test: test-serial test-mpi
 
+# the serial suite on both cores (pytest-xdist), then the tests that start mpiexec
+# themselves, alone (their ranks need the cores), then the mpi suite under mpiexec
 test-serial: $(VENV)/.installed
-	$(PY) -m pytest -m "not mpi" -q
+	$(PY) -m pytest -m "not mpi and not spawns_mpi" -q -n 2
+	$(PY) -m pytest -m "spawns_mpi" -q
 
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider

@@ -229,6 +229,7 @@ def solve(newton):
                       "tangent_assemblies": r.work.tangent_assemblies,
                       "krylov_iterations": r.work.krylov_iterations,
                       "residual_norms": list(r.residual_norms)})
+        cli.converged_step({"load_factor": t, **steps[-1]})
         sets = (f" in {r.active_set_iterations} active-set iterations"
                 if r.active_set_iterations else "")
         say(f"  {newton}: step {len(steps)}/{total}, F = {t * args.force:.4g} N, "

@@ -223,6 +223,9 @@ def record(t, result):
     tip = beam.tip()
     history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
                     tip["axial"]))
+    cli.converged_step({"load_factor": t, "load_ratio": r, "tip_rotation_deg": history[-1][1],
+                        "tip_deflection": history[-1][2], "tip_axial": history[-1][3],
+                        "newton_iterations": result.iterations})
     if args.png:
         shapes.append((r, centreline(beam)))
 

@@ -215,6 +215,9 @@ def record(t, result):
              else float(body.pressure.value))
     path.append((p_now, body.inner_displacement()))
     step_iterations.append(result.iterations)
+    cli.converged_step({"load_factor": p_now / target_pressure, "pressure": p_now,
+                        "inner_displacement": path[-1][1],
+                        "newton_iterations": result.iterations})
     say(f"  step {len(path) - 1}: p = {p_now:.6g} ({p_now / p_lim:.4f} p_lim), "
         f"u(a) = {path[-1][1]:.6g}, {result.iterations} Newton iterations")
 
@@ -223,6 +226,9 @@ def commit():
     material.commit(body.u, body.model)
 
 
+cli.known(dofs=body.dofs, ranks=comm.size, limit_pressure_exact=p_lim,
+          yield_onset_pressure_exact=p_e_exact)
+target_pressure = args.pressure_ratio * p_lim if control == "pressure" else p_lim
 if control == "pressure":
     target = args.pressure_ratio * p_lim
 

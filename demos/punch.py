@@ -252,6 +252,10 @@ states = load.states
 
 def report(t, result):
     s = states[-1]
+    cli.converged_step({"load_factor": t if len(states) <= args.steps else 1 - t,
+                        "indentation": s.indentation, "force": s.force,
+                        "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
+                        "active_set_iterations": s.active_set_iterations})
     say(f"step {len(states)}/{args.steps * (2 if args.unload else 1)}: δ = "
         f"{s.indentation:.5g}, P = {s.force:.6g}, "
         f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "

@@ -150,6 +150,8 @@ shapes = [(0.0, arch.centreline())] if args.png else []
 
 def record(lam, result):
     history.append((lam, arch.midspan_rise()))
+    cli.converged_step({"load_factor": lam, "midspan_rise": history[-1][1],
+                        "newton_iterations": result.iterations})
     if args.png:
         shapes.append((lam, arch.centreline()))
 

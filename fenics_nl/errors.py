@@ -2,7 +2,8 @@
 
 `SolveError` is the base of every failure a user can meet while solving (no convergence,
 a load that cannot be reached, an active set that cycles): a demo reports it in one line.
-Bad parameters are `ValueError`. Anything else is a bug and keeps its traceback.
+Bad parameters are `ValueError`, and so is `SupportError` (a body its supports do not hold).
+Anything else is a bug and keeps its traceback.
 """
 
 
@@ -16,3 +17,15 @@ class SolveError(RuntimeError):
     def __init__(self, message: str, result=None):
         super().__init__(message)
         self.result = result
+
+
+class SupportError(ValueError):
+    """The supports leave a rigid-body motion free: the problem as posed has no unique answer.
+
+    Bad input, not a solver failure: a step cut cannot mend it. `motions` names each free
+    motion ('translation along y', 'rotation about z through (0, 0)').
+    """
+
+    def __init__(self, message: str, motions: list[str] | None = None):
+        super().__init__(message)
+        self.motions = list(motions or [])

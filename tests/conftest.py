@@ -51,8 +51,9 @@ class Demos:
     output is in it).
     """
 
-    def __init__(self, tmp_path, capfd, monkeypatch):
+    def __init__(self, tmp_path, capfd, monkeypatch, request):
         self.tmp_path, self.capfd, self.monkeypatch = tmp_path, capfd, monkeypatch
+        self.spawns_mpi = request.node.get_closest_marker("spawns_mpi") is not None
 
     def run(self, args, check=True, ranks=1) -> subprocess.CompletedProcess:
         """`python demos/args[0] args[1:]`; with `check`, a non-zero exit fails the test.
@@ -99,6 +100,10 @@ class Demos:
         return subprocess.CompletedProcess([name, *argv], code, out, err)
 
     def _mpiexec(self, name, argv, ranks):
+        # its ranks need the cores: `make test` runs these tests after the parallel
+        # (pytest-xdist) serial suite, alone; MPICH's busy-waiting ranks crawl when
+        # oversubscribed
+        assert self.spawns_mpi, "a test that runs mpiexec must be marked spawns_mpi"
         script = ["-m", "fenics_nl"] if name == "-m fenics_nl" else [str(DEMOS / name)]
         cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, *script, *argv]
         return subprocess.run(cmd, cwd=self.tmp_path, capture_output=True, text=True,
@@ -121,9 +126,9 @@ class Demos:
 
 
 @pytest.fixture
-def demo(tmp_path, capfd, monkeypatch) -> Demos:
+def demo(tmp_path, capfd, monkeypatch, request) -> Demos:
     """Run the demos in `tmp_path` (see `Demos`)."""
-    return Demos(tmp_path, capfd, monkeypatch)
+    return Demos(tmp_path, capfd, monkeypatch, request)
 
 
 @pytest.fixture

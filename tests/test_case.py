@@ -1,8 +1,10 @@
 """Case files against closed forms, through `python -m fenics_nl` only."""
 
+import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
@@ -222,6 +224,7 @@ def test_every_shipped_case_checks(demo, path):
     assert "the case is complete" in proc.stdout
 
 
+@pytest.mark.spawns_mpi
 def test_two_ranks_give_the_serial_answer(demo):
     s = demo.case(CASES / "thick_cylinder.toml")
     p = demo.case(CASES / "thick_cylinder.toml", ranks=2)
@@ -256,6 +259,21 @@ def test_every_mistake_of_a_file_at_once(tmp_path, demo):
     for e in expected:
         assert sum(e in line for line in lines) == 1, (e, lines)
     assert len(lines) == len(expected)
+    assert "did you mean 'size'?" in next(line for line in lines if "mesh.sise" in line)
+
+
+def test_a_load_too_large_for_floating_point_names_its_key(tmp_path, demo):
+    write(tmp_path, "bar.geo", BAR_GEO)
+    lines = check(demo, tmp_path, BAR.replace("[50.0, 0.0, 0.0]", "[1e308, 1e308, 0.0]"))
+    assert len(lines) == 1 and lines[0].startswith("error: boundary[4].traction: "), lines
+    assert "overflows floating point" in lines[0]
+
+
+def test_a_misspelt_key_beside_the_missing_one_is_named(tmp_path, demo):
+    write(tmp_path, "bar.geo", BAR_GEO)
+    lines = check(demo, tmp_path, BAR.replace('law = "linear-elastic"', 'lawe = "j2"'))
+    assert any("material.law: missing" in line for line in lines), lines
+    assert any("material.lawe: unknown key (did you mean 'law'?" in line for line in lines)
 
 
 def test_a_2d_model_on_a_3d_mesh_is_one_line(tmp_path, demo):
@@ -420,3 +438,94 @@ def test_arc_length_refuses_what_it_cannot_scale(tmp_path, demo):
         'group = "middle"\ntraction = [1.0, 0.0]', 'group = "middle"\ndisplacement = [0.1, '
                                                   '"free"]'), geo=SPLIT_GEO)
     assert any("arc-length control scales loads only" in line for line in lines), lines
+
+
+def without_symmetry_y(tmp_path):
+    text = (CASES / "thick_cylinder.toml").read_text()
+    tables = text.split("[[boundary]]")
+    text = "[[boundary]]".join(t for t in tables if "symmetry_y" not in t)
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    return write(tmp_path, "free.toml", text)
+
+
+def test_a_body_its_supports_leave_free_is_one_line(tmp_path, demo):
+    # the quarter cylinder without its symmetry_y support slides along y
+    proc = demo.run(["-m fenics_nl", "run", without_symmetry_y(tmp_path), "--json",
+                     tmp_path / "free.json"], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "translation along y" in lines[0] and "support or a symmetry condition" in lines[0]
+    assert not (tmp_path / "free.json").exists()  # bad input: nothing was solved
+
+
+def test_the_stress_at_a_probe_is_lame(demo):
+    # Lamé at the bore: σ_r = −p, σ_θ = p (b² + a²)/(b² − a²), σ_z = ν(σ_r + σ_θ); the same
+    # P2 evaluation as von Mises above (measured −0.2 %, −0.9 %, −2.5 % of p)
+    d = demo.case(CASES / "thick_cylinder.toml")
+    s = d["probes"]["inner"]["stress"]
+    sr, st = -100.0, 100.0 * 500 / 300
+    assert [s[0][0], s[1][1], s[2][2]] == pytest.approx([sr, st, 0.3 * (sr + st)], abs=3.0)
+    assert abs(s[0][1]) < 0.02 * 100.0 and s[0][2] == s[1][2] == 0.0
+
+
+def test_a_case_loaded_past_its_limit_keeps_every_converged_step(tmp_path, demo):
+    # p_lim = 2 × 120 ln 2 / √3 = 96.05: factors 0.5 and 0.8 (80) converge, 1.2 (120) has no
+    # equilibrium; the message gives the case's own load factors, not a segment's fraction
+    text = (CASES / "thick_cylinder.toml").read_text()
+    text = text.replace('law = "linear-elastic"', 'law = "j2"\nsigma0 = 120.0')
+    text = text.replace("steps = 1", "steps = [0.5, 0.8, 1.2]\nadaptive = false")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    out, fields = tmp_path / "run.json", tmp_path / "fields"
+    proc = demo.run(["-m fenics_nl", "run", write(tmp_path, "j2.toml", text), "--json", out,
+                     "--output", fields], check=False)
+    assert proc.returncode == 2
+    error = [line for line in proc.stderr.splitlines() if line.startswith("error")]
+    assert len(error) == 1 and "load factor 1.2 not reached" in error[0], proc.stderr
+    assert "last converged load factor is 0.8 " in error[0]
+    d = json.loads(out.read_text())
+    assert d["status"] == "failed" and d["message"] in error[0]
+    assert d["load_factor"] == 0.8 and d["converged_steps"] == 2
+    assert [s["load_factor"] for s in d["steps"]] == [0.5, 0.8]
+    # the steps are the converged states: σ_r(a) = −p at each
+    for s in d["steps"]:
+        sr = s["probes"]["inner"]["stress"][0][0]
+        assert sr == pytest.approx(-100.0 * s["load_factor"], rel=0.01)
+    # the fields of both converged steps, the load factor as time
+    times, _ = read_series(fields / "displacement.bp", "displacement")
+    assert times == [0.5, 0.8]
+    times, p = read_series(fields / "cumulated_plastic_strain.bp", "cumulated_plastic_strain")
+    assert times == [0.5, 0.8] and p[0].max() == 0.0 < p[1].max()  # 0.8 > p_e = 0.52 p_lim
+
+
+def read_series(path, name):
+    """(times, values per step) of one VTX field."""
+    import adios2
+
+    times, values = [], []
+    with adios2.Stream(str(path), "r") as f:
+        for _ in f.steps():
+            times.append(float(np.ravel(f.read("step"))[0]))
+            values.append(np.asarray(f.read(name)))
+    return times, values
+
+
+def test_every_step_of_a_case_is_a_time_series(tmp_path, demo):
+    # the elastic cylinder in two steps: the displacement at 0.5 is half that at 1.0
+    text = (CASES / "thick_cylinder.toml").read_text().replace("steps = 1", "steps = 2")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    demo.case(write(tmp_path, "two.toml", text), "--output", tmp_path / "fields")
+    times, u = read_series(tmp_path / "fields" / "displacement.bp", "displacement")
+    assert times == [0.5, 1.0]
+    assert np.abs(u[0] - 0.5 * u[1]).max() < 1e-12 * np.abs(u[1]).max()
+
+
+def test_an_output_path_that_cannot_be_written_is_refused_before_the_solve(tmp_path, demo):
+    for flag, path in (("--json", tmp_path / "missing" / "x.json"),
+                       ("--png", tmp_path / "missing" / "x.png"),
+                       ("--output", tmp_path / "file.txt" / "fields")):
+        (tmp_path / "file.txt").write_text("")
+        proc = demo.run(["-m fenics_nl", "run", CASES / "thick_cylinder.toml", flag, path],
+                        check=False)
+        assert proc.returncode == 2 and "load factor" not in proc.stdout, proc.stdout
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and flag in lines[0], proc.stderr

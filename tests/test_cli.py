@@ -25,3 +25,17 @@ def test_anything_else_is_one_clear_error(argv, capsys):
         parse_with_petsc_options(parser(), argv)
     assert exc.value.code == 2
     assert "unrecognized arguments" in capsys.readouterr().err
+
+
+def test_a_dolfinx_script_that_imports_dolfinx_first_runs_in_the_venv(tmp_path):
+    # make installs a finder that loads the wheel's MPI before dolfinx's compiled modules
+    import subprocess
+    import sys
+
+    script = tmp_path / "user.py"
+    script.write_text("import dolfinx\nfrom dolfinx import mesh\nfrom mpi4py import MPI\n"
+                      "m = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)\n"
+                      "print(m.topology.index_map(2).size_global)\n")
+    proc = subprocess.run([sys.executable, script], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == "8", proc.stderr

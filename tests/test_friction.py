@@ -204,6 +204,7 @@ def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
     assert rough["slip_nodes"] == 0 and rough["stick_nodes"] == rough["nodes_in_contact"]
 
 
+@pytest.mark.spawns_mpi
 def test_friction_two_ranks_give_the_serial_answer(demo):
     # a block 10 a wide: there the partition cuts the contact zone (both ranks own stick
     # and slip nodes: `test_friction_on_a_cut_contact_zone` checks it)
@@ -294,6 +295,7 @@ def test_friction_on_a_cut_contact_zone(model):
 BRACKET_ON_FLOOR = ("--support", "contact", "--size", "20", "--steps", "2")
 
 
+@pytest.mark.spawns_mpi
 def test_bracket_on_a_rough_floor(demo):
     # f = 0 is the frictionless floor; at f = 0.3 the floor takes a tangential force (the
     # bolts no longer hold exactly the pull), within Coulomb's cone as a whole, and holds

@@ -9,6 +9,8 @@ load factor.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import ufl
 from dolfinx import fem
@@ -29,6 +31,7 @@ from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import SnesSolver
 
 PREFIX = "case_"
+FLOAT_RANGE = 1e150  # a load beyond it has no square in double precision (max ~1.8e308)
 
 
 class CaseProblem:
@@ -122,9 +125,15 @@ class CaseProblem:
         total = 0.0
         for c in self.case.conditions:
             if c.kind in ("traction", "pressure"):
-                size = float(np.linalg.norm(c.value)) if c.kind == "traction" else abs(c.value)
+                # hypot: no overflow warning for a huge component
+                size = math.hypot(*c.value) if c.kind == "traction" else abs(c.value)
                 area = fem.assemble_scalar(fem.form(self.weight * self.ds(tag[c.group])))
                 total += size * self.mesh.comm.allreduce(area)
+                if not total < FLOAT_RANGE:  # inf and NaN too
+                    raise CaseError([f"{c.key}: the load it gives (its size {size:.3g} × the "
+                                     f"group's area) is beyond {FLOAT_RANGE:.0e}: its square "
+                                     "(in norms and energies) overflows floating point; use "
+                                     "other units"])
         return total or None
 
     def _pressure_direction(self, c: Condition):
@@ -305,16 +314,25 @@ class CaseProblem:
                         f"the mesh" for i in probes.outside]
 
     def probe_values(self) -> dict[str, dict]:
-        """Displacement and von Mises stress at every probe (see `domain.probes`)."""
+        """Displacement, von Mises and Cauchy stress at every probe (see `domain.probes`).
+
+        The stress in the model's components: 3x3 in (x, y, z); plane strain (x, y, z) with
+        σ_zz; plane stress 2x2; axisymmetric (r, z, θ).
+        """
         if not self.case.probes:
             return {}
         u = self.probes.continuous(self.displacement())
-        expression = (mixed_form.von_mises_expression(self.material, self.u, self.mixed.p,
-                                                      self.model) if self.mixed else
-                      self.material.von_mises_expression(self.u, self.model))
+        if self.mixed:
+            expression = mixed_form.von_mises_expression(self.material, self.u, self.mixed.p,
+                                                         self.model)
+            stress = mixed_form.cauchy_stress(self.material, self.u, self.mixed.p, self.model)
+        else:
+            expression = self.material.von_mises_expression(self.u, self.model)
+            stress = self.material.cauchy_stress(self.u, self.model)
         vm = self.probes.discontinuous("von_mises", expression, self.case.degree)
-        return {p.name: {"displacement": d, "von_mises": s}
-                for p, d, s in zip(self.case.probes, u, vm, strict=True)}
+        sigma = self.probes.discontinuous("stress", stress, self.case.degree)
+        return {p.name: {"displacement": d, "von_mises": s, "stress": t}
+                for p, d, s, t in zip(self.case.probes, u, vm, sigma, strict=True)}
 
 
 class ContactSteps:

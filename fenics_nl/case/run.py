@@ -2,27 +2,69 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.case.problem import CaseProblem
-from fenics_nl.io import output
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength
-from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
 
-def solve_case(problem: CaseProblem) -> dict:
+def solve_case(problem: CaseProblem, output_folder: str | None = None) -> dict:
     """Visit the case's load factors in order; returns the JSON record of the run.
 
     Each segment between two factors starts as one step and is cut in half on failure
     (`loading.adaptive`); every converged step is recorded with its load factor, Newton
-    (and active-set) iterations, probes, reactions and, with contact, the contact force.
+    (and active-set) iterations, probes, reactions and, with contact, the contact force,
+    and handed to `cli.converged_step` (a run that fails later keeps it). With
+    `output_folder`, the fields of every converged step are written as a time series.
     """
-    case, steps, work = problem.case, [], WorkCounts()
+    t0 = time.perf_counter()
     solver = problem.make_solver()
+    setup = time.perf_counter() - t0
+    series = output.FieldSeries(output_folder, lambda: fields(problem)) if output_folder \
+        else None
+    try:
+        out = _solve(problem, solver, series)
+    finally:
+        if series is not None:
+            paths = series.paths
+            series.close()
+            if series.times:
+                say(f"wrote {', '.join(str(p) for p in paths)} ({len(series.times)} "
+                    "steps, the load factor as time; ADIOS2 VTX: open in ParaView)")
+    out["solver_setup_time_s"] = setup
+    return out
+
+
+def fields(problem: CaseProblem) -> list:
+    """The fields written at each step: displacement, von Mises, and what the case has."""
+    functions = [problem.displacement(), problem.von_mises()]
+    if problem.mixed:
+        functions.append(problem.mixed.pressure())
+    if getattr(problem.material, "path_dependent", False):
+        functions += [problem.material.cumulated_plastic_strain_per_cell(),
+                      problem.material.plastic_strain_per_cell()]
+    if problem.contact is not None:
+        functions += problem.solver.contact.fields(problem.weight)
+    return functions
+
+
+def _solve(problem: CaseProblem, solver, series) -> dict:
+    """The load path of `solve_case`."""
+    case, steps, work = problem.case, [], WorkCounts()
+
+    def converged(t, result):
+        steps.append(step_record(problem, t, result))
+        cli.converged_step(steps[-1])
+        if series is not None:
+            series.write(t)
 
     commit = None
     if getattr(problem.material, "path_dependent", False):  # committed when a step converges
@@ -35,12 +77,15 @@ def solve_case(problem: CaseProblem) -> dict:
 
     critical = None
     if case.arc is not None:  # the load factor is an unknown: through limit points
-        critical = _follow_path(problem, solver, steps, work, commit, show)
+        critical = _follow_path(problem, solver, converged, steps, work, commit, show)
     elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
-        path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
-                                   max_step=1.0 / n, progress=show, commit=commit,
-                                   on_step=lambda t, r: steps.append(step_record(problem, t, r)))
+        try:
+            path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
+                                       max_step=1.0 / n, progress=show, commit=commit,
+                                       on_step=converged)
+        except LoadStepError as err:
+            raise _not_reached(err, err.target, steps) from err
         work.add(path.work)
     else:  # from factor to factor, each segment one step (cut in half on failure)
         previous = 0.0
@@ -49,10 +94,14 @@ def solve_case(problem: CaseProblem) -> dict:
                 problem.set_load(a + s * (b - a))
 
             def record(s, result, a=previous, b=target):  # the target itself when reached
-                steps.append(step_record(problem, b if s == 1 else a + s * (b - a), result))
+                converged(b if s == 1 else a + s * (b - a), result)
 
-            path = solve_incrementally(solver, load, 1, adaptive=case.adaptive,
-                                       on_step=record, progress=show, commit=commit)
+            try:
+                path = solve_incrementally(solver, load, 1, adaptive=case.adaptive,
+                                           on_step=record, progress=show, commit=commit)
+            except LoadStepError as err:  # err's factors are fractions of the segment
+                raise _not_reached(err, previous + err.target * (target - previous),
+                                   steps) from err
             work.add(path.work)
             previous = target
     last = steps[-1]
@@ -79,8 +128,20 @@ def solve_case(problem: CaseProblem) -> dict:
     return out
 
 
-def _follow_path(problem: CaseProblem, solver, steps: list, work: WorkCounts, commit,
-                 show) -> list[dict]:
+def _not_reached(err: LoadStepError, asked: float, steps: list[dict]) -> LoadStepError:
+    """The driver's failure in the case's own load factors (a segment's are fractions)."""
+    reached = steps[-1]["load_factor"] if steps else 0.0
+    cause = str(err.__cause__ or err).split(": ", 1)[-1] if err.__cause__ else str(err)
+    return LoadStepError(
+        f"load factor {asked:.6g} not reached: the last converged load factor is "
+        f"{reached:.6g} ({len(steps)} converged steps); the limit load is reached, or the "
+        f"solver cannot take the step (the last attempt: {cause}); past a limit point, "
+        'follow the path with [loading] control = "arc-length"', err.result,
+        reached=reached, target=asked)
+
+
+def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
+                 work: WorkCounts, commit, show) -> list[dict]:
     """`loading.control = "arc-length"`: the path to the target; its critical points."""
     arc = problem.case.arc
     mixed = problem.mixed
@@ -89,8 +150,7 @@ def _follow_path(problem: CaseProblem, solver, steps: list, work: WorkCounts, co
         max_arc_length=arc["max_arc_length"], commit=commit, prefix="case_continuation_",
         metric_dofs=mixed.displacement_dofs if mixed else None,
         multipliers=mixed.pressure_dofs if mixed else 0)
-    path = continuation.run(arc["target"], arc["max_steps"], progress=show,
-                            on_step=lambda t, r: steps.append(step_record(problem, t, r)))
+    path = continuation.run(arc["target"], arc["max_steps"], progress=show, on_step=converged)
     work.add(path.work)
     for record, negative in zip(steps, path.unstable, strict=True):
         record["negative_eigenvalues"] = negative  # of the tangent: 0 where stable
@@ -130,20 +190,10 @@ def warnings(problem: CaseProblem) -> list[str]:
     return notes
 
 
-def write_outputs(problem: CaseProblem, folder: str | None, png: str | None):
-    """Writers for run_scene: VTX fields and the picture, each on its own."""
-    vm = problem.von_mises() if folder or png else None
+def write_outputs(problem: CaseProblem, png: str | None):
+    """Writers for run_scene: the picture (the fields were written step by step)."""
+    vm = problem.von_mises() if png else None
     writers = []
-    if folder:
-        def fields():
-            functions = [problem.displacement(), vm]
-            if problem.mixed:
-                functions.append(problem.mixed.pressure())
-            if problem.contact is not None:
-                functions += problem.solver.contact.fields(problem.weight)
-            paths = output.write_fields(folder, functions)
-            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-        writers.append(fields)
     if png:
         def picture():
             from fenics_nl.io.pictures import deformed_picture, facet_points

@@ -9,6 +9,7 @@ required one, a value of the wrong type or out of range. Each message names the 
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field, fields
@@ -29,7 +30,8 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
-nu = 0.3                 # Mises plasticity) also sigma0, H (isotropic), C (kinematic hardening)
+nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
+                         # (kinematic hardening modulus), each 0 by default (perfect plasticity)
 
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
@@ -72,7 +74,9 @@ linear = "direct"        # direct (MUMPS LU) | iterative (CG + GAMG)
 tolerance = 1e-9         # |R| <= tolerance x the force scale of the step ends Newton
 max_iterations = 50      # Newton iterations per step
 
-[[probe]]                # optional: displacement and von Mises stress at a point, every step
+[[probe]]                # optional: displacement, von Mises and Cauchy stress (key stress, the
+                         # model's components: (x, y, z), plane stress (x, y), axisymmetric
+                         # (r, z, θ)) at a point, every step
 name = "tip"
 point = [10.0, 1.0]
 """
@@ -84,6 +88,8 @@ LAWS: dict[str, type[laws.Material]] = {
     "neo-hookean": laws.NeoHookean,
     "j2": J2Plasticity,
 }
+# parameters a case may leave out, and their values: J2 without hardening is perfect plasticity
+OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}}
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "quasi-newton", "snes")
 LINEAR = ("direct", "iterative")
@@ -177,7 +183,9 @@ class _Reader:
     def unknown(self, table: dict, where: str, allowed: tuple[str, ...]) -> None:
         for k in table:
             if k not in allowed:
-                self.fail(f"{where}.{k}", f"unknown key (accepted: {', '.join(allowed)})")
+                near = difflib.get_close_matches(k, allowed, n=1)
+                hint = f"did you mean {near[0]!r}? " if near else ""
+                self.fail(f"{where}.{k}", f"unknown key ({hint}accepted: {', '.join(allowed)})")
 
     def get(self, table: dict, key: str, where: str, kind, *, default=None, required=False,
             choices=None, positive=False, minimum=None):
@@ -309,14 +317,19 @@ def _material(r: _Reader, data: dict, model: str | None):
         r.fail("material", "missing table" if m is None else "must be a table [material]")
         return None, {}
     law = r.get(m, "law", "material", str, required=True, choices=tuple(LAWS))
-    if law is None:
+    if law is None:  # still name a misspelt key (lawe = ...) beside the missing law
+        every = {f.name for cls in LAWS.values() for f in fields(cls)
+                 if not f.name.startswith("_")}
+        r.unknown(m, "material", ("law", *sorted(every)))
         return None, {}
     params = [f for f in fields(LAWS[law]) if not f.name.startswith("_")]  # not the state
     accepted = tuple(f.name for f in params)
     r.unknown(m, "material", ("law", *accepted))
     parameters = {}
-    for f in params:  # every parameter, even one the class defaults: say it
-        value = r.get(m, f.name, "material", float, required=True)
+    defaults = OPTIONAL.get(law, {})
+    for f in params:  # every parameter but a documented optional one: say it
+        value = r.get(m, f.name, "material", float, required=f.name not in defaults,
+                      default=defaults.get(f.name))
         if value is not None:
             parameters[f.name] = value
     if len(parameters) == len(params):

@@ -40,7 +40,7 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.contact.surface import ContactSurface
-from fenics_nl.errors import SolveError
+from fenics_nl.errors import SolveError, SupportError
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
@@ -218,6 +218,20 @@ class ActiveSetContact:
             return np.zeros(n, dtype=bool)
         return self.surface.sync(self.normal_gap() >= 0)
 
+    def _unheld(self, err: SupportError, k: int) -> SupportError:
+        """The free-body error, saying how many contact nodes hold the body at iteration k."""
+        n = self.surface.count(self.active)
+        if n:
+            where = f"{n} active contact node(s) at active-set iteration {k} and the supports"
+        else:
+            where = (f"no contact node is active (active-set iteration {k}): contact does not "
+                     "hold the body yet, and the supports")
+        free = "; ".join(err.motions)
+        return SupportError(
+            f"{where} leave a rigid-body motion free ({free}); add a support or a symmetry "
+            "condition, or hold the body by contact from the start (the obstacle touching, "
+            "a prescribed displacement)", err.motions)
+
     # -- the loop ----------------------------------------------------------------------
 
     def solve(self) -> SolveResult:
@@ -234,7 +248,10 @@ class ActiveSetContact:
         changes = None  # nodes that changed since the last solve (None: unknown, many)
         for k in range(1, self.max_iterations + 1):
             self.system.set_active(self.active, changes)
-            nr = self.system.solve()
+            try:
+                nr = self.system.solve()
+            except SupportError as err:
+                raise self._unheld(err, k) from None
             res.iterations += nr.iterations
             res.work.add(nr.work)
             res.residual_norms = nr.residual_norms

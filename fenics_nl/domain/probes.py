@@ -43,12 +43,16 @@ class Probes:
             out.append(comm.bcast(value, root=owner))
         return out
 
-    def discontinuous(self, name: str, expr, degree: int) -> list[float]:
-        """Values of a scalar UFL expression at the points (collective; compiled once)."""
+    def discontinuous(self, name: str, expr, degree: int) -> list:
+        """Values of a UFL expression at the points (collective; compiled once).
+
+        A float per point for a scalar, nested lists of the expression's shape for a tensor.
+        """
+        shape = expr.ufl_shape
         if name not in self._fields:
             import basix.ufl
 
-            el = basix.ufl.element("DG", self.mesh.basix_cell(), degree,
+            el = basix.ufl.element("DG", self.mesh.basix_cell(), degree, shape=shape or None,
                                    lagrange_variant=basix.LagrangeVariant.legendre)
             Q = fem.functionspace(self.mesh, el)
             self._fields[name] = (fem.Function(Q),
@@ -56,7 +60,10 @@ class Probes:
         f, compiled = self._fields[name]
         f.interpolate(compiled)
         comm, out = self.mesh.comm, []
+        size = int(np.prod(shape)) if shape else 1
         for x, _, _, owned in self.where:
-            total = sum(float(f.eval(x, np.array([c], dtype=np.int32))[0]) for c in owned)
-            out.append(comm.allreduce(total) / comm.allreduce(len(owned)))
+            total = sum((f.eval(x, np.array([c], dtype=np.int32))[:size] for c in owned),
+                        np.zeros(size))
+            mean = comm.allreduce(total) / comm.allreduce(len(owned))
+            out.append(mean.reshape(shape).tolist() if shape else float(mean[0]))
         return out

@@ -7,6 +7,11 @@ name; PETSc options accepted only under the run's own prefixes), the last `resul
 `run_file` turns the library's errors into one line and a non-zero exit, writes the JSON
 first and then every other output, each on its own, so that a failing picture never loses
 the numbers, and reports a PETSc option that no solver read.
+
+Nothing computed is lost: the output paths are checked before anything is solved, and each
+converged step a scene reports (`converged_step`) is kept, so that a run that fails after
+some steps still writes its JSON, with ``"status": "failed"``, the message, every converged
+step and the last converged load factor.
 """
 
 from __future__ import annotations
@@ -199,7 +204,7 @@ def error(message: str) -> None:
 
 
 class _Run:
-    """A demo run in progress: its command line, PETSc options, results and writers."""
+    """A run in progress: its command line, PETSc options, converged steps, results, writers."""
 
     def __init__(self, argv: Sequence[str]):
         self.argv = list(argv)
@@ -207,9 +212,55 @@ class _Run:
         self.json_path: str | None = None
         self.out: dict | None = None
         self.writers: Sequence[Callable[[], None]] = ()
+        self.steps: list[dict] = []  # every converged step, as the scene reported it
+        self.known: dict = {}  # quantities set before the solve (dofs, references)
 
 
 _current: _Run | None = None
+
+
+def converged_step(record: dict) -> None:
+    """Keep one converged step's quantities (a dict with its ``load_factor``).
+
+    They go to the JSON as ``steps``, and stay there if a later step fails. Outside a run
+    (a notebook, an import) nothing is kept.
+    """
+    if _current is not None:
+        _current.steps.append(dict(record))
+
+
+def known(**quantities) -> None:
+    """Quantities known before the solve (``dofs``, reference values): in any JSON written."""
+    if _current is not None:
+        _current.known.update(quantities)
+
+
+def check_output_paths(json: str | None = None, png: str | None = None,
+                       plot: str | None = None, output: str | None = None) -> None:
+    """Refuse an output path that cannot be written, before anything is solved (ValueError).
+
+    A file's folder must exist and be writable (and the file, if it exists, be a writable
+    file); `output`, a folder, must be one or be creatable.
+    """
+    for flag, path in (("--json", json), ("--png", png), ("--plot", plot)):
+        if path is None:
+            continue
+        target = Path(path)
+        folder = target.parent
+        if target.is_dir():
+            raise ValueError(f"{flag} {path}: is a folder, not a file")
+        if not folder.is_dir():
+            raise ValueError(f"{flag} {path}: the folder {folder} does not exist")
+        if not os.access(folder, os.W_OK) or (target.exists() and not os.access(target,
+                                                                               os.W_OK)):
+            raise ValueError(f"{flag} {path}: not writable")
+    if output is not None:
+        target = Path(output)
+        existing = next(p for p in (target, *target.parents) if p.exists())
+        if not existing.is_dir():
+            raise ValueError(f"--output {output}: {existing} is a file, not a folder")
+        if not os.access(existing, os.W_OK):
+            raise ValueError(f"--output {output}: {existing} is not writable")
 
 
 def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
@@ -233,14 +284,12 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
         _forget(run.options)
         return stop.code if isinstance(stop.code, int) else int(stop.code is not None)
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
-        error(_one_line(err))
-        _forget(run.options)
-        return 2
+        return _failed(run, err, t0)
     finally:
         _current = None
     if run.out is None:
         raise RuntimeError(f"{path} ended without calling cli.results")
-    return _finish(run.out, run.writers, run.options, run.json_path, t0)
+    return _finish(run, t0)
 
 
 def arguments(parser: argparse.ArgumentParser,
@@ -255,6 +304,11 @@ def arguments(parser: argparse.ArgumentParser,
     args, petsc = parse_with_petsc_options(parser, run.argv if run else [])
     if run is not None:
         run.json_path = getattr(args, "json", None)
+        try:
+            check_output_paths(*(getattr(args, k, None) for k in ("json", "png", "plot",
+                                                                   "output")))
+        except ValueError as err:
+            parser.error(str(err))
         run.options = PetscOptions(petsc, prefixes(args) if callable(prefixes) else prefixes)
     return args
 
@@ -275,16 +329,18 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
     """
     from petsc4py import PETSc
 
+    global _current
     t0 = time.perf_counter()
-    options = None
+    run = _current = _Run([])
+    run.json_path = json_path
     try:
-        options = PetscOptions(petsc_argv, prefixes or {})
-        out, writers = solve()
+        run.options = PetscOptions(petsc_argv, prefixes or {})
+        run.out, run.writers = solve()
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
-        error(_one_line(err))
-        _forget(options)
-        return 2
-    return _finish(out, writers, options, json_path, t0)
+        return _failed(run, err, t0)
+    finally:
+        _current = None
+    return _finish(run, t0)
 
 
 def _forget(options: PetscOptions | None) -> None:
@@ -293,26 +349,65 @@ def _forget(options: PetscOptions | None) -> None:
         options.unused()
 
 
-def _finish(out: dict, writers: Sequence[Callable[[], None]], options: PetscOptions | None,
-            json_path: str | None, t0: float) -> int:
-    """Warnings, the JSON (first), every writer on its own, unread PETSc options."""
-    out["wall_time_s"] = time.perf_counter() - t0
-    out.setdefault("warnings", [])
-    for w in out["warnings"]:
-        say(f"warning: {w}")
-    status = 0
-    try:  # on every rank, so that every rank stops here together
+def _failed(run: _Run, err: BaseException, t0: float) -> int:
+    """One line, and, for a solve that failed (not bad input), the JSON of what converged."""
+    message = _one_line(err)
+    error(message)
+    _forget(run.options)
+    if isinstance(err, SolveError) and run.json_path:
+        last = next((s["load_factor"] for s in reversed(run.steps) if "load_factor" in s),
+                    None)
+        out = {**run.known, "status": "failed", "message": message,
+               "converged_steps": len(run.steps), "load_factor": last, "steps": run.steps,
+               "ranks": MPI.COMM_WORLD.size, "wall_time_s": time.perf_counter() - t0,
+               "warnings": ["the run failed: the quantities are those of the last converged "
+                            "step"] if run.steps else ["the run failed before any step "
+                                                       "converged"]}
+        _write_json(out, run.json_path)
+        say(f"wrote {run.json_path} (status failed, {len(run.steps)} converged step(s))")
+    return 2
+
+
+def _write_json(out: dict, json_path: str | None) -> bool:
+    """`out` as JSON at `json_path` (rank 0); False, said in one line, if it cannot be.
+
+    Collective: every rank encodes it, so that every rank stops here together.
+    """
+    try:
         text = json.dumps(out, indent=2, allow_nan=False)
     except ValueError:  # a NaN among the results: a defect, never a silent answer
         error("a result is not a finite number: no output written")
-        _forget(options)
-        return 2
+        return False
     if json_path and MPI.COMM_WORLD.rank == 0:
         try:
             Path(json_path).write_text(text)
         except OSError as err:
             error(f"cannot write {json_path}: {err.strerror}")
-            status = 1
+            return False
+    return True
+
+
+def _finish(run: _Run, t0: float) -> int:
+    """Warnings, the JSON (first), every writer on its own, unread PETSc options."""
+    out, writers, options = run.out, run.writers, run.options
+    out["wall_time_s"] = time.perf_counter() - t0
+    out.setdefault("warnings", [])
+    out.setdefault("status", "ok")
+    if run.steps:
+        out.setdefault("steps", run.steps)
+    for key, value in run.known.items():
+        out.setdefault(key, value)
+    for w in out["warnings"]:
+        say(f"warning: {w}")
+    status = 0
+    try:
+        json.dumps(out, allow_nan=False)
+    except ValueError:  # a NaN among the results: a defect, never a silent answer
+        error("a result is not a finite number: no output written")
+        _forget(options)
+        return 2
+    if not _write_json(out, run.json_path):
+        status = 1
     for write in writers:
         try:
             write()

@@ -2,6 +2,8 @@
 
 * `write_fields`: one ADIOS2 VTX file per function (any Lagrange degree, on any mesh
   degree: P2 on quadrilaterals included), which ParaView opens directly.
+* `FieldSeries`: the same files as a time series, one time per converged load step (the
+  load factor as time), written as the steps converge: a run that fails keeps them.
 * `gather_grid`: the mesh of a Lagrange space, its nodal and cell fields, collected from
   every rank on rank 0, so that a picture shows the whole body whatever the number of ranks.
 """
@@ -34,6 +36,53 @@ def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path
             w.write(0.0)
         paths.append(path)
     return paths
+
+
+class FieldSeries:
+    """`folder`/<name>.bp for each function, one time (the load factor) per `write(t)`.
+
+    `functions()` gives the fields of the current state (new Function objects each call are
+    fine: their values are copied into the series' own). Each file is written and flushed
+    at every step. Collective; `close()` at the end, or use it as a context manager.
+    """
+
+    def __init__(self, folder: str | Path, functions):
+        self.folder, self.functions = Path(folder), functions
+        self._series: dict[str, tuple] = {}  # name -> (writer, its own copy of the field)
+        self.times: list[float] = []
+
+    def write(self, t: float) -> None:
+        """Every field of the current state, at time `t`."""
+        from dolfinx.io import VTXWriter
+
+        for f in self.functions():
+            if f.name not in self._series:
+                self.folder.mkdir(parents=True, exist_ok=True)
+                copy = fem.Function(f.function_space, name=f.name)
+                writer = VTXWriter(f.function_space.mesh.comm, self.folder / f"{f.name}.bp",
+                                   [copy])
+                self._series[f.name] = (writer, copy)
+            writer, copy = self._series[f.name]
+            copy.x.array[:] = f.x.array
+            writer.write(t)
+        self.times.append(t)
+
+    @property
+    def paths(self) -> list[Path]:
+        """The files written so far."""
+        return [self.folder / f"{name}.bp" for name in self._series]
+
+    def close(self) -> None:
+        """Close every file (collective)."""
+        for writer, _ in self._series.values():
+            writer.close()
+        self._series.clear()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
 @dataclass

@@ -106,6 +106,19 @@ class J2Plasticity(Isotropic, SmallStrain):
         _per_cell(p, cells, np.max)
         return cells
 
+    def plastic_strain_per_cell(self):
+        """The mean committed plastic strain ε_p of each cell's quadrature points (DG0, 3x3)."""
+        from dolfinx import fem
+
+        eps_p = self.plastic_strain
+        msh = eps_p.function_space.mesh
+        f = fem.Function(fem.functionspace(msh, ("DG", 0, (3, 3))), name="plastic_strain")
+        n = msh.topology.index_map(msh.topology.dim).size_local
+        at_points = eps_p.x.array.reshape(-1, 9)[eps_p.function_space.dofmap.list[:n]]
+        f.x.array.reshape(-1, 9)[f.function_space.dofmap.list[:n, 0]] = at_points.mean(axis=1)
+        f.x.scatter_forward()
+        return f
+
     def _bound(self) -> dict:
         if self._state is None:
             raise ValueError("J2Plasticity has no state: call bind(mesh, quadrature degree) "

@@ -49,6 +49,7 @@ from fenics_nl.solvers.linear_solver import (
     rigid_body_modes,
 )
 from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.supports import RigidMotions, check_supports
 
 log = logging.getLogger(__name__)
 
@@ -350,6 +351,8 @@ class NewtonSolver:
         self.policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse)
         self.bfgs = InverseBFGS(bfgs_memory) if method == "bfgs" else None
         self.total = WorkCounts()
+        self.motions = RigidMotions.of(V)  # None: not a displacement (sub-)space
+        self._supports_checked = False  # for the current Dirichlet rows (and springs)
 
     @property
     def dofs(self) -> int:
@@ -364,6 +367,7 @@ class NewtonSolver:
         """
         self.bcs = list(bcs)
         self.policy.bcs_changed(small_change)
+        self._supports_checked = False
 
     def set_nodal_load(self, dofs: np.ndarray, values: np.ndarray) -> None:
         """External point forces: R(u) − F, F = `values` at `dofs` (owned, local indices).
@@ -388,6 +392,7 @@ class NewtonSolver:
         had, has = self._springs is not None, comm.allreduce(bool(dofs.size), op=MPI.LOR)
         if had or has:
             self.policy.bcs_changed(small=False)
+            self._supports_checked = False
         self._springs = (dofs, np.asarray(stiffness, dtype=float),
                          np.asarray(anchor, dtype=float)) if has else None
 
@@ -505,7 +510,13 @@ class NewtonSolver:
         for bc in self.bcs:
             owned, count = bc.dof_indices()
             values[owned[:count]] = 0.0
-        return math.sqrt(self.b.comm.tompi4py().allreduce(float(values @ values)))
+        comm = self.b.comm.tompi4py()
+        # scaled by the largest entry: the sum of squares neither overflows nor underflows
+        scale = comm.allreduce(float(np.max(np.abs(values), initial=0.0)), op=MPI.MAX)
+        if scale == 0 or not math.isfinite(scale):
+            return scale
+        values /= scale
+        return scale * math.sqrt(comm.allreduce(float(values @ values)))
 
     def _assemble_tangent(self, work: WorkCounts) -> None:
         with _Timer(work, "tangent"):
@@ -522,6 +533,10 @@ class NewtonSolver:
                 self._M.zeroEntries()
                 petsc.assemble_matrix(self._M, self._M_form, bcs=self.bcs, diag=1.0)
                 self._M.assemble()
+        if not self._supports_checked and self.motions is not None:
+            # a free rigid motion makes K singular: refused before any factorization
+            check_supports(self.A, self.motions, self.bcs)
+            self._supports_checked = True
         if self.policy.needs_factorization():
             self._factorize(work)
         self.policy.assembled()

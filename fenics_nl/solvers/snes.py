@@ -18,6 +18,7 @@ from petsc4py import PETSc
 
 from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.supports import RigidMotions, check_supports
 
 # PETSc event names behind each count; MUMPS factorizations log as Mat*FactorNum.
 EVENTS = {
@@ -150,6 +151,8 @@ class SnesSolver:
         stamps = self._stamps
         self.snes.setMonitor(lambda snes, it, norm: stamps.append(time.perf_counter()))
         self.counter = EventCounter(all_event_names())
+        self.motions = RigidMotions.of(u.function_space)
+        self._supports_checked = False
 
     def solve(self) -> SolveResult:
         """Solve from the current `u`, the boundary values imposed first.
@@ -163,6 +166,11 @@ class SnesSolver:
         self.counter.start()
         self._stamps.clear()
         self.problem.solve()
+        if not self._supports_checked and self.motions is not None:
+            # MUMPS factorizes a singular K without a word, and SNES then converges to an
+            # answer with an arbitrary rigid motion in it: the first Jacobian is checked
+            check_supports(self.problem.A, self.motions, self.bcs)
+            self._supports_checked = True
         work = petsc_work(self.counter)
         norms = [float(r) for r in self.snes.getConvergenceHistory()[0]]
         reason = self.snes.getConvergedReason()
