@@ -42,6 +42,14 @@ def parser() -> argparse.ArgumentParser:
                             "totals",
                     output="displacement, von Mises stress (and contact pressure)",
                     png="the deformed body coloured by von Mises stress")
+    p.add_argument("--checkpoint", metavar="DIR",
+                   help="save the state after every converged step (or every "
+                        "--checkpoint-every N) in DIR, to restart from")
+    p.add_argument("--checkpoint-every", metavar="N", type=cli.at_least(1), default=1,
+                   help="save one converged step out of N")
+    p.add_argument("--restart", metavar="DIR",
+                   help="go on from the last checkpoint in DIR (the same case file, mesh "
+                        "and number of ranks)")
     return p
 
 
@@ -49,10 +57,13 @@ def main(argv=None) -> int:
     """The command; returns the exit status (0, or 1/2 on a failed output/bad input)."""
     p = parser()
     args, petsc = cli.parse_with_petsc_options(p, argv)
-    if args.command == "check" and (args.json or args.output or args.png or petsc):
+    if args.command == "check" and (args.json or args.output or args.png or petsc
+                                    or args.checkpoint or args.restart):
         p.error("check takes the case file only")
     try:  # an output that cannot be written is said now, not after the solve
         cli.check_output_paths(json=args.json, png=args.png, output=args.output)
+        if args.checkpoint:
+            cli.check_output_paths(output=args.checkpoint)
     except ValueError as err:
         p.error(str(err))
     t0 = time.perf_counter()
@@ -78,7 +89,8 @@ def main(argv=None) -> int:
         from fenics_nl.case.run import solve_case, write_outputs
 
         cli.known(case=str(case.path), model=case.model, law=case.law, dofs=problem.dofs)
-        out = solve_case(problem, output_folder=args.output)
+        out = solve_case(problem, output_folder=args.output, checkpoint=args.checkpoint,
+                         checkpoint_every=args.checkpoint_every, restart=args.restart)
         # before the first step: the problem, then the solver (its forms compiled)
         out["setup_time_s"] = built + out.pop("solver_setup_time_s")
         return out, write_outputs(problem, args.png)

@@ -529,3 +529,102 @@ def test_an_output_path_that_cannot_be_written_is_refused_before_the_solve(tmp_p
         assert proc.returncode == 2 and "load factor" not in proc.stdout, proc.stdout
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and flag in lines[0], proc.stderr
+
+
+# -- checkpoint and restart --------------------------------------------------------------
+
+def j2_path_case(tmp_path, steps=20):
+    """The J2 cylinder (σ0 = 100, p_lim = 80.05) to p = 75 in equal steps: path-dependent."""
+    text = (CASES / "thick_cylinder.toml").read_text()
+    text = text.replace('law = "linear-elastic"', 'law = "j2"\nsigma0 = 100.0')
+    text = text.replace("steps = 1", f"steps = {steps}").replace("pressure = 100.0",
+                                                                 "pressure = 75.0")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    return write(tmp_path, "path.toml", text)
+
+
+def run_and_kill(cmd, cwd, after_line: str, ranks=1):
+    """Start `cmd`, SIGKILL it (and its ranks) once its stdout shows `after_line`."""
+    import os
+    import signal
+    import subprocess
+
+    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    for line in proc.stdout:
+        if line.startswith(after_line):
+            os.killpg(proc.pid, signal.SIGKILL)
+            break
+    proc.wait(timeout=600)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.read()
+
+
+def same_answer(a, b, rel=1e-10):
+    """Every step's load factor, probes and reactions agree to `rel` of their largest value."""
+    assert [s["load_factor"] for s in a["steps"]] == [s["load_factor"] for s in b["steps"]]
+    for sa, sb in zip(a["steps"], b["steps"], strict=True):
+        for key in ("probes", "reactions"):
+            x, y = np.array(flatten(sa[key])), np.array(flatten(sb[key]))
+            assert np.abs(x - y).max() <= rel * np.abs(x).max(), key
+
+
+def flatten(x):
+    if isinstance(x, dict):
+        return [v for k in sorted(x) for v in flatten(x[k])]
+    if isinstance(x, list):
+        return [v for item in x for v in flatten(item)]
+    return [float(x)]
+
+
+def test_a_killed_run_restarts_from_its_checkpoint_to_the_same_answer(tmp_path, demo):
+    import sys
+
+    case = j2_path_case(tmp_path)
+    whole = demo.case(case)
+    run_and_kill([sys.executable, "-m", "fenics_nl", "run", case, "--checkpoint", "ck"],
+                 tmp_path, "load factor 0.15:")
+    latest = json.loads((tmp_path / "ck" / "latest.json").read_text())["step"]
+    assert 2 <= int(latest.split("-")[1]) < 20  # killed in the middle of the path
+    resumed = demo.case(case, "--restart", tmp_path / "ck")
+    same_answer(whole, resumed)
+
+
+def test_a_checkpoint_every_n_steps_and_one_line_for_a_bad_one(tmp_path, demo):
+    case = j2_path_case(tmp_path, steps=6)
+    demo.case(case, "--checkpoint", tmp_path / "ck", "--checkpoint-every", "4")
+    assert json.loads((tmp_path / "ck" / "latest.json").read_text())["step"] == "step-000004"
+
+    def refused(path, message, other=case):
+        proc = demo.run(["-m fenics_nl", "run", other, "--restart", path], check=False)
+        lines = proc.stderr.strip().splitlines()
+        assert proc.returncode == 2 and len(lines) == 1 and message in lines[0], proc.stderr
+
+    refused(tmp_path / "none", "no checkpoint folder")
+    (tmp_path / "empty").mkdir()
+    refused(tmp_path / "empty", "holds no complete checkpoint")
+    other = write(tmp_path, "other.toml", case.read_text().replace("75.0", "70.0"))
+    refused(tmp_path / "ck", "is of another run: its case file differs", other)
+    arrays = tmp_path / "ck" / "step-000004" / "rank0.npz"
+    arrays.write_bytes(arrays.read_bytes()[:100])  # truncated
+    refused(tmp_path / "ck", "is damaged")
+
+
+@pytest.mark.spawns_mpi
+def test_a_killed_run_on_two_ranks_restarts_to_the_same_answer(tmp_path, demo):
+    import sys
+
+    from conftest import MPIEXEC
+
+    case = j2_path_case(tmp_path)
+    whole = demo.case(case, ranks=2)
+    run_and_kill([MPIEXEC, "-n", "2", sys.executable, "-m", "fenics_nl", "run", case,
+                  "--checkpoint", "ck"], tmp_path, "load factor 0.15:")
+    latest = json.loads((tmp_path / "ck" / "latest.json").read_text())["step"]
+    assert 2 <= int(latest.split("-")[1]) < 20
+    assert sorted(p.name for p in (tmp_path / "ck" / latest).iterdir()) == [
+        "rank0.npz", "rank1.npz", "state.json"]
+    resumed = demo.case(case, "--restart", tmp_path / "ck", ranks=2)
+    same_answer(whole, resumed)
+    # another number of ranks is another partition: refused in one line
+    proc = demo.run(["-m fenics_nl", "run", case, "--restart", tmp_path / "ck"], check=False)
+    assert proc.returncode == 2 and "its ranks is 2, this run's 1" in proc.stderr

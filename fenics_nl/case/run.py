@@ -8,6 +8,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.case.problem import CaseProblem
+from fenics_nl.case.resume import CaseCheckpoints, Resumed
 from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
@@ -16,7 +17,9 @@ from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
 
-def solve_case(problem: CaseProblem, output_folder: str | None = None) -> dict:
+def solve_case(problem: CaseProblem, output_folder: str | None = None, *,
+               checkpoint: str | None = None, checkpoint_every: int = 1,
+               restart: str | None = None) -> dict:
     """Visit the case's load factors in order; returns the JSON record of the run.
 
     Each segment between two factors starts as one step and is cut in half on failure
@@ -24,14 +27,25 @@ def solve_case(problem: CaseProblem, output_folder: str | None = None) -> dict:
     (and active-set) iterations, probes, reactions and, with contact, the contact force,
     and handed to `cli.converged_step` (a run that fails later keeps it). With
     `output_folder`, the fields of every converged step are written as a time series.
+    `checkpoint`: a folder where the state after every `checkpoint_every`-th converged step
+    is saved; `restart`: a folder to go on from (the same case, mesh and ranks).
     """
     t0 = time.perf_counter()
     solver = problem.make_solver()
     setup = time.perf_counter() - t0
+    if (checkpoint or restart) and problem.case.arc is not None:
+        raise ValueError("--checkpoint and --restart take load control: arc-length control "
+                         "has no checkpoint yet")
+    saving = CaseCheckpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
+    resumed = CaseCheckpoints(problem, restart).restore() if restart else None
+    if resumed is not None:
+        say(f"restarted from {restart}: {len(resumed.steps)} converged steps, load factor "
+            f"{resumed.steps[-1]['load_factor']:.6g}" if resumed.steps else
+            f"restarted from {restart}")
     series = output.FieldSeries(output_folder, lambda: fields(problem)) if output_folder \
         else None
     try:
-        out = _solve(problem, solver, series)
+        out = _solve(problem, solver, series, saving, resumed)
     finally:
         if series is not None:
             paths = series.paths
@@ -40,6 +54,10 @@ def solve_case(problem: CaseProblem, output_folder: str | None = None) -> dict:
                 say(f"wrote {', '.join(str(p) for p in paths)} ({len(series.times)} "
                     "steps, the load factor as time; ADIOS2 VTX: open in ParaView)")
     out["solver_setup_time_s"] = setup
+    if resumed is not None and output_folder and resumed.steps:
+        out["warnings"].append(f"restarted: the --output time series begins after load factor "
+                               f"{resumed.steps[-1]['load_factor']:.6g}, where the restart "
+                               "took the run up (VTX files are not appended to)")
     return out
 
 
@@ -56,15 +74,34 @@ def fields(problem: CaseProblem) -> list:
     return functions
 
 
-def _solve(problem: CaseProblem, solver, series) -> dict:
-    """The load path of `solve_case`."""
+def _solve(problem: CaseProblem, solver, series, saving: CaseCheckpoints | None,
+           resumed: Resumed | None) -> dict:
+    """The load path of `solve_case`, from its start or from where `resumed` left it."""
     case, steps, work = problem.case, [], WorkCounts()
+    first, start = 0, None  # the segment to begin with, and the driver's state in it
+    if resumed is not None:
+        steps, first, start = resumed.steps, resumed.segment, resumed.driver
+        work.add(resumed.work)
+        for record in steps:
+            cli.converged_step(record)
 
     def converged(t, result):
         steps.append(step_record(problem, t, result))
         cli.converged_step(steps[-1])
         if series is not None:
             series.write(t)
+
+    def save(segment):  # after each converged step, with the driver's state
+        if saving is None:
+            return None
+
+        def checkpoint(driver, path):  # the work so far: the segments before, and this one's
+            total = WorkCounts()
+            total.add(work)
+            total.add(path.work)
+            saving.save(segment, driver, steps, total)
+
+        return checkpoint
 
     commit = None
     if getattr(problem.material, "path_dependent", False):  # committed when a step converges
@@ -80,16 +117,21 @@ def _solve(problem: CaseProblem, solver, series) -> dict:
         critical = _follow_path(problem, solver, converged, steps, work, commit, show)
     elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
-        try:
-            path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
-                                       max_step=1.0 / n, progress=show, commit=commit,
-                                       on_step=converged)
-        except LoadStepError as err:
-            raise _not_reached(err, err.target, steps) from err
-        work.add(path.work)
+        if first == 0:
+            try:
+                path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
+                                           max_step=1.0 / n, progress=show, commit=commit,
+                                           on_step=converged, start=start, on_state=save(0))
+            except LoadStepError as err:
+                raise _not_reached(err, err.target, steps) from err
+            work.add(path.work)
     else:  # from factor to factor, each segment one step (cut in half on failure)
         previous = 0.0
-        for target in case.factors:
+        for k, target in enumerate(case.factors):
+            if k < first:  # done before the restart
+                previous = target
+                continue
+
             def load(s, a=previous, b=target):
                 problem.set_load(a + s * (b - a))
 
@@ -98,7 +140,9 @@ def _solve(problem: CaseProblem, solver, series) -> dict:
 
             try:
                 path = solve_incrementally(solver, load, 1, adaptive=case.adaptive,
-                                           on_step=record, progress=show, commit=commit)
+                                           on_step=record, progress=show, commit=commit,
+                                           start=start if k == first else None,
+                                           on_state=save(k))
             except LoadStepError as err:  # err's factors are fractions of the segment
                 raise _not_reached(err, previous + err.target * (target - previous),
                                    steps) from err

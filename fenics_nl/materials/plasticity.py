@@ -106,6 +106,11 @@ class J2Plasticity(Isotropic, SmallStrain):
         _per_cell(p, cells, np.max)
         return cells
 
+    def state_functions(self) -> dict:
+        """The committed state's quadrature Functions by name (to checkpoint and restore)."""
+        st = self._bound()
+        return {"plastic_strain": st["eps_p"], "cumulated_plastic_strain": st["p"]}
+
     def plastic_strain_per_cell(self):
         """The mean committed plastic strain ε_p of each cell's quadrature points (DG0, 3x3)."""
         from dolfinx import fem

@@ -22,6 +22,8 @@ import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
@@ -37,6 +39,21 @@ class LoadStepError(SolveError):
     def __init__(self, message: str, result=None, *, reached: float = 0.0, target: float = 0.0):
         super().__init__(message, result)
         self.reached, self.target = reached, target
+
+
+@dataclass
+class DriverState:
+    """Where a load path stands after a converged step: enough to go on from it exactly.
+
+    `t` the converged load factor, `dt` the next increment, and, for the predictor, the
+    increment that led to `t` and the state before it (this rank's array of the unknown, or
+    None). A restart from a checkpoint hands it back to `solve_incrementally` (`start`).
+    """
+
+    t: float
+    dt: float
+    dt_previous: float | None = None
+    previous: np.ndarray | None = None
 
 
 @dataclass
@@ -68,8 +85,15 @@ def solve_incrementally(
     progress: Callable[[str], None] | None = None,
     commit: Callable[[], None] | None = None,
     restore: Callable[[], None] | None = None,
+    start: DriverState | None = None,
+    on_state: Callable[[DriverState, LoadPath], None] | None = None,
 ) -> LoadPath:
-    """Drive the load factor from 0 to 1, starting with `steps` equal increments."""
+    """Drive the load factor from 0 to 1, starting with `steps` equal increments.
+
+    `start`: go on from a converged state (a restart: `solver.u` and the internal variables
+    already hold it); `on_state(state, path)` after each converged step, with what a restart
+    needs (a checkpoint) and the path so far.
+    """
     if steps < 1:
         raise ValueError(f"steps must be >= 1, got {steps}")
     path = LoadPath()
@@ -77,6 +101,12 @@ def solve_incrementally(
     saved = x.copy()  # last converged state
     previous, dt_previous = None, None  # the one before, for the predictor
     t, dt = 0.0, 1.0 / steps
+    if start is not None:
+        t, dt, dt_previous = start.t, start.dt, start.dt_previous
+        if start.previous is not None:
+            previous = x.duplicate()
+            previous.array[:] = start.previous
+        set_load(t)  # the load of the converged state, as after its step
     while t < 1.0 - 1e-12:
         dt = min(dt, 1.0 - t)
         set_load(t + dt)
@@ -124,4 +154,8 @@ def solve_incrementally(
             on_step(t, result)
         if adaptive and result.iterations <= easy_iterations:
             dt = min(1.5 * dt, max_step)
+        if on_state:
+            on_state(DriverState(t, dt, dt_previous if predictor else None,
+                                 previous.array.copy() if predictor and previous is not None
+                                 else None), path)
     return path

@@ -355,6 +355,15 @@ class NewtonSolver:
         self._supports_checked = False  # for the current Dirichlet rows (and springs)
 
     @property
+    def force_reference(self) -> float:
+        """The largest first residual seen: the default force scale (kept by a checkpoint)."""
+        return self._largest_r0
+
+    @force_reference.setter
+    def force_reference(self, value: float) -> None:
+        self._largest_r0 = float(value)
+
+    @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
         return output.dofs(self.u.function_space)
