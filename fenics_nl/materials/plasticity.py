@@ -36,8 +36,9 @@ YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
 class J2Plasticity(Isotropic, SmallStrain):
     """J2 plasticity: yield stress σ0 > 0, isotropic hardening H ≥ 0, kinematic C ≥ 0.
 
-    H = C = 0 is perfect plasticity. Models: 3D, plane strain, axisymmetric (3x3 strains);
-    plane stress needs its own return mapping and is refused.
+    H = C = 0 is perfect plasticity (the defaults of H and C). Models: 3D, plane strain,
+    axisymmetric (3x3 strains); plane stress through `materials.plane_stress`, with the
+    out-of-plane strain an unknown at the quadrature points (a 2x2 strain is refused).
     """
 
     sigma0: float = 1.0
@@ -195,11 +196,15 @@ class J2Plasticity(Isotropic, SmallStrain):
 
         The update is compiled for the first `u` given: one displacement per bound material.
         """
+        self.commit_strain(kinematics.small_strain(u, model))
+
+    def commit_strain(self, strain) -> None:
+        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`)."""
         from dolfinx import fem
 
         st = self._bound()
         if st["commit"] is None:  # compiled once
-            eps_p, p, _ = self.return_map(kinematics.small_strain(u, model))
+            eps_p, p, _ = self.return_map(strain)
             st["commit"] = (fem.Expression(eps_p, st["points"]), fem.Expression(p, st["points"]))
         new_eps_p, new_p = st["commit"]
         # evaluate both before storing: each reads the committed state
