@@ -23,7 +23,7 @@ from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, plane_stress
 from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.newton import NewtonSolver
@@ -46,16 +46,22 @@ class CaseProblem:
         self.probes, outside = self._locate_probes()
         if problems + outside:
             raise CaseError(problems + outside)
-        # `unknown`: what the solver updates; `u`: the displacement in forms (its part, if
-        # mixed); `displacement()`: a Function of it to probe, draw and write
-        self.fields = f = unknowns(msh, case.degree, case.formulation == "mixed")
-        self.mixed = f if f.mixed else None
-        self.V, self.unknown, self.u = f.V, f.w, f.u
         self.material = case.material()
-        self.t = fem.Constant(msh, 0.0)  # the load factor
-        tags = data.facet_tags
         # 2 × degree: exact for the linear part of every law on affine cells (bracket's table)
         q = 2 * case.degree
+        # `unknown`: what the solver updates; `u`: the displacement in forms (its part, if
+        # mixed, or beside J2's out-of-plane strain in plane stress); `displacement()`: a
+        # Function of it to probe, draw and write
+        self.plane_stress = None
+        if case.model == "plane_stress" and getattr(self.material, "path_dependent", False):
+            f = self.plane_stress = plane_stress.PlaneStressUnknown(msh, case.degree, q)
+        else:
+            f = unknowns(msh, case.degree, case.formulation == "mixed")
+        self.fields = f
+        self.mixed = f if f.mixed else None
+        self.V, self.unknown, self.u = f.V, f.w, f.u
+        self.t = fem.Constant(msh, 0.0)  # the load factor
+        tags = data.facet_tags
         self.dx = kinematics.quadrature_measure("dx", msh, q)
         self.ds = kinematics.quadrature_measure("ds", msh, q + 1, subdomain_data=tags)
         self.weight = kinematics.measure_weight(msh, self.model)
@@ -102,6 +108,9 @@ class CaseProblem:
             m = self.mixed
             v = m.v
             R = mixed_form.internal_work(self.material, m.u, m.p, m.v, m.q, self.model) * self.dx
+        elif self.plane_stress:
+            v = self.plane_stress.v
+            R = plane_stress.internal_work(self.material, self.plane_stress) * self.dx
         else:
             v = ufl.TestFunction(self.V)
             R = self.material.internal_work(self.u, v, self.model) * self.dx
@@ -253,17 +262,22 @@ class CaseProblem:
             opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed,
                                                                self.model, self.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = (
-                mixed_form.modified_newton_tangent(self.material, self.mixed, self.model,
-                                                   self.dx) if self.mixed else
-                self.material.modified_newton_tangent(self.u, self.model, self.dx))
+            if self.mixed:
+                tangent = mixed_form.modified_newton_tangent(self.material, self.mixed,
+                                                             self.model, self.dx)
+            elif self.plane_stress:
+                tangent = plane_stress.elastic_tangent(self.material, self.plane_stress,
+                                                       self.dx)
+            else:
+                tangent = self.material.modified_newton_tangent(self.u, self.model, self.dx)
+            opts["constant_tangent"] = tangent
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(
                 self.residual, self.unknown, self.bcs, facets, self.gap(0.0), normal_axis=axis,
                 normal_sign=sign, initial="penetrating", prefix=PREFIX,
                 newton_options={"method": method, **opts},
-                displacement_space=self.V if self.mixed else None)
+                displacement_space=self.V if self.mixed or self.plane_stress else None)
             return ContactSteps(contact, self)
         if case.newton == "snes":
             return SnesSolver(self.residual, self.unknown, self.bcs, prefix=PREFIX + "snes_",
@@ -305,7 +319,24 @@ class CaseProblem:
         if self.mixed:
             return mixed_form.von_mises(self.material, self.u, self.mixed.p, self.model,
                                         self.mesh)
+        if self.plane_stress:  # J2: at its quadrature points
+            return self.material.cell_mean(von_mises_of(self._stress()), "von_mises")
         return self.material.von_mises(self.u, self.model)
+
+    def _stress(self):
+        """The Cauchy stress (UFL): 3x3, or 2x2 in plane stress."""
+        if self.mixed:
+            return mixed_form.cauchy_stress(self.material, self.u, self.mixed.p, self.model)
+        if self.plane_stress:
+            return plane_stress.stress(self.material, self.plane_stress)
+        return self.material.cauchy_stress(self.u, self.model)
+
+    def commit(self) -> None:
+        """Commit a path-dependent law's state at the converged step."""
+        if self.plane_stress:
+            self.material.commit_strain(self.plane_stress.strain())
+        else:
+            self.material.commit(self.u, self.model)
 
     def _locate_probes(self):
         """The probes located in the mesh, and a line for each one outside it."""
@@ -322,17 +353,22 @@ class CaseProblem:
         if not self.case.probes:
             return {}
         u = self.probes.continuous(self.displacement())
-        if self.mixed:
-            expression = mixed_form.von_mises_expression(self.material, self.u, self.mixed.p,
-                                                         self.model)
-            stress = mixed_form.cauchy_stress(self.material, self.u, self.mixed.p, self.model)
-        else:
-            expression = self.material.von_mises_expression(self.u, self.model)
-            stress = self.material.cauchy_stress(self.u, self.model)
-        vm = self.probes.discontinuous("von_mises", expression, self.case.degree)
+        stress = self._stress()
+        vm = self.probes.discontinuous("von_mises", von_mises_of(stress), self.case.degree)
+        if self.plane_stress:  # the in-plane components, as the other plane-stress laws
+            stress = ufl.as_tensor([[stress[i, j] for j in range(2)] for i in range(2)])
         sigma = self.probes.discontinuous("stress", stress, self.case.degree)
         return {p.name: {"displacement": d, "von_mises": s, "stress": t}
                 for p, d, s, t in zip(self.case.probes, u, vm, sigma, strict=True)}
+
+
+def von_mises_of(sigma):
+    """σ_eq = √(3/2) ‖dev σ‖ of a 3x3 stress, or of a 2x2 one embedded with σ_zz = 0."""
+    if sigma.ufl_shape[0] == 2:
+        sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0], [sigma[1, 0], sigma[1, 1], 0],
+                               [0, 0, 0]])
+    s = ufl.dev(sigma)
+    return ufl.sqrt(1.5 * ufl.inner(s, s))
 
 
 class ContactSteps:

@@ -106,7 +106,7 @@ def _solve(problem: CaseProblem, solver, series, saving: CaseCheckpoints | None,
     commit = None
     if getattr(problem.material, "path_dependent", False):  # committed when a step converges
         def commit():
-            problem.material.commit(problem.u, case.model)
+            problem.commit()
 
     def show(message):  # step cuts; the converged steps are reported by step_record
         if not message.startswith("step "):

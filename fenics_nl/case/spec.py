@@ -31,7 +31,8 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
-                         # (kinematic hardening modulus), each 0 by default (perfect plasticity)
+                         # (kinematic hardening modulus), each 0 by default (perfect plasticity);
+                         # plane stress: linear-elastic, saint-venant-kirchhoff or j2
 
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
@@ -338,7 +339,7 @@ def _material(r: _Reader, data: dict, model: str | None):
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"material.{name}" if name in parameters else "material", rest or name)
-    if law in ("neo-hookean", "power-law", "j2") and model == "plane_stress":
+    if law in ("neo-hookean", "power-law") and model == "plane_stress":
         r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters
