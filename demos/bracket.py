@@ -40,7 +40,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output, pictures
+from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
@@ -117,8 +117,8 @@ def parser():
                         "(--support contact; default: frictionless)")
     p.add_argument("--unload", action="store_true",
                    help="unload in as many steps after loading: the permanent displacement")
-    cli.add_outputs(p, output="displacement, von Mises stress, with --support contact the "
-                              "floor pressure and active set",
+    cli.add_outputs(p, output="displacement, von Mises stress (j2: plastic strains), with "
+                              "--support contact the floor pressure and active set",
                     png="deformed bracket coloured by von Mises stress (j2: by the cumulated "
                         "plastic strain), load and supports drawn",
                     plot="load against load-point displacement")
@@ -207,6 +207,13 @@ residual = internal * part.dx - ufl.dot(part.traction, v) * part.ds_load
 # variant runs on the same mesh from u = 0.
 
 # +
+def fields(b):
+    """What --output writes at every converged step (a time series)."""
+    state = [part.displacement(), *([part.mixed.pressure()] if args.mixed else []),
+             b.von_mises(), *(b.contact_fields() if args.support == "contact" else [])]
+    return state + (material.output_fields() if plastic else [])
+
+
 def solve(newton):
     """Load steps with one Newton variant; returns the bracket and a record per step."""
     part.unknown.x.array[:] = 0.0
@@ -229,7 +236,7 @@ def solve(newton):
                       "tangent_assemblies": r.work.tangent_assemblies,
                       "krylov_iterations": r.work.krylov_iterations,
                       "residual_norms": list(r.residual_norms)})
-        cli.converged_step({"load_factor": t, **steps[-1]})
+        cli.converged_step({"load_factor": t, **steps[-1]}, fields=lambda: fields(b))
         sets = (f" in {r.active_set_iterations} active-set iterations"
                 if r.active_set_iterations else "")
         say(f"  {newton}: step {len(steps)}/{total}, F = {t * args.force:.4g} N, "
@@ -385,15 +392,9 @@ def compare():
 
 
 def writers(b, vm, steps, args):
-    """The outputs asked for, each run on its own after the JSON."""
+    """The outputs asked for, each run on its own after the JSON (--output's fields were
+    written at every converged step)."""
     todo = []
-    if args.output:
-        def fields():
-            extra = b.contact_fields() if args.support == "contact" else []
-            fields = [part.displacement(), *([part.mixed.pressure()] if args.mixed else [])]
-            paths = output.write_fields(args.output, [*fields, vm, *extra])
-            say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-        todo.append(fields)
     if args.plot:
         todo.append(lambda: plot(steps, args))
     if args.png:

@@ -46,7 +46,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output, pictures
+from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.parallel import gather_rows
@@ -104,7 +104,7 @@ def parser():
     p.add_argument("--mixed", action="store_true",
                    help="Q2-Q1 Taylor-Hood displacement-pressure elements, for a nearly or "
                         "exactly incompressible beam (nu up to 0.5; --plane strain)")
-    cli.add_outputs(p, output="the final displacement",
+    cli.add_outputs(p, output="the displacement",
                     png="deformed shapes along the path, with the elastica's",
                     plot="P/P_cr against tip rotation and deflection")
     return p
@@ -225,7 +225,9 @@ def record(t, result):
                     tip["axial"]))
     cli.converged_step({"load_factor": t, "load_ratio": r, "tip_rotation_deg": history[-1][1],
                         "tip_deflection": history[-1][2], "tip_axial": history[-1][3],
-                        "newton_iterations": result.iterations})
+                        "newton_iterations": result.iterations},
+                       fields=lambda: [beam.fields.displacement(),
+                                       *([beam.fields.pressure()] if args.mixed else [])])
     if args.png:
         shapes.append((r, centreline(beam)))
 
@@ -357,6 +359,10 @@ def picture(shapes, args):
     ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
     ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
                 arrowprops={"arrowstyle": "->"})
+    tip = picks[-1][1][-1]  # the dead load P at the last tip, along −x whatever the rotation
+    ax.annotate(f"P = {picks[-1][0]:.3g} P_cr (dead)", tip, xytext=(tip[0] + 0.22 * L, tip[1]),
+                fontsize=8, color="tab:red", va="center",
+                arrowprops={"arrowstyle": "-|>", "color": "tab:red", "lw": 1.5})
     ax.set_aspect("equal")
     ax.set_xlabel("x [length]")
     ax.set_ylabel("y [length]")
@@ -370,13 +376,7 @@ def picture(shapes, args):
     pictures.save_figure(fig, args.png)
 
 
-writers = []
-if args.output:
-    def fields():
-        paths = output.write_fields(args.output, [beam.fields.displacement(),
-                                                  *([f.pressure()] if args.mixed else [])])
-        say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-    writers.append(fields)
+writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
     writers.append(lambda: plot(history, args))
 if args.png:

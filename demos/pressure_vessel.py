@@ -399,8 +399,13 @@ def plot():
 
 def picture():
     """The deformed quarter coloured by the largest cumulated plastic strain of each cell."""
+    theta = np.linspace(0.0, 0.5 * np.pi, 91)
+    arc = {f"closed-form plastic radius {c_exact:.4g}"
+           + (" (for nu = 1/2)" if shape == "cylinder" else ""):
+           np.column_stack([c_exact * np.cos(theta), c_exact * np.sin(theta)])}
     pictures.deformed_picture(body.displacement(), material.cumulated_plastic_strain_per_cell(),
-                              args.png, state_title(), label="cumulated plastic strain")
+                              args.png, state_title(), label="cumulated plastic strain",
+                              curves=arc)
     say(f"wrote {args.png}")
 
 

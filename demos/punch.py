@@ -127,7 +127,8 @@ def parser():
     tangential.add_argument("--tangential-displacement", type=cli.finite, default=None,
                             metavar="D", help="after the normal load, move the punch by D "
                                               "[length] along x")
-    cli.add_outputs(p, output="displacement, von Mises stress, contact pressure and active set",
+    cli.add_outputs(p, output="displacement, von Mises stress (j2: plastic strains), contact "
+                              "pressure and active set",
                     png="the deformed contact zone (von Mises stress) beside the contact "
                         "pressure, against Hertz",
                     plot="force-indentation and pressure against Hertz")
@@ -250,12 +251,19 @@ load = PunchLoad(punch, indentation=args.indentation, force=args.force,
 states = load.states
 
 
+def fields():
+    """What --output writes at every converged step (a time series)."""
+    state = [block.displacement(), *([m.pressure()] if args.mixed else []),
+             *punch.contact_fields(), punch.von_mises()]
+    return state + (material.output_fields() if args.material == "j2" else [])
+
+
 def report(t, result):
     s = states[-1]
     cli.converged_step({"load_factor": t if len(states) <= args.steps else 1 - t,
                         "indentation": s.indentation, "force": s.force,
                         "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
-                        "active_set_iterations": s.active_set_iterations})
+                        "active_set_iterations": s.active_set_iterations}, fields=fields)
     say(f"step {len(states)}/{args.steps * (2 if args.unload else 1)}: δ = "
         f"{s.indentation:.5g}, P = {s.force:.6g}, "
         f"a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
@@ -469,12 +477,6 @@ def summary():
     return out
 
 
-def write_fields(vm):
-    fields = [block.displacement(), *([m.pressure()] if args.mixed else [])]
-    paths = output.write_fields(args.output, [*fields, *punch.contact_fields(), vm])
-    say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-
-
 def plot(punch, states, ref, args):
     profile = punch.surface_profile()
     if comm.rank != 0:
@@ -590,9 +592,11 @@ def pressure_panel(ax, profile, state, ref):
     ax.plot(r / a, p / p0, "o", ms=3, label="FE nodal pressure")
     rr = np.linspace(0, 1.5, 300)
     ax.plot(rr, hertz.pressure_profile(1.0, 1.0, rr), "-", label="Hertz")
-    ax.axvline(state.contact_radius / a, color="C3", ls="--", lw=1,
+    # Hertz's a drawn over the FE one (they coincide on a fine mesh): both stay visible
+    ax.axvline(state.contact_radius / a, color="C3", ls="-", lw=2.5, alpha=0.6,
                label=f"last active node: a = {state.contact_radius:.3g}")
-    ax.axvline(1.0, color="gray", ls=":", lw=1, label=f"Hertz a = {a:.3g}")
+    ax.axvline(1.0, color="black", ls=(0, (3, 3)), lw=1.2, zorder=5,
+               label=f"Hertz a = {a:.3g}")
     ax.set_xlim(0, 1.5)
     ax.set_ylim(-0.05, 1.25)
     ax.set_xlabel("r / a (Hertz)")
@@ -654,7 +658,7 @@ def picture(punch, vm, state, ref, args):
 
 
 writers = []
-vm = punch.von_mises() if args.output or args.png else None  # once for both
+vm = punch.von_mises() if args.png else None
 # gathered on every rank's call (rank 0 keeps it) before the writers run on rank 0
 traction_profile = None
 if traction is not None and (args.png or args.plot):  # collective: on every rank
@@ -663,9 +667,7 @@ if traction is not None and (args.png or args.plot):  # collective: on every ran
         traction_profile = (rings, punch.tangential_force_within(rings))
     else:
         traction_profile = punch.traction_profile()
-if args.output:
-    writers.append(lambda: write_fields(vm))
-if args.plot:
+if args.plot:  # (--output: the fields of every step were written as they converged)
     writers.append(lambda: plot(punch, states, ref, args))
 if args.png:
     writers.append(lambda: picture(punch, vm, last, ref, args))

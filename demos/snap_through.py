@@ -38,7 +38,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl.io import cli, output, pictures
+from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
 from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength
@@ -93,7 +93,7 @@ def parser():
                    help="Q2 elements through the thickness, even (a node on the centreline)")
     p.add_argument("--aspect", type=cli.positive, default=4.0,
                    help="element length over element height along the span [-]")
-    cli.add_outputs(p, output="the final displacement",
+    cli.add_outputs(p, output="the displacement",
                     png="the deformed arch at states along the path",
                     plot="load against midspan rise, FE and closed form")
     return p
@@ -151,7 +151,7 @@ shapes = [(0.0, arch.centreline())] if args.png else []
 def record(lam, result):
     history.append((lam, arch.midspan_rise()))
     cli.converged_step({"load_factor": lam, "midspan_rise": history[-1][1],
-                        "newton_iterations": result.iterations})
+                        "newton_iterations": result.iterations}, fields=lambda: [arch.u])
     if args.png:
         shapes.append((lam, arch.centreline()))
 
@@ -280,12 +280,7 @@ def picture():
     pictures.save_figure(fig, args.png)
 
 
-writers = []
-if args.output:
-    def fields():
-        paths = output.write_fields(args.output, [arch.u])
-        say(f"wrote {', '.join(str(p) for p in paths)} (ADIOS2 VTX: open in ParaView)")
-    writers.append(fields)
+writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
     writers.append(plot)
 if args.png:

@@ -40,8 +40,11 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("case", help="the case file (.toml)")
     cli.add_outputs(p, json="the steps (load factor, iterations, probes, reactions) and "
                             "totals",
-                    output="displacement, von Mises stress (and contact pressure)",
-                    png="the deformed body coloured by von Mises stress")
+                    output="displacement, von Mises stress (the mixed form's pressure, J2's "
+                           "plastic strains, the contact pressure and active set)",
+                    png="the deformed body coloured by von Mises stress",
+                    plot="each probe's displacement and von Mises stress, and each support's "
+                         "reaction, against the load factor (matplotlib)")
     p.add_argument("--checkpoint", metavar="DIR",
                    help="save the state after every converged step (or every "
                         "--checkpoint-every N) in DIR, to restart from")
@@ -57,11 +60,12 @@ def main(argv=None) -> int:
     """The command; returns the exit status (0, or 1/2 on a failed output/bad input)."""
     p = parser()
     args, petsc = cli.parse_with_petsc_options(p, argv)
-    if args.command == "check" and (args.json or args.output or args.png or petsc
-                                    or args.checkpoint or args.restart):
+    if args.command == "check" and (args.json or args.output or args.png or args.plot
+                                    or petsc or args.checkpoint or args.restart):
         p.error("check takes the case file only")
     try:  # an output that cannot be written is said now, not after the solve
-        cli.check_output_paths(json=args.json, png=args.png, output=args.output)
+        cli.check_output_paths(json=args.json, png=args.png, plot=args.plot,
+                               output=args.output)
         if args.checkpoint:
             cli.check_output_paths(output=args.checkpoint)
     except ValueError as err:
@@ -89,14 +93,19 @@ def main(argv=None) -> int:
         from fenics_nl.case.run import solve_case, write_outputs
 
         cli.known(case=str(case.path), model=case.model, law=case.law, dofs=problem.dofs)
-        out = solve_case(problem, output_folder=args.output, checkpoint=args.checkpoint,
+        out = solve_case(problem, checkpoint=args.checkpoint,
                          checkpoint_every=args.checkpoint_every, restart=args.restart)
+        if args.output and "restarted_after_load_factor" in out:
+            out["warnings"].append(
+                "restarted: the --output time series begins after load factor "
+                f"{out['restarted_after_load_factor']:.6g}, where the restart took the run up "
+                "(VTX files are not appended to)")
         # before the first step: the problem, then the solver (its forms compiled)
         out["setup_time_s"] = built + out.pop("solver_setup_time_s")
-        return out, write_outputs(problem, args.png)
+        return out, write_outputs(problem, out, args.png, args.plot)
 
     what = "Newton's KSP (case_), SNES (case_snes_), contact (case_elim_)"
-    return cli.run_scene(solve, petsc_argv=petsc, json_path=args.json,
+    return cli.run_scene(solve, petsc_argv=petsc, json_path=args.json, output=args.output,
                          prefixes={"case_": what})
 
 

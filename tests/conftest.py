@@ -143,3 +143,16 @@ def on_elastica():
         assert all(math.isfinite(p["tip_rotation_deg"]) for p in d["path"])
 
     return check
+
+
+def read_series(path, name):
+    """(times, values per step) of one VTX field."""
+    import adios2
+    import numpy as np
+
+    times, values = [], []
+    with adios2.Stream(str(path), "r") as f:
+        for _ in f.steps():
+            times.append(float(np.ravel(f.read("step"))[0]))
+            values.append(np.asarray(f.read(name)))
+    return times, values

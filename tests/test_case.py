@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import read_series
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
@@ -497,26 +498,16 @@ def test_a_case_loaded_past_its_limit_keeps_every_converged_step(tmp_path, demo)
     assert times == [0.5, 0.8] and p[0].max() == 0.0 < p[1].max()  # 0.8 > p_e = 0.52 p_lim
 
 
-def read_series(path, name):
-    """(times, values per step) of one VTX field."""
-    import adios2
-
-    times, values = [], []
-    with adios2.Stream(str(path), "r") as f:
-        for _ in f.steps():
-            times.append(float(np.ravel(f.read("step"))[0]))
-            values.append(np.asarray(f.read(name)))
-    return times, values
-
-
 def test_every_step_of_a_case_is_a_time_series(tmp_path, demo):
     # the elastic cylinder in two steps: the displacement at 0.5 is half that at 1.0
     text = (CASES / "thick_cylinder.toml").read_text().replace("steps = 1", "steps = 2")
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
-    demo.case(write(tmp_path, "two.toml", text), "--output", tmp_path / "fields")
+    demo.case(write(tmp_path, "two.toml", text), "--output", tmp_path / "fields", "--plot",
+              tmp_path / "path.png")
     times, u = read_series(tmp_path / "fields" / "displacement.bp", "displacement")
     assert times == [0.5, 1.0]
     assert np.abs(u[0] - 0.5 * u[1]).max() < 1e-12 * np.abs(u[1]).max()
+    assert (tmp_path / "path.png").stat().st_size > 20_000  # probes and reactions drawn
 
 
 def test_an_output_path_that_cannot_be_written_is_refused_before_the_solve(tmp_path, demo):
@@ -767,3 +758,31 @@ def test_a_thin_plate_in_j2_is_the_plane_stress_model(tmp_path, demo):
     assert hole_3d["displacement"][1] == pytest.approx(hole_2d["displacement"][1], rel=0.01)
     assert hole_3d["von_mises"] == pytest.approx(hole_2d["von_mises"], rel=0.01)
     assert len(hole_2d["stress"]) == 2  # plane stress reports the in-plane components
+
+
+def test_a_hyperelastic_case_takes_its_newton_steps_whole(tmp_path):
+    # the neo-Hookean bracket: from the elastic predictor, ‖R‖ grows 28-fold on the step
+    # that converges next (the clamped holes' singular edges), so backtracking until ‖R‖
+    # falls crawls (19 iterations); the energy's slope along the step says the step is good
+    # (4 iterations, the same answer)
+    from fenics_nl.case.problem import CaseProblem
+    from fenics_nl.case.spec import read_case
+    from fenics_nl.solvers.newton import NewtonSolver
+
+    text = (CASES / "bracket.toml").read_text().replace("size = 6.0", "size = 20.0")
+    text = text.replace('law = "power-law"', 'law = "neo-hookean"')
+    text = text.replace("sigma0 = 200.0\n", "").replace("n = 0.2\n", "")
+    (tmp_path / "bracket.geo").write_text((CASES / "bracket.geo").read_text())
+    p = CaseProblem(read_case(write(tmp_path, "nh.toml", text)))
+    p.set_load(0.25)
+    solved = {}
+    for line_search in (True, "slope"):
+        p.unknown.x.array[:] = 0.0
+        s = NewtonSolver(p.residual, p.unknown, p.bcs, line_search=line_search,
+                         force_scale=p.force_scale, max_it=40, prefix=f"nh_{line_search}_")
+        solved[line_search] = (s.solve(), p.unknown.x.array.copy())
+    (by_norm, u_norm), (by_slope, u_slope) = solved[True], solved["slope"]
+    assert by_slope.iterations <= 5 < 15 <= by_norm.iterations
+    assert by_slope.residual_norms[1] > 10 * by_slope.residual_norms[0]  # the step it keeps
+    assert np.abs(u_slope - u_norm).max() < 1e-8 * np.abs(u_norm).max()
+    assert p.line_search() == "slope"  # what the case runner uses for this law

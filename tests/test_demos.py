@@ -121,6 +121,18 @@ def test_punch_every_output_is_written(tmp_path, demo):
     assert (tmp_path / "p.png").stat().st_size > 20_000 and out.exists()
 
 
+def test_output_is_a_time_series_of_every_converged_step(tmp_path, demo):
+    from conftest import read_series
+
+    demo.punch("--refine", "0", "--steps", "3", "--material", "j2", "--output", tmp_path / "f")
+    times, u = read_series(tmp_path / "f" / "displacement.bp", "displacement")
+    assert times == pytest.approx([1 / 3, 2 / 3, 1.0], rel=1e-12)
+    assert np.abs(u[0]).max() < np.abs(u[1]).max() < np.abs(u[2]).max()
+    times, p = read_series(tmp_path / "f" / "cumulated_plastic_strain.bp",
+                           "cumulated_plastic_strain")
+    assert len(times) == 3 and p[-1].max() > 0  # J2 writes its state too
+
+
 def test_a_failing_picture_keeps_the_json(tmp_path, demo, monkeypatch):
     from fenics_nl.io import pictures
 

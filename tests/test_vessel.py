@@ -1,5 +1,6 @@
 """The thick sphere and cylinder in perfect J2 plasticity against the closed forms."""
 
+import json
 import math
 
 import numpy as np
@@ -61,11 +62,19 @@ def test_beyond_the_limit_load_is_one_line(demo):
     # (h = 12.5: the discrete limit is 1.4 % above the exact one; at h = 25, 4 elements
     # through the wall, it is more than 20 % above: P2 locks in the incompressible flow)
     proc = demo.run(["pressure_vessel.py", "--pressure-ratio", "1.1", "--steps", "5",
-                     "--size", "12.5"],
+                     "--size", "12.5", "--json", "failed.json"],
                     check=False)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "the limit load was reached" in lines[0]
+    # and the steps that converged are kept: every one below the (discrete) limit pressure
+    d = json.loads((demo.tmp_path / "failed.json").read_text())
+    assert d["status"] == "failed" and d["message"] in lines[0]
+    assert d["converged_steps"] == len(d["steps"]) >= 5
+    p_lim = d["limit_pressure_exact"]
+    pressures = [s["pressure"] for s in d["steps"]]
+    assert pressures == sorted(pressures) and p_lim * 0.9 < pressures[-1] < 1.02 * p_lim
+    assert d["load_factor"] == pytest.approx(pressures[-1] / (1.1 * p_lim), rel=1e-12)
 
 
 @pytest.mark.parametrize("ranks", [2])

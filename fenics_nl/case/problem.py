@@ -221,6 +221,18 @@ class CaseProblem:
                              f"; the active set constrains one displacement component"])
         return axis, int(np.sign(mean[axis]))
 
+    def mean_normal(self, group: str) -> np.ndarray:
+        """The mean outward normal of a group: ∫ n ds / ∫ ds (0 for a closed surface)."""
+        comm = self.mesh.comm
+        f = np.sort(self.facets[group])
+        mt = dmesh.meshtags(self.mesh, self.mesh.topology.dim - 1, f,
+                            np.ones(len(f), dtype=np.int32))
+        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=mt)(1)
+        n = ufl.FacetNormal(self.mesh)
+        area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)))
+        return np.array([comm.allreduce(fem.assemble_scalar(fem.form(n[i] * ds)))
+                         for i in range(self.case.dim)]) / area
+
     def obstacle_at(self, t: float) -> dict:
         """The contact obstacle at load factor t (moved by t × its displacement)."""
         ob = dict(self.contact[0].value)
@@ -247,6 +259,17 @@ class CaseProblem:
 
         return plane if ob["obstacle"] == "plane" else sphere
 
+    def line_search(self):
+        """Backtracking for a non-linear law; on the energy's slope for a hyperelastic one.
+
+        A hyperelastic energy is smooth, so its slope along a Newton step says whether the
+        step is good even when ‖R‖ grows (`NewtonSolver._step`); J2 and the power law keep
+        the test on ‖R‖.
+        """
+        if self.material.is_linear:
+            return False
+        return "slope" if self.material.finite_strain else True
+
     def make_solver(self):
         """The case's solver (compiles the forms; reads the PETSc options under case_)."""
         self.solver = self._solver()
@@ -257,7 +280,7 @@ class CaseProblem:
         method = {"quasi-newton": "bfgs"}.get(case.newton, case.newton)
         linear = "lu" if case.linear == "direct" else "gamg"
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
-                "line_search": not self.material.is_linear, "force_scale": self.force_scale}
+                "line_search": self.line_search(), "force_scale": self.force_scale}
         if linear == "gamg" and self.mixed:  # MINRES with the block preconditioner
             opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed,
                                                                self.model, self.dx)

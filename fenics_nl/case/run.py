@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.case.problem import CaseProblem
 from fenics_nl.case.resume import CaseCheckpoints, Resumed
-from fenics_nl.io import cli, output
+from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength
@@ -17,16 +18,15 @@ from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
 
-def solve_case(problem: CaseProblem, output_folder: str | None = None, *,
-               checkpoint: str | None = None, checkpoint_every: int = 1,
-               restart: str | None = None) -> dict:
+def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
+               checkpoint_every: int = 1, restart: str | None = None) -> dict:
     """Visit the case's load factors in order; returns the JSON record of the run.
 
     Each segment between two factors starts as one step and is cut in half on failure
     (`loading.adaptive`); every converged step is recorded with its load factor, Newton
     (and active-set) iterations, probes, reactions and, with contact, the contact force,
-    and handed to `cli.converged_step` (a run that fails later keeps it). With
-    `output_folder`, the fields of every converged step are written as a time series.
+    and handed to `cli.converged_step` with its fields (a run that fails later keeps both;
+    with --output the fields of every step are a time series).
     `checkpoint`: a folder where the state after every `checkpoint_every`-th converged step
     is saved; `restart`: a folder to go on from (the same case, mesh and ranks).
     """
@@ -42,22 +42,10 @@ def solve_case(problem: CaseProblem, output_folder: str | None = None, *,
         say(f"restarted from {restart}: {len(resumed.steps)} converged steps, load factor "
             f"{resumed.steps[-1]['load_factor']:.6g}" if resumed.steps else
             f"restarted from {restart}")
-    series = output.FieldSeries(output_folder, lambda: fields(problem)) if output_folder \
-        else None
-    try:
-        out = _solve(problem, solver, series, saving, resumed)
-    finally:
-        if series is not None:
-            paths = series.paths
-            series.close()
-            if series.times:
-                say(f"wrote {', '.join(str(p) for p in paths)} ({len(series.times)} "
-                    "steps, the load factor as time; ADIOS2 VTX: open in ParaView)")
+    out = _solve(problem, solver, saving, resumed)
     out["solver_setup_time_s"] = setup
-    if resumed is not None and output_folder and resumed.steps:
-        out["warnings"].append(f"restarted: the --output time series begins after load factor "
-                               f"{resumed.steps[-1]['load_factor']:.6g}, where the restart "
-                               "took the run up (VTX files are not appended to)")
+    if resumed is not None and resumed.steps:
+        out["restarted_after_load_factor"] = resumed.steps[-1]["load_factor"]
     return out
 
 
@@ -67,14 +55,13 @@ def fields(problem: CaseProblem) -> list:
     if problem.mixed:
         functions.append(problem.mixed.pressure())
     if getattr(problem.material, "path_dependent", False):
-        functions += [problem.material.cumulated_plastic_strain_per_cell(),
-                      problem.material.plastic_strain_per_cell()]
+        functions += problem.material.output_fields()
     if problem.contact is not None:
         functions += problem.solver.contact.fields(problem.weight)
     return functions
 
 
-def _solve(problem: CaseProblem, solver, series, saving: CaseCheckpoints | None,
+def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
            resumed: Resumed | None) -> dict:
     """The load path of `solve_case`, from its start or from where `resumed` left it."""
     case, steps, work = problem.case, [], WorkCounts()
@@ -87,9 +74,7 @@ def _solve(problem: CaseProblem, solver, series, saving: CaseCheckpoints | None,
 
     def converged(t, result):
         steps.append(step_record(problem, t, result))
-        cli.converged_step(steps[-1])
-        if series is not None:
-            series.write(t)
+        cli.converged_step(steps[-1], fields=lambda: fields(problem))
 
     def save(segment):  # after each converged step, with the driver's state
         if saving is None:
@@ -234,10 +219,56 @@ def warnings(problem: CaseProblem) -> list[str]:
     return notes
 
 
-def write_outputs(problem: CaseProblem, png: str | None):
-    """Writers for run_scene: the picture (the fields were written step by step)."""
+def load_path_plot(out: dict, path: str) -> None:
+    """Each probe's displacement and σ_eq, and each reaction, against the load factor.
+
+    Read from the JSON's step records (rank 0 draws); components that stay zero are left
+    out. Units are the case's own: a length, a stress, a force.
+    """
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    from fenics_nl.io import pictures
+
+    steps = out["steps"]
+    t = [0.0] + [s["load_factor"] for s in steps]
+    plt = pictures.pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
+    names = "xyz" if out["model"] != "axisymmetric" else "rz"
+    curves = [{}, {}, {}]
+    for s in steps:
+        for name, probe in s["probes"].items():
+            for i, value in enumerate(probe["displacement"]):
+                curves[0].setdefault(f"{name}: u_{names[i]}", []).append(value)
+            curves[1].setdefault(f"{name}", []).append(probe["von_mises"])
+        for group, force in s["reactions"].items():
+            for i, value in enumerate(force):
+                curves[2].setdefault(f"{group}: R_{names[i]}", []).append(value)
+    titles = ("probe displacements [length]", "probe von Mises stress [stress]",
+              "support reactions [force]")
+    for ax, series, title in zip(axes, curves, titles, strict=True):
+        peak = max((abs(v) for values in series.values() for v in values), default=0.0)
+        for label, values in series.items():
+            if max(abs(v) for v in values) > 1e-9 * peak:
+                ax.plot(t, [0.0, *values], "o-", ms=3, label=label)
+        ax.set_xlabel("load factor")
+        ax.set_title(title, fontsize=10)
+        ax.grid(alpha=0.3)
+        if ax.lines:
+            ax.legend(fontsize=7)
+        else:
+            ax.text(0.5, 0.5, "none in this case", ha="center", transform=ax.transAxes)
+    fig.suptitle(f"{Path(out['case']).name}: {out['law']}, {out['model']}, {len(steps)} "
+                 f"converged steps, load factor {out['load_factor']:.4g}", fontsize=11)
+    pictures.save_figure(fig, path)
+
+
+def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | None = None):
+    """Writers for run_scene: the picture and the load-path plot.
+
+    The fields were written step by step (`cli.converged_step`).
+    """
     vm = problem.von_mises() if png else None
-    writers = []
+    writers = [lambda: load_path_plot(out, plot)] if plot else []
     if png:
         def picture():
             from fenics_nl.io.pictures import deformed_picture, facet_points
@@ -248,10 +279,25 @@ def write_outputs(problem: CaseProblem, png: str | None):
                     held = "fixed" if None not in c.value else "partly fixed"
                     marked[f"{c.group} ({held})"] = facet_points(problem.mesh,
                                                                 problem.facets[c.group])
-            arrows = {f"{c.group} (traction)": (facet_points(problem.mesh,
-                                                             problem.facets[c.group]), c.value)
-                      for c in problem.case.conditions if c.kind == "traction" and any(c.value)}
-            title = (f"{problem.case.path.name}: load factor {float(problem.t.value):.3g}, "
+            t = float(problem.t.value)
+            arrows = {}  # the loads as they are now: none at load factor 0
+            for c in problem.case.conditions:
+                if c.kind == "traction" and any(c.value) and t != 0:
+                    arrows[f"{c.group} (traction)"] = (
+                        facet_points(problem.mesh, problem.facets[c.group]),
+                        t * np.asarray(c.value))
+                elif c.kind == "pressure" and c.value and t != 0:
+                    normal = problem.mean_normal(c.group)  # a closed surface has none
+                    if np.linalg.norm(normal) > 1e-6:
+                        arrows[f"{c.group} (pressure)"] = (
+                            facet_points(problem.mesh, problem.facets[c.group]),
+                            -t * c.value * normal)
+            labels = {}  # each probe's σ_eq at its point (the colours are per cell)
+            if problem.case.probes and out["steps"]:
+                values = out["steps"][-1]["probes"]
+                labels = {f"{p.name}: {values[p.name]['von_mises']:.4g}": p.point
+                          for p in problem.case.probes}
+            title = (f"{problem.case.path.name}: load factor {t:.3g}, "
                      f"{problem.case.law}, {problem.case.model}")
             focus = obstacle = None
             if problem.contact is not None:
@@ -263,7 +309,8 @@ def write_outputs(problem: CaseProblem, png: str | None):
                 obstacle = problem.obstacle_at(float(problem.t.value))
                 title += f", {S.count(c.active)} nodes in contact"
             deformed_picture(problem.displacement(), vm, png, title, marked, arrows, focus,
-                             obstacle)
+                             obstacle, label="von Mises stress (per cell)", labels=labels,
+                             detail=focus is None)
             say(f"wrote {png}")
         writers.append(picture)
     return writers

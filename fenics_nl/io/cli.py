@@ -68,7 +68,9 @@ def add_outputs(p: argparse.ArgumentParser, *, json: str = "the quantities of in
     """The output flags of a demo: --json always, --output/--png/--plot where it has them."""
     p.add_argument("--json", metavar="PATH", help=f"write {json} as JSON")
     if output:
-        p.add_argument("--output", metavar="DIR", help=f"{output} (ADIOS2 VTX, for ParaView)")
+        p.add_argument("--output", metavar="DIR",
+                       help=f"{output}, at every converged step (ADIOS2 VTX time series, the "
+                            "load factor as time, for ParaView)")
     for flag, text in (("--png", png), ("--plot", plot)):
         if text:
             p.add_argument(flag, metavar="PATH", help=text)
@@ -214,19 +216,41 @@ class _Run:
         self.writers: Sequence[Callable[[], None]] = ()
         self.steps: list[dict] = []  # every converged step, as the scene reported it
         self.known: dict = {}  # quantities set before the solve (dofs, references)
+        self.output: str | None = None  # --output: the fields of every converged step
+        self.series = None  # their time series, opened at the first step
+
+    def close_series(self) -> None:
+        """Close the fields' time series, saying what it holds (collective)."""
+        if self.series is None:
+            return
+        paths = self.series.paths
+        self.series.close()
+        say(f"wrote {', '.join(str(p) for p in paths)} ({len(self.series.times)} steps, the "
+            "load factor as time; ADIOS2 VTX: open in ParaView)")
+        self.series = None
 
 
 _current: _Run | None = None
 
 
-def converged_step(record: dict) -> None:
+def converged_step(record: dict, fields: Callable[[], list] | None = None) -> None:
     """Keep one converged step's quantities (a dict with its ``load_factor``).
 
-    They go to the JSON as ``steps``, and stay there if a later step fails. Outside a run
-    (a notebook, an import) nothing is kept.
+    They go to the JSON as ``steps``, and stay there if a later step fails. With --output,
+    `fields()` (the Functions of the state) are written as one more time of the run's time
+    series (`output.FieldSeries`). Outside a run (a notebook, an import) nothing is kept.
+    Collective when `fields` is given.
     """
-    if _current is not None:
-        _current.steps.append(dict(record))
+    run = _current
+    if run is None:
+        return
+    run.steps.append(dict(record))
+    if fields is not None and run.output:
+        if run.series is None:
+            from fenics_nl.io.output import FieldSeries
+
+            run.series = FieldSeries(run.output)
+        run.series.write(record["load_factor"], fields)
 
 
 def known(**quantities) -> None:
@@ -287,6 +311,7 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
         return _failed(run, err, t0)
     finally:
         _current = None
+        run.close_series()  # the fields of every converged step, also after a failure
     if run.out is None:
         raise RuntimeError(f"{path} ended without calling cli.results")
     return _finish(run, t0)
@@ -304,6 +329,7 @@ def arguments(parser: argparse.ArgumentParser,
     args, petsc = parse_with_petsc_options(parser, run.argv if run else [])
     if run is not None:
         run.json_path = getattr(args, "json", None)
+        run.output = getattr(args, "output", None)
         try:
             check_output_paths(*(getattr(args, k, None) for k in ("json", "png", "plot",
                                                                    "output")))
@@ -321,7 +347,7 @@ def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
 
 def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
               petsc_argv: Sequence[str] = (), prefixes: dict[str, str] | None = None,
-              json_path: str | None = None) -> int:
+              json_path: str | None = None, output: str | None = None) -> int:
     """Run `solve()`, which returns quantities for the JSON and output writers.
 
     The same contract as `run_file` (one-line errors, the JSON first, PETSc options checked)
@@ -332,7 +358,7 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
     global _current
     t0 = time.perf_counter()
     run = _current = _Run([])
-    run.json_path = json_path
+    run.json_path, run.output = json_path, output
     try:
         run.options = PetscOptions(petsc_argv, prefixes or {})
         run.out, run.writers = solve()
@@ -340,6 +366,7 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
         return _failed(run, err, t0)
     finally:
         _current = None
+        run.close_series()
     return _finish(run, t0)
 
 

@@ -3,7 +3,8 @@
 * `write_fields`: one ADIOS2 VTX file per function (any Lagrange degree, on any mesh
   degree: P2 on quadrilaterals included), which ParaView opens directly.
 * `FieldSeries`: the same files as a time series, one time per converged load step (the
-  load factor as time), written as the steps converge: a run that fails keeps them.
+  load factor as time, Σ|Δt| on a path that comes back), written as the steps converge: a
+  run that fails keeps them.
 * `gather_grid`: the mesh of a Lagrange space, its nodal and cell fields, collected from
   every rank on rank 0, so that a picture shows the whole body whatever the number of ranks.
 """
@@ -39,23 +40,28 @@ def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path
 
 
 class FieldSeries:
-    """`folder`/<name>.bp for each function, one time (the load factor) per `write(t)`.
+    """`folder`/<name>.bp for each function, one time per converged step (`write(t)`).
 
-    `functions()` gives the fields of the current state (new Function objects each call are
-    fine: their values are copied into the series' own). Each file is written and flushed
-    at every step. Collective; `close()` at the end, or use it as a context manager.
+    The time is the load-path time τ = Σ |Δt| of the load factors t given: the load factor
+    itself while it grows, and still increasing when the path comes back (an unloading), as
+    ParaView needs. `functions()` gives the fields of the current state (new Function
+    objects each call are fine: their values are copied into the series' own). Each file is
+    written at every step. Collective; `close()` at the end, or use it as a context manager.
     """
 
-    def __init__(self, folder: str | Path, functions):
+    def __init__(self, folder: str | Path, functions=None):
         self.folder, self.functions = Path(folder), functions
         self._series: dict[str, tuple] = {}  # name -> (writer, its own copy of the field)
         self.times: list[float] = []
+        self._last = 0.0  # the last load factor
 
-    def write(self, t: float) -> None:
-        """Every field of the current state, at time `t`."""
+    def write(self, t: float, functions=None) -> None:
+        """Every field of the current state (`functions()`, or the series' own), at t."""
         from dolfinx.io import VTXWriter
 
-        for f in self.functions():
+        tau = (self.times[-1] if self.times else 0.0) + abs(t - self._last)
+        self._last = t
+        for f in (functions or self.functions)():
             if f.name not in self._series:
                 self.folder.mkdir(parents=True, exist_ok=True)
                 copy = fem.Function(f.function_space, name=f.name)
@@ -64,8 +70,8 @@ class FieldSeries:
                 self._series[f.name] = (writer, copy)
             writer, copy = self._series[f.name]
             copy.x.array[:] = f.x.array
-            writer.write(t)
-        self.times.append(t)
+            writer.write(tau)
+        self.times.append(tau)
 
     @property
     def paths(self) -> list[Path]:

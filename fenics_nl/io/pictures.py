@@ -115,6 +115,7 @@ def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: flo
                                      i_size=1.3 * (hi[0] - lo[0]), j_size=1.3 * (hi[1] - lo[1])),
                             color="tan", opacity=0.5)
         pl.view_vector(direction)
+        pl.add_axes(line_width=3, labels_off=False)  # which way is x, y, z in each view
         if i == 0:
             state = (f"unloaded from F = {force / 1e3:.3g} kN: permanent load-point "
                      f"displacement" if unloaded else
@@ -145,7 +146,8 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                      marked: dict[str, np.ndarray] | None = None,
                      arrows: dict[str, np.ndarray] | None = None,
                      focus: np.ndarray | None = None, obstacle: dict | None = None,
-                     label: str = "von Mises stress") -> None:
+                     label: str = "von Mises stress", labels: dict | None = None,
+                     detail: bool = False, curves: dict | None = None) -> None:
     """The deformed body (2D or 3D) coloured by σ_eq (or the `label`led cell field `vm`).
 
     `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
@@ -154,7 +156,12 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
     their deformed positions): the view is cut to a box 2.5 times their extent around
     them, and they are drawn. `obstacle`: a rigid sphere (center, radius) or plane (point,
     normal) at its current position, drawn; the body is then drawn at true scale, since
-    a magnified displacement would pass through the obstacle.
+    a magnified displacement would pass through the obstacle. `labels`: text → a point
+    (the same on every rank), written there (a probe and its value). `detail`: when the
+    cell of the largest value is a small feature (smaller than 3 % of the body: a hole, a
+    notch), a second view beside the first zooms on it. `curves`: name → points of a line
+    in the undeformed body (a closed form's boundary, the same on every rank), drawn where
+    the deformation takes them.
     The displacement is magnified until the largest motion is 5 % of the body (said in
     the picture). Collective; rank 0 writes `path`.
     """
@@ -191,19 +198,27 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
     scale = 1.0 if obstacle else max(1.0, 0.05 * size / max(u_max, 1e-300))
     warped = mesh.warp_by_vector("u", factor=scale)
     flat = bool(np.ptp(grid.points[:, 2]) == 0)
-    pl = pv.Plotter(off_screen=True, window_size=(1100, 850))
-    if flat:  # the undeformed outline; cell edges only while they do not hide the colours
-        # (clean: the gathered mesh repeats the nodes of partition interfaces)
-        merged = mesh.clean(tolerance=1e-9 * size)
-        outline = merged.extract_feature_edges(boundary_edges=True, feature_edges=False,
-                                               manifold_edges=False, non_manifold_edges=False)
-        pl.add_mesh(outline, color="gray", line_width=1.5)
-    else:
-        pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.25)
-    pl.add_mesh(warped, scalars="vm", cmap="turbo", show_edges=flat and mesh.n_cells < 3000,
-                edge_color="white", line_width=0.2, scalar_bar_args={
-                    "title": label, "vertical": False, "position_x": 0.2,
-                    "position_y": 0.03, "width": 0.6, "fmt": "%.3g"})
+    zoom = _small_peak(mesh, warped, size) if detail else None
+    pl = pv.Plotter(off_screen=True, window_size=(1700 if zoom else 1100, 850),
+                    shape=(1, 2) if zoom else (1, 1))
+    for view in range(2 if zoom else 1):
+        pl.subplot(0, view)
+        _draw_body(pl, mesh, warped, flat, size, label, bar=view == 0)
+        if labels:
+            pts = np.array([_as_3d(np.asarray(x, dtype=float)[None, :])[0] for x in
+                            labels.values()])
+            moved = pts + scale * np.array([_displacement_at(warped, mesh, x) for x in pts])
+            pl.add_point_labels(moved, list(labels), point_size=9, font_size=12,
+                                point_color="black", text_color="black",
+                                render_points_as_spheres=True, always_visible=True)
+        if view == 1:
+            pl.add_text("zoom on the largest value", font_size=10, position="upper_left")
+            if flat:
+                pl.view_xy()
+            else:
+                pl.view_vector((1.0, -1.6, 0.9))
+            pl.reset_camera(bounds=zoom)
+    pl.subplot(0, 0)
     colours = ["black", "magenta", "blue", "orange", "green", "brown"]
     legend = []
     for (name, rows), colour in zip(points.items(), colours * 4, strict=False):
@@ -218,6 +233,13 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
             pl.add_arrows(pts.mean(axis=0)[None, :], d[None, :],
                           mag=0.25 * size / np.linalg.norm(d), color="red")
             legend.append(f"red arrow: {name}")
+    for (name, line), colour in zip((curves or {}).items(), ["white", "black"] * 4,
+                                    strict=False):
+        pts = _as_3d(np.asarray(line, dtype=float))
+        moved = pv.PolyData(pts).sample(mesh)  # the displacement there, interpolated
+        pl.add_lines(pts + scale * moved.point_data["u"], color=colour, width=3,
+                     connected=True)
+        legend.append(f"{colour} line: {name}")
     if focus is not None and len(focus[0]):
         pl.add_points(_as_3d(focus[0]), color="white", point_size=8,
                       render_points_as_spheres=True)
@@ -235,6 +257,43 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                 f"{u_max:.3g}", font_size=11, position="upper_left")
     pl.screenshot(path)
     pl.close()
+
+
+def _draw_body(pl, mesh, warped, flat: bool, size: float, label: str, bar: bool) -> None:
+    """The undeformed outline (2D) or wireframe (3D) and the deformed body, coloured."""
+    if flat:  # the undeformed outline; cell edges only while they do not hide the colours
+        # (clean: the gathered mesh repeats the nodes of partition interfaces)
+        merged = mesh.clean(tolerance=1e-9 * size)
+        outline = merged.extract_feature_edges(boundary_edges=True, feature_edges=False,
+                                               manifold_edges=False, non_manifold_edges=False)
+        pl.add_mesh(outline, color="gray", line_width=1.5)
+    else:
+        pl.add_mesh(mesh, style="wireframe", color="gray", opacity=0.25)
+    pl.add_mesh(warped.copy(), scalars="vm", cmap="turbo",
+                show_edges=flat and mesh.n_cells < 3000, edge_color="white", line_width=0.2,
+                show_scalar_bar=bar, scalar_bar_args={
+                    "title": label, "vertical": False, "position_x": 0.2,
+                    "position_y": 0.03, "width": 0.6, "fmt": "%.3g"})
+
+
+def _small_peak(mesh, warped, size: float):
+    """Bounds of a box around the cell of the largest value, if that cell is small.
+
+    Its size is read on the undeformed mesh (a magnified motion stretches cells), its
+    centre on the deformed one (where the picture shows it).
+    """
+    k = int(np.argmax(warped.cell_data["vm"]))
+    extent = np.ptp(mesh.extract_cells([k]).points, axis=0).max()
+    if extent >= 0.03 * size:
+        return None
+    c = warped.extract_cells([k]).points.mean(axis=0)
+    half = 12 * extent
+    return [c[0] - half, c[0] + half, c[1] - half, c[1] + half, c[2] - half, c[2] + half]
+
+
+def _displacement_at(warped, mesh, x: np.ndarray) -> np.ndarray:
+    """The displacement of the node of `mesh` nearest to x (to place a label)."""
+    return mesh.point_data["u"][mesh.find_closest_point(x)]
 
 
 def _as_3d(points: np.ndarray) -> np.ndarray:

@@ -112,6 +112,10 @@ class J2Plasticity(Isotropic, SmallStrain):
         st = self._bound()
         return {"plastic_strain": st["eps_p"], "cumulated_plastic_strain": st["p"]}
 
+    def output_fields(self) -> list:
+        """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0."""
+        return [self.cumulated_plastic_strain_per_cell(), self.plastic_strain_per_cell()]
+
     def plastic_strain_per_cell(self):
         """The mean committed plastic strain ε_p of each cell's quadrature points (DG0, 3x3)."""
         from dolfinx import fem
