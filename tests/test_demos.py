@@ -382,7 +382,8 @@ def test_beam_bad_input_one_clear_line(args, message, demo):
 
 
 def test_bracket_newton_variants_agree(demo):
-    d = demo.bracket("--compare")
+    # 14 mm elements (16.7k unknowns, ε_eq still 12 ε0): the variants agree on any mesh
+    d = demo.bracket("--compare", "--size", "14")
     ref = d["variants"]["full"]["load_point_displacement"]
     for name, v in d["variants"].items():
         assert abs(v["load_point_displacement"] / ref - 1) < 1e-7, name
@@ -393,8 +394,10 @@ def test_bracket_newton_variants_agree(demo):
 
 
 def test_bracket_contact_support_lifts_off(tmp_path, demo):
-    c = demo.bracket("--support", "contact")
-    k = demo.bracket()
+    # equilibrium and the floor's one-sidedness hold on any mesh: 14 mm elements (at 20 mm
+    # the polygonal bolt holes leave more base than the exact area the bound below takes)
+    c = demo.bracket("--support", "contact", "--size", "14")
+    k = demo.bracket("--size", "14")
     base_area = 100 * 60 - 2 * math.pi * 6**2
     assert 0 < c["lifted_off_area"] < base_area
     # equilibrium: the bolts take the pull, the frictionless floor pushes only upwards, and
