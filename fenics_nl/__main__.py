@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -66,8 +67,15 @@ def main(argv=None) -> int:
     try:  # an output that cannot be written is said now, not after the solve
         cli.check_output_paths(json=args.json, png=args.png, plot=args.plot,
                                output=args.output)
+        if args.restart and args.output and any(Path(args.output).glob("*.bp")):
+            # VTX files are rewritten, not appended to: the first run's fields would be lost
+            p.error(f"--output {args.output} holds fields already (the interrupted run's?): "
+                    "a restart writes its own series, give it another folder")
         if args.checkpoint:
-            cli.check_output_paths(output=args.checkpoint)
+            try:
+                cli.check_output_paths(output=args.checkpoint)
+            except ValueError as err:
+                p.error(str(err).replace("--output", "--checkpoint", 1))
     except ValueError as err:
         p.error(str(err))
     t0 = time.perf_counter()
@@ -97,9 +105,9 @@ def main(argv=None) -> int:
                          checkpoint_every=args.checkpoint_every, restart=args.restart)
         if args.output and "restarted_after_load_factor" in out:
             out["warnings"].append(
-                "restarted: the --output time series begins after load factor "
-                f"{out['restarted_after_load_factor']:.6g}, where the restart took the run up "
-                "(VTX files are not appended to)")
+                "restarted: this --output time series begins after load factor "
+                f"{out['restarted_after_load_factor']:.6g}, where the restart took the run "
+                "up; the steps before are in the first run's folder")
         # before the first step: the problem, then the solver (its forms compiled)
         out["setup_time_s"] = built + out.pop("solver_setup_time_s")
         return out, write_outputs(problem, out, args.png, args.plot)

@@ -129,6 +129,18 @@ def test_a_box_on_a_frictionless_floor_names_its_three_free_motions():
     assert message.count("rotation") == 1
 
 
+@pytest.mark.parametrize("L,E", [(1.0, 1e3), (1000.0, 2e5)])
+def test_a_soft_foundation_holds_a_body_in_any_units(L, E):
+    # k = 1e-6 E per unit area on one edge: weak next to the body (its resistance to a
+    # rigid motion ~1e-7 of max K_ii), yet it holds: accepted, 1000 times above the threshold
+    p = Plate(L=L, E=E)
+    spring = 1e-6 * E / L * ufl.dot(p.u, p.v) * p.ds(2)
+    # (the soft support makes K ill-conditioned: ‖R‖ stops at ~2e-9 of its start)
+    result = NewtonSolver(p.residual + spring, p.u, [], rtol=1e-8, atol=1e-8,
+                          prefix="soft_").solve()
+    assert result.converged
+
+
 def test_what_holds_a_body_without_a_dirichlet_row_is_accepted():
     # an elastic foundation k u.v on the left edge: no support, yet nothing is free; and the
     # axisymmetric model, whose radial "translation" strains the hoops: held by u_z alone

@@ -263,12 +263,16 @@ class CaseProblem:
         """Backtracking for a non-linear law; on the energy's slope for a hyperelastic one.
 
         A hyperelastic energy is smooth, so its slope along a Newton step says whether the
-        step is good even when ‖R‖ grows (`NewtonSolver._step`); J2 and the power law keep
-        the test on ‖R‖.
+        step is good even when ‖R‖ grows (`NewtonSolver._step`). Only where R is the
+        gradient of an energy that is minimised: not the mixed form (a saddle point: the
+        pressure rows' slope can cancel the displacement's), not a follower pressure (no
+        potential); J2 and the power law keep the test on ‖R‖ (a kink in R).
         """
         if self.material.is_linear:
             return False
-        return "slope" if self.material.finite_strain else True
+        follower = any(c.kind == "pressure" and c.follower for c in self.case.conditions)
+        minimised = self.material.finite_strain and not self.mixed and not follower
+        return "slope" if minimised else True
 
     def make_solver(self):
         """The case's solver (compiles the forms; reads the PETSc options under case_)."""

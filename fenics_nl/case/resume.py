@@ -41,10 +41,11 @@ class CaseCheckpoints:
         identity = {"case file": hashlib.sha256(problem.case.path.read_bytes()).hexdigest(),
                     "ranks": comm.size, "dofs": problem.dofs}
         self.store = Checkpoints(folder, comm, identity, every)
-        W = problem.unknown.function_space
-        owned = W.dofmap.index_map.size_local
+        # this rank's unknowns and mesh nodes (a mixed space tabulates no dof coordinates)
+        msh = problem.mesh
+        nodes = msh.geometry.index_map().size_local
         self.local = {"unknown": int(problem.unknown.x.array.size),
-                      "coordinates": fingerprint(W.tabulate_dof_coordinates()[:owned])}
+                      "coordinates": fingerprint(msh.geometry.x[:nodes])}
 
     # -- what is saved -----------------------------------------------------------------
 

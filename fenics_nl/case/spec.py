@@ -281,6 +281,10 @@ def read_case(path: str | Path) -> Case:
     dim = 3 if model == "3d" else 2
 
     law, parameters = _material(r, data, model)
+    if law == "j2" and model == "plane_stress" and degree is not None and degree > 2:
+        # ε_zz needs one function per quadrature point (materials.plane_stress): P3's rule
+        # on a triangle has 12 points, and no discontinuous space has 12 functions
+        r.fail("mesh.degree", f"j2 in plane stress takes degree 1 or 2, got {degree}")
     if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"):
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)

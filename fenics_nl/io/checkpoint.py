@@ -69,14 +69,16 @@ class Checkpoints:
         if step % self.every:
             return False
         target = self.folder / f"step-{step:06d}"
-        if self.comm.rank == 0:
+
+        def folder():
             shutil.rmtree(target, ignore_errors=True)
             target.mkdir(parents=True)
-        self.comm.barrier()
-        np.savez(target / f"rank{self.comm.rank}.npz", **arrays)
-        ranks = self.comm.gather(local_identity, root=0)
-        self.comm.barrier()  # every rank's arrays are on disk
-        if self.comm.rank == 0:
+
+        self._together(folder if self.comm.rank == 0 else None)
+        self._together(lambda: np.savez(target / f"rank{self.comm.rank}.npz", **arrays))
+        ranks = self.comm.gather(local_identity, root=0)  # every rank's arrays are on disk
+
+        def publish():  # state.json, then latest.json names the step: atomic (os.replace)
             meta = {"format": FORMAT, "identity": self.identity, "ranks_identity": ranks,
                     "step": step, **state}
             (target / "state.json").write_text(json.dumps(meta, allow_nan=False))
@@ -87,8 +89,26 @@ class Checkpoints:
             for old in self._saved[:-KEEP]:
                 shutil.rmtree(old, ignore_errors=True)
             self._saved = self._saved[-KEEP:]
-        self.comm.barrier()
+
+        self._together(publish if self.comm.rank == 0 else None)
         return True
+
+    def _together(self, write) -> None:
+        """Run this rank's `write` (or nothing); if it fails on any rank, fail on every one.
+
+        A rank-local error (a full disk on one rank) must not leave the others waiting in
+        the next collective: CheckpointError everywhere, naming the first failure.
+        """
+        problem = None
+        if write is not None:
+            try:
+                write()
+            except (OSError, ValueError) as err:  # ValueError: a NaN in the state's JSON
+                problem = f"rank {self.comm.rank}: {type(err).__name__}: {err}"
+        problems = [p for p in self.comm.allgather(problem) if p]
+        if problems:
+            raise CheckpointError(f"cannot write the checkpoint in {self.folder} "
+                                  f"({problems[0]})")
 
     def load(self, local_identity: dict) -> tuple[dict, dict[str, np.ndarray]]:
         """(rank 0's state, this rank's arrays) of the latest complete step.

@@ -377,11 +377,14 @@ def _forget(options: PetscOptions | None) -> None:
 
 
 def _failed(run: _Run, err: BaseException, t0: float) -> int:
-    """One line, and, for a solve that failed (not bad input), the JSON of what converged."""
+    """One line, and the JSON of what converged if a solve failed or steps had converged.
+
+    Bad input found before any step (a ValueError) writes nothing: nothing was solved.
+    """
     message = _one_line(err)
     error(message)
     _forget(run.options)
-    if isinstance(err, SolveError) and run.json_path:
+    if (isinstance(err, SolveError) or run.steps) and run.json_path:
         last = next((s["load_factor"] for s in reversed(run.steps) if "load_factor" in s),
                     None)
         out = {**run.known, "status": "failed", "message": message,

@@ -163,14 +163,19 @@ class SnesSolver:
         x = self.u.x.petsc_vec
         petsc.set_bc(x, self.bcs)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        if not self._supports_checked and self.motions is not None:
+            # MUMPS factorizes a singular K without a word, and SNES then converges to an
+            # answer with an arbitrary rigid motion in it: the tangent at the start (an
+            # unstressed state for a first solve) is checked before SNES runs
+            A = self.problem.A
+            A.zeroEntries()
+            petsc.assemble_matrix(A, self.problem.J, bcs=self.bcs, diag=1.0)
+            A.assemble()
+            check_supports(A, self.motions, self.bcs)
+            self._supports_checked = True
         self.counter.start()
         self._stamps.clear()
         self.problem.solve()
-        if not self._supports_checked and self.motions is not None:
-            # MUMPS factorizes a singular K without a word, and SNES then converges to an
-            # answer with an arbitrary rigid motion in it: the first Jacobian is checked
-            check_supports(self.problem.A, self.motions, self.bcs)
-            self._supports_checked = True
         work = petsc_work(self.counter)
         norms = [float(r) for r in self.snes.getConvergenceHistory()[0]]
         reason = self.snes.getConvergedReason()
