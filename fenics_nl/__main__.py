@@ -65,8 +65,13 @@ def main(argv=None) -> int:
                                     or petsc or args.checkpoint or args.restart):
         p.error("check takes the case file only")
     try:  # an output that cannot be written is said now, not after the solve
+        inputs = [args.case]
+        try:  # the mesh file too, when the case names one (its mistakes are said below)
+            inputs.append(read_case(args.case).mesh_file)
+        except (CaseError, OSError):
+            pass
         cli.check_output_paths(json=args.json, png=args.png, plot=args.plot,
-                               output=args.output)
+                               output=args.output, inputs=inputs)
         if args.restart and args.output and any(Path(args.output).glob("*.bp")):
             # VTX files are rewritten, not appended to: the first run's fields would be lost
             p.error(f"--output {args.output} holds fields already (the interrupted run's?): "
@@ -101,6 +106,8 @@ def main(argv=None) -> int:
         from fenics_nl.case.run import solve_case, write_outputs
 
         cli.known(case=str(case.path), model=case.model, law=case.law, dofs=problem.dofs)
+        # a run that fails still draws its converged steps (the last converged state)
+        cli.on_failure(lambda failed: write_outputs(problem, failed, args.png, args.plot))
         out = solve_case(problem, checkpoint=args.checkpoint,
                          checkpoint_every=args.checkpoint_every, restart=args.restart)
         if args.output and "restarted_after_load_factor" in out:

@@ -478,7 +478,7 @@ def test_a_case_loaded_past_its_limit_keeps_every_converged_step(tmp_path, demo)
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
     out, fields = tmp_path / "run.json", tmp_path / "fields"
     proc = demo.run(["-m fenics_nl", "run", write(tmp_path, "j2.toml", text), "--json", out,
-                     "--output", fields], check=False)
+                     "--output", fields, "--plot", tmp_path / "path.png"], check=False)
     assert proc.returncode == 2
     error = [line for line in proc.stderr.splitlines() if line.startswith("error")]
     assert len(error) == 1 and "load factor 1.2 not reached" in error[0], proc.stderr
@@ -486,6 +486,10 @@ def test_a_case_loaded_past_its_limit_keeps_every_converged_step(tmp_path, demo)
     d = json.loads(out.read_text())
     assert d["status"] == "failed" and d["message"] in error[0]
     assert d["load_factor"] == 0.8 and d["converged_steps"] == 2
+    # the totals it can give, and the curves of its converged steps
+    assert d["newton_iterations"] == sum(s["newton_iterations"] for s in d["steps"])
+    assert d["probes"] == d["steps"][-1]["probes"]
+    assert (tmp_path / "path.png").stat().st_size > 20_000
     assert [s["load_factor"] for s in d["steps"]] == [0.5, 0.8]
     # the steps are the converged states: σ_r(a) = −p at each
     for s in d["steps"]:
@@ -513,7 +517,11 @@ def test_every_step_of_a_case_is_a_time_series(tmp_path, demo):
 def test_an_output_path_that_cannot_be_written_is_refused_before_the_solve(tmp_path, demo):
     for flag, path in (("--json", tmp_path / "missing" / "x.json"),
                        ("--png", tmp_path / "missing" / "x.png"),
-                       ("--output", tmp_path / "file.txt" / "fields")):
+                       ("--output", tmp_path / "file.txt" / "fields"),
+                       ("--json", "/proc/x.json"),  # a folder that takes no file
+                       ("--png", tmp_path / "x.txt"),  # no picture type
+                       ("--json", CASES / "thick_cylinder.toml"),  # the input itself
+                       ("--json", CASES / "thick_cylinder.geo")):
         (tmp_path / "file.txt").write_text("")
         proc = demo.run(["-m fenics_nl", "run", CASES / "thick_cylinder.toml", flag, path],
                         check=False)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from pathlib import Path
 
@@ -107,8 +108,9 @@ def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
                 path = solve_incrementally(solver, problem.set_load, n, adaptive=case.adaptive,
                                            max_step=1.0 / n, progress=show, commit=commit,
                                            on_step=converged, start=start, on_state=save(0))
-            except LoadStepError as err:
-                raise _not_reached(err, err.target, steps) from err
+            except LoadStepError as err:  # heading for the next of the n equal steps
+                asked = min(1.0, (math.floor(err.reached * n + 1e-9) + 1) / n)
+                raise _not_reached(err, asked, err.target, steps) from err
             work.add(path.work)
     else:  # from factor to factor, each segment one step (cut in half on failure)
         previous = 0.0
@@ -129,7 +131,7 @@ def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
                                            start=start if k == first else None,
                                            on_state=save(k))
             except LoadStepError as err:  # err's factors are fractions of the segment
-                raise _not_reached(err, previous + err.target * (target - previous),
+                raise _not_reached(err, target, previous + err.target * (target - previous),
                                    steps) from err
             work.add(path.work)
             previous = target
@@ -157,15 +159,19 @@ def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
     return out
 
 
-def _not_reached(err: LoadStepError, asked: float, steps: list[dict]) -> LoadStepError:
-    """The driver's failure in the case's own load factors (a segment's are fractions)."""
+def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[dict]
+                 ) -> LoadStepError:
+    """The driver's failure in the case's own load factors (a segment's are fractions).
+
+    `asked` is the factor of the case the path was heading for, `failed` the cut step's.
+    """
     reached = steps[-1]["load_factor"] if steps else 0.0
     cause = str(err.__cause__ or err).split(": ", 1)[-1] if err.__cause__ else str(err)
     return LoadStepError(
         f"load factor {asked:.6g} not reached: the last converged load factor is "
-        f"{reached:.6g} ({len(steps)} converged steps); the limit load is reached, or the "
-        f"solver cannot take the step (the last attempt: {cause}); past a limit point, "
-        'follow the path with [loading] control = "arc-length"', err.result,
+        f"{reached:.6g} ({len(steps)} converged steps); the step to {failed:.6g} failed "
+        f"({cause}): the limit load is reached, or the solver cannot take the step; past a "
+        'limit point, follow the path with [loading] control = "arc-length"', err.result,
         reached=reached, target=asked)
 
 

@@ -218,6 +218,7 @@ class _Run:
         self.known: dict = {}  # quantities set before the solve (dofs, references)
         self.output: str | None = None  # --output: the fields of every converged step
         self.series = None  # their time series, opened at the first step
+        self.failure_writers = None  # out -> writers of a failed run (its pictures)
 
     def close_series(self) -> None:
         """Close the fields' time series, saying what it holds (collective)."""
@@ -253,38 +254,86 @@ def converged_step(record: dict, fields: Callable[[], list] | None = None) -> No
         run.series.write(record["load_factor"], fields)
 
 
+def on_failure(writers: Callable[[dict], Sequence[Callable[[], None]]]) -> None:
+    """What a failed run still draws: `writers(out)` gets the failed run's JSON record.
+
+    The state is then the last converged one (the load driver restores it), so its pictures
+    and curves are those of the converged steps.
+    """
+    if _current is not None:
+        _current.failure_writers = writers
+
+
 def known(**quantities) -> None:
     """Quantities known before the solve (``dofs``, reference values): in any JSON written."""
     if _current is not None:
         _current.known.update(quantities)
 
 
+IMAGE_TYPES = {"--png": (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"),
+               "--plot": (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".eps", ".ps", ".tif",
+                          ".tiff", ".webp")}
+
+
 def check_output_paths(json: str | None = None, png: str | None = None,
-                       plot: str | None = None, output: str | None = None) -> None:
+                       plot: str | None = None, output: str | None = None,
+                       inputs: Sequence[str | Path] = ()) -> None:
     """Refuse an output path that cannot be written, before anything is solved (ValueError).
 
-    A file's folder must exist and be writable (and the file, if it exists, be a writable
-    file); `output`, a folder, must be one or be creatable.
+    Each file is opened for writing once (and removed if it was not there): a folder that
+    exists but takes no file (/proc) is found now, not after the solve. A picture needs an
+    extension its writer knows. No output may be an input (`inputs`: the case file, its
+    mesh) or another output. `output`, a folder, is created now (and checked writable).
     """
-    for flag, path in (("--json", json), ("--png", png), ("--plot", plot)):
-        if path is None:
-            continue
+    files = [(f, p) for f, p in (("--json", json), ("--png", png), ("--plot", plot)) if p]
+    seen = {Path(p).resolve(): "input" for p in inputs}
+    for flag, path in files + ([("--output", output)] if output else []):
+        key = Path(path).resolve()
+        if key in seen:
+            raise ValueError(f"{flag} {path}: is also the {seen[key]}: it would be overwritten")
+        seen[key] = flag
+    for flag, path in files:
         target = Path(path)
-        folder = target.parent
         if target.is_dir():
             raise ValueError(f"{flag} {path}: is a folder, not a file")
-        if not folder.is_dir():
-            raise ValueError(f"{flag} {path}: the folder {folder} does not exist")
-        if not os.access(folder, os.W_OK) or (target.exists() and not os.access(target,
-                                                                               os.W_OK)):
-            raise ValueError(f"{flag} {path}: not writable")
+        if not target.parent.is_dir():
+            what = "is not a folder" if target.parent.exists() else "does not exist"
+            raise ValueError(f"{flag} {path}: {target.parent} {what}")
+        if flag in IMAGE_TYPES and target.suffix.lower() not in IMAGE_TYPES[flag]:
+            raise ValueError(f"{flag} {path}: the picture needs one of the extensions "
+                             f"{', '.join(IMAGE_TYPES[flag])}")
+        _try_writing(flag, target)
     if output is not None:
         target = Path(output)
         existing = next(p for p in (target, *target.parents) if p.exists())
         if not existing.is_dir():
             raise ValueError(f"--output {output}: {existing} is a file, not a folder")
-        if not os.access(existing, os.W_OK):
-            raise ValueError(f"--output {output}: {existing} is not writable")
+        try:
+            target.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise ValueError(f"--output {output}: cannot create it ({err.strerror})") from None
+        _try_writing("--output", target / ".fenics_nl_write_test")
+
+
+def _try_writing(flag: str, target: Path) -> None:
+    """Open `target` for appending on rank 0, removing it if it was not there (collective).
+
+    The answer is broadcast, so that every rank refuses together.
+    """
+    comm = MPI.COMM_WORLD
+    problem = None
+    if comm.rank == 0:
+        existed = target.exists()
+        try:
+            with open(target, "a"):
+                pass
+            if not existed:
+                target.unlink()
+        except OSError as err:
+            problem = f"{flag} {target}: not writable ({err.strerror})"
+    problem = comm.bcast(problem, root=0)
+    if problem:
+        raise ValueError(problem)
 
 
 def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
@@ -393,9 +442,29 @@ def _failed(run: _Run, err: BaseException, t0: float) -> int:
                "warnings": ["the run failed: the quantities are those of the last converged "
                             "step"] if run.steps else ["the run failed before any step "
                                                        "converged"]}
+        out.update(_totals(run.steps))
         _write_json(out, run.json_path)
         say(f"wrote {run.json_path} (status failed, {len(run.steps)} converged step(s))")
+    if run.steps and run.failure_writers is not None:
+        out = {**run.known, "steps": run.steps, "load_factor": run.steps[-1].get(
+            "load_factor"), **_totals(run.steps)}
+        for write in run.failure_writers(out):
+            try:  # each on its own, as after a run that succeeds
+                write()
+            except Exception as err:
+                error(f"writing an output failed: {_one_line(err)}")
     return 2
+
+
+def _totals(steps: list[dict]) -> dict:
+    """The totals a failed run can give: iterations summed, the last step's quantities."""
+    out = {}
+    if steps and all("newton_iterations" in s for s in steps):
+        out["newton_iterations"] = sum(s["newton_iterations"] for s in steps)
+    for key in ("probes", "reactions", "contact_force"):
+        if steps and key in steps[-1]:
+            out[key] = steps[-1][key]
+    return out
 
 
 def _write_json(out: dict, json_path: str | None) -> bool:
