@@ -507,6 +507,8 @@ def _finish(run: _Run, t0: float) -> int:
         return 2
     if not _write_json(out, run.json_path):
         status = 1
+    elif run.json_path:
+        say(f"wrote {run.json_path}")
     for write in writers:
         try:
             write()
