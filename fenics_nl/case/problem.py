@@ -25,6 +25,7 @@ from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, plane_stress
 from fenics_nl.materials import mixed as mixed_form
+from fenics_nl.materials.laws import von_mises_of
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult
@@ -203,17 +204,9 @@ class CaseProblem:
 
     def _flat_normal(self, c: Condition) -> tuple[int, int]:
         """The group's outward normal ±e_axis, or CaseError if it is not flat and aligned."""
-        comm = self.mesh.comm
-        n = ufl.FacetNormal(self.mesh)
-        f = np.sort(self.facets[c.group])
-        mt = dmesh.meshtags(self.mesh, self.mesh.topology.dim - 1, f,
-                            np.ones(len(f), dtype=np.int32))
-        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=mt)(1)
-        area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)))
+        area, mean = self.mean_normal(c.group)
         if area <= 0:
             raise CaseError([f"{c.key}: group {c.group!r} has no facet on the boundary"])
-        mean = np.array([comm.allreduce(fem.assemble_scalar(fem.form(n[i] * ds)))
-                         for i in range(self.case.dim)]) / area
         axis = int(np.argmax(np.abs(mean)))
         if abs(abs(mean[axis]) - 1) > 1e-8:
             raise CaseError([f"{c.key}: the contact group must be flat with its outward "
@@ -221,8 +214,11 @@ class CaseProblem:
                              f"; the active set constrains one displacement component"])
         return axis, int(np.sign(mean[axis]))
 
-    def mean_normal(self, group: str) -> np.ndarray:
-        """The mean outward normal of a group: ∫ n ds / ∫ ds (0 for a closed surface)."""
+    def mean_normal(self, group: str) -> tuple[float, np.ndarray]:
+        """(∫ ds, ∫ n ds / ∫ ds) of a group: its area and mean outward normal (collective).
+
+        The normal is 0 for a closed surface, and for a group with no area.
+        """
         comm = self.mesh.comm
         f = np.sort(self.facets[group])
         mt = dmesh.meshtags(self.mesh, self.mesh.topology.dim - 1, f,
@@ -230,8 +226,9 @@ class CaseProblem:
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=mt)(1)
         n = ufl.FacetNormal(self.mesh)
         area = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)))
-        return np.array([comm.allreduce(fem.assemble_scalar(fem.form(n[i] * ds)))
-                         for i in range(self.case.dim)]) / area
+        total = np.array([comm.allreduce(fem.assemble_scalar(fem.form(n[i] * ds)))
+                          for i in range(self.case.dim)])
+        return area, total / area if area > 0 else np.zeros(self.case.dim)
 
     def obstacle_at(self, t: float) -> dict:
         """The contact obstacle at load factor t (moved by t × its displacement)."""
@@ -387,15 +384,6 @@ class CaseProblem:
         sigma = self.probes.discontinuous("stress", stress, self.case.degree)
         return {p.name: {"displacement": d, "von_mises": s, "stress": t}
                 for p, d, s, t in zip(self.case.probes, u, vm, sigma, strict=True)}
-
-
-def von_mises_of(sigma):
-    """σ_eq = √(3/2) ‖dev σ‖ of a 3x3 stress, or of a 2x2 one embedded with σ_zz = 0."""
-    if sigma.ufl_shape[0] == 2:
-        sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0], [sigma[1, 0], sigma[1, 1], 0],
-                               [0, 0, 0]])
-    s = ufl.dev(sigma)
-    return ufl.sqrt(1.5 * ufl.inner(s, s))
 
 
 class ContactSteps:

@@ -293,7 +293,7 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                         facet_points(problem.mesh, problem.facets[c.group]),
                         t * np.asarray(c.value))
                 elif c.kind == "pressure" and c.value and t != 0:
-                    normal = problem.mean_normal(c.group)  # a closed surface has none
+                    _, normal = problem.mean_normal(c.group)  # a closed surface has none
                     if np.linalg.norm(normal) > 1e-6:
                         arrows[f"{c.group} (pressure)"] = (
                             facet_points(problem.mesh, problem.facets[c.group]),

@@ -433,21 +433,18 @@ def _failed(run: _Run, err: BaseException, t0: float) -> int:
     message = _one_line(err)
     error(message)
     _forget(run.options)
+    last = next((s["load_factor"] for s in reversed(run.steps) if "load_factor" in s), None)
+    out = {**run.known, "status": "failed", "message": message,
+           "converged_steps": len(run.steps), "load_factor": last, "steps": run.steps,
+           "ranks": MPI.COMM_WORLD.size, "wall_time_s": time.perf_counter() - t0,
+           "warnings": ["the run failed: the quantities are those of the last converged "
+                        "step"] if run.steps else ["the run failed before any step "
+                                                   "converged"], **_totals(run.steps)}
     if (isinstance(err, SolveError) or run.steps) and run.json_path:
-        last = next((s["load_factor"] for s in reversed(run.steps) if "load_factor" in s),
-                    None)
-        out = {**run.known, "status": "failed", "message": message,
-               "converged_steps": len(run.steps), "load_factor": last, "steps": run.steps,
-               "ranks": MPI.COMM_WORLD.size, "wall_time_s": time.perf_counter() - t0,
-               "warnings": ["the run failed: the quantities are those of the last converged "
-                            "step"] if run.steps else ["the run failed before any step "
-                                                       "converged"]}
-        out.update(_totals(run.steps))
-        _write_json(out, run.json_path)
-        say(f"wrote {run.json_path} (status failed, {len(run.steps)} converged step(s))")
+        text = _encode(out)
+        if text is not None and _write_json(text, run.json_path):
+            say(f"wrote {run.json_path} (status failed, {len(run.steps)} converged step(s))")
     if run.steps and run.failure_writers is not None:
-        out = {**run.known, "steps": run.steps, "load_factor": run.steps[-1].get(
-            "load_factor"), **_totals(run.steps)}
         for write in run.failure_writers(out):
             try:  # each on its own, as after a run that succeeds
                 write()
@@ -467,16 +464,20 @@ def _totals(steps: list[dict]) -> dict:
     return out
 
 
-def _write_json(out: dict, json_path: str | None) -> bool:
-    """`out` as JSON at `json_path` (rank 0); False, said in one line, if it cannot be.
+def _encode(out: dict) -> str | None:
+    """`out` as JSON text; None, said in one line, if a result is not a finite number.
 
-    Collective: every rank encodes it, so that every rank stops here together.
+    On every rank, so that every rank takes the same way out.
     """
     try:
-        text = json.dumps(out, indent=2, allow_nan=False)
+        return json.dumps(out, indent=2, allow_nan=False)
     except ValueError:  # a NaN among the results: a defect, never a silent answer
         error("a result is not a finite number: no output written")
-        return False
+        return None
+
+
+def _write_json(text: str, json_path: str | None) -> bool:
+    """The JSON `text` at `json_path` (rank 0); False, said in one line, if it cannot be."""
     if json_path and MPI.COMM_WORLD.rank == 0:
         try:
             Path(json_path).write_text(text)
@@ -499,13 +500,11 @@ def _finish(run: _Run, t0: float) -> int:
     for w in out["warnings"]:
         say(f"warning: {w}")
     status = 0
-    try:
-        json.dumps(out, allow_nan=False)
-    except ValueError:  # a NaN among the results: a defect, never a silent answer
-        error("a result is not a finite number: no output written")
+    text = _encode(out)
+    if text is None:
         _forget(options)
         return 2
-    if not _write_json(out, run.json_path):
+    if not _write_json(text, run.json_path):
         status = 1
     elif run.json_path:
         say(f"wrote {run.json_path}")

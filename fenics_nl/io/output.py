@@ -46,22 +46,22 @@ class FieldSeries:
     itself while it grows, and still increasing when the path comes back (an unloading), as
     ParaView needs. `functions()` gives the fields of the current state (new Function
     objects each call are fine: their values are copied into the series' own). Each file is
-    written at every step. Collective; `close()` at the end, or use it as a context manager.
+    written at every step. Collective; `close()` at the end.
     """
 
-    def __init__(self, folder: str | Path, functions=None):
-        self.folder, self.functions = Path(folder), functions
+    def __init__(self, folder: str | Path):
+        self.folder = Path(folder)
         self._series: dict[str, tuple] = {}  # name -> (writer, its own copy of the field)
         self.times: list[float] = []
         self._last = 0.0  # the last load factor
 
-    def write(self, t: float, functions=None) -> None:
-        """Every field of the current state (`functions()`, or the series' own), at t."""
+    def write(self, t: float, functions) -> None:
+        """Every field of the current state, `functions()`, at load factor t."""
         from dolfinx.io import VTXWriter
 
         tau = (self.times[-1] if self.times else 0.0) + abs(t - self._last)
         self._last = t
-        for f in (functions or self.functions)():
+        for f in functions():
             if f.name not in self._series:
                 self.folder.mkdir(parents=True, exist_ok=True)
                 copy = fem.Function(f.function_space, name=f.name)
@@ -83,12 +83,6 @@ class FieldSeries:
         for writer, _ in self._series.values():
             writer.close()
         self._series.clear()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 @dataclass

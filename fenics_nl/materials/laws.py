@@ -85,6 +85,15 @@ class Isotropic:
             raise ValueError(f"{type(self).__name__} does not support the plane-stress model")
 
 
+def von_mises_of(sigma):
+    """σ_eq = √(3/2) ‖dev σ‖ of a 3x3 stress, or of a 2x2 one embedded with σ_zz = 0 (UFL)."""
+    if sigma.ufl_shape[0] == 2:
+        sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0],
+                               [sigma[1, 0], sigma[1, 1], 0], [0, 0, 0]])
+    s = ufl.dev(sigma)
+    return ufl.sqrt(1.5 * ufl.inner(s, s))
+
+
 class Material(ABC):
     """A material law: a free energy, and the internal virtual work derived from it.
 
@@ -128,12 +137,7 @@ class Material(ABC):
 
         Plane stress: σ is embedded in 3D with σ_zz = 0 (the deviator is the 3D one).
         """
-        sigma = self.cauchy_stress(u, model)
-        if sigma.ufl_shape[0] == 2:
-            sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0],
-                                   [sigma[1, 0], sigma[1, 1], 0], [0, 0, 0]])
-        s = ufl.dev(sigma)
-        return ufl.sqrt(1.5 * ufl.inner(s, s))
+        return von_mises_of(self.cauchy_stress(u, model))
 
     def von_mises(self, u, model: str = "3d"):
         """σ_eq of the displacement `u`, one value per cell (DG0 Function, at the centroid)."""

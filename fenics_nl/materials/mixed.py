@@ -30,6 +30,7 @@ import ufl
 from dolfinx import fem
 
 from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import von_mises_of
 
 
 def collapsed(V: fem.FunctionSpace):
@@ -93,8 +94,7 @@ def cauchy_stress(material, u, p, model: str = "3d"):
 
 def von_mises_expression(material, u, p, model: str = "3d"):
     """σ_eq = √(3/2) ‖dev σ‖ of the mixed state (UFL)."""
-    s = ufl.dev(cauchy_stress(material, u, p, model))
-    return ufl.sqrt(1.5 * ufl.inner(s, s))
+    return von_mises_of(cauchy_stress(material, u, p, model))
 
 
 def von_mises(material, u, p, model: str, mesh) -> fem.Function:

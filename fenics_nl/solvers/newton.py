@@ -245,9 +245,10 @@ class NewtonSolver:
         force_scale: a force of the problem (the load); default the largest ‖R₀‖ seen.
         max_it: iterations before ConvergenceError.
         divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ stops with ConvergenceError.
-        line_search: backtracking (halving, at most 10 times): True (or ``residual``) until
-            ‖R‖ falls; ``slope`` also stops once the energy's slope along the step fell to
-            half (for a smooth energy: a hyperelastic law; see `_step`).
+        line_search: True (or ``residual``): backtracking (halving, at most 10 times) until
+            ‖R‖ falls; ``slope``: the full step if ‖R‖ fell, else secant steps to the
+            energy's minimum along the step (for a minimised smooth energy, a hyperelastic
+            law: see `_step`).
         bfgs_memory: pairs kept by ``bfgs``.
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
