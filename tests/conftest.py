@@ -156,3 +156,41 @@ def read_series(path, name):
             times.append(float(np.ravel(f.read("step"))[0]))
             values.append(np.asarray(f.read(name)))
     return times, values
+
+
+def taylor_remainders(residual, w, scale: float, seed: int,
+                      steps=(1e-2, 5e-3, 2.5e-3, 1.25e-3)):
+    """(‖R(w + h dw) − R(w) − h K dw‖ for each h, their slopes) along a random dw.
+
+    dw = `scale` × standard normal entries; K = UFL's derivative of the residual form. A
+    consistent tangent gives slope 2. `w` is left at its value on entry plus the last h dw.
+    """
+    import numpy as np
+    import ufl
+    from dolfinx import fem
+    from dolfinx.fem import petsc
+
+    rng = np.random.default_rng(seed)
+    w0 = w.x.array.copy()
+    dw = fem.Function(w.function_space)
+    dw.x.array[:] = scale * rng.standard_normal(dw.x.array.size)
+    R, K = fem.form(residual), fem.form(ufl.derivative(residual, w))
+
+    def residual_at(h):
+        w.x.array[:] = w0 + h * dw.x.array
+        b = petsc.assemble_vector(R)
+        b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
+        return b
+
+    r0 = residual_at(0.0)
+    A = petsc.assemble_matrix(K)
+    A.assemble()
+    Kdw = r0.duplicate()
+    A.mult(dw.x.petsc_vec, Kdw)
+    errs = []
+    for h in steps:
+        rh = residual_at(h)
+        rh.axpy(-1.0, r0)
+        rh.axpy(-h, Kdw)
+        errs.append(rh.norm())
+    return errs, np.diff(np.log(errs)) / np.diff(np.log(steps))

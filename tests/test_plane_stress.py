@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 import ufl
+from conftest import taylor_remainders
 from dolfinx import fem, mesh
-from dolfinx.fem import petsc
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
@@ -168,32 +168,7 @@ def test_consistent_tangent_taylor_slope_two_in_the_plastic_regime():
     sheet.go([1.2 * S0])  # committed plastic state
     sheet.t.value = 1.6 * S0  # and a plastic step from it (inside the plastic zone: f > 0)
     sheet.solver.solve()
-    w = sheet.w.w
-    rng = np.random.default_rng(3)
-    w0 = w.x.array.copy()
-    dw = fem.Function(w.function_space)
-    dw.x.array[:] = 1e-3 * rng.standard_normal(dw.x.array.size)
-    R, K = fem.form(sheet.residual), fem.form(ufl.derivative(sheet.residual, w))
-
-    def residual_at(h):
-        w.x.array[:] = w0 + h * dw.x.array
-        b = petsc.assemble_vector(R)
-        b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
-        return b
-
-    r0 = residual_at(0.0)
-    A = petsc.assemble_matrix(K)
-    A.assemble()
-    Kdw = r0.duplicate()
-    A.mult(dw.x.petsc_vec, Kdw)
-    hs = [1e-2, 5e-3, 2.5e-3, 1.25e-3]
-    errs = []
-    for h in hs:
-        rh = residual_at(h)
-        rh.axpy(-1.0, r0)
-        rh.axpy(-h, Kdw)
-        errs.append(rh.norm())
-    slopes = np.diff(np.log(errs)) / np.diff(np.log(hs))
+    errs, slopes = taylor_remainders(sheet.residual, sheet.w.w, 1e-3, seed=3)
     assert np.all(slopes > 1.9), (errs, slopes)
 
 

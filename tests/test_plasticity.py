@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 import ufl
+from conftest import taylor_remainders
 from dolfinx import fem, mesh
-from dolfinx.fem import petsc
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
@@ -122,28 +122,5 @@ def test_consistent_tangent_taylor_slope_two_in_the_plastic_regime():
     bar.go([1.5 * EPS_Y, 3.0 * EPS_Y])  # committed plastic state
     bar.pull.g.x.array[:] = 4.0 * EPS_Y  # and a plastic step from it
     bar.solver.solve()
-    rng = np.random.default_rng(1)
-    u0 = bar.u.x.array.copy()
-    du = fem.Function(bar.u.function_space)
-    du.x.array[:] = EPS_Y * 0.05 * rng.standard_normal(du.x.array.size)
-    R, K = fem.form(bar.residual), fem.form(ufl.derivative(bar.residual, bar.u))
-
-    def residual_at(h):
-        bar.u.x.array[:] = u0 + h * du.x.array
-        b = petsc.assemble_vector(R)
-        b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
-        return b
-
-    r0 = residual_at(0.0)
-    A = petsc.assemble_matrix(K)
-    A.assemble()
-    Kdu = r0.duplicate()
-    A.mult(du.x.petsc_vec, Kdu)
-    errs = []
-    for h in (1e-2, 5e-3, 2.5e-3, 1.25e-3):
-        rh = residual_at(h)
-        rh.axpy(-1.0, r0)
-        rh.axpy(-h, Kdu)
-        errs.append(rh.norm())
-    slopes = np.diff(np.log(errs)) / np.diff(np.log([1e-2, 5e-3, 2.5e-3, 1.25e-3]))
+    errs, slopes = taylor_remainders(bar.residual, bar.u, EPS_Y * 0.05, seed=1)
     assert np.all(slopes > 1.9), (errs, slopes)
