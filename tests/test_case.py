@@ -635,6 +635,27 @@ def test_a_killed_run_on_two_ranks_restarts_to_the_same_answer(tmp_path, demo):
     assert proc.returncode == 2 and "its ranks is 2, this run's 1" in proc.stderr
 
 
+def test_a_killed_arc_length_run_restarts_on_the_same_path(tmp_path, demo):
+    # killed while a limit point is being bracketed (the arc halved, the walk's inertia, sense
+    # and last increment in the checkpoint): the restart meets the same critical points and
+    # takes the same steps, through the snap to the target
+    import sys
+
+    for name in ("shallow_arch.toml", "shallow_arch.geo"):
+        (tmp_path / name).write_text((CASES / name).read_text())
+    case = tmp_path / "shallow_arch.toml"
+    whole = demo.case(case)
+    run_and_kill([sys.executable, "-m", "fenics_nl", "run", case, "--checkpoint", "ck"],
+                 tmp_path, "load factor 0.2752:")
+    latest = json.loads((tmp_path / "ck" / "latest.json").read_text())["step"]
+    assert 3 <= int(latest.split("-")[1]) < len(whole["steps"]) // 2
+    resumed = demo.case(case, "--restart", tmp_path / "ck")
+    same_answer(whole, resumed)
+    assert resumed["critical_points"] == whole["critical_points"]
+    assert [s["negative_eigenvalues"] for s in resumed["steps"]] == [
+        s["negative_eigenvalues"] for s in whole["steps"]]
+
+
 # -- J2 in plane stress ------------------------------------------------------------------
 
 PLATE_GEO = """// quarter of a plate with a central hole: halves W, H; hole radius a

@@ -3,7 +3,8 @@
 After a converged step: the unknown (with the pressure of the mixed form), the internal
 variables at the quadrature points (J2's plastic strain and cumulated plastic strain), the
 contact's active set, the load-step driver's increments and predictor state, the segment of
-the load path, the step records of the JSON, the work counted so far, and Newton's force
+the load path (or, under arc-length control, the continuation's `ArcState`), the step
+records of the JSON, the work counted so far, and Newton's force
 reference. The identity is the case file's content (its hash), the ranks and the unknowns;
 each rank adds the size and a hash of its dof coordinates, so a restart needs the same case,
 the same mesh and the same partition (`io.checkpoint` says why).
@@ -17,6 +18,7 @@ import hashlib
 import numpy as np
 
 from fenics_nl.io.checkpoint import CheckpointError, Checkpoints, fingerprint
+from fenics_nl.solvers.arclength import ArcState
 from fenics_nl.solvers.loading import DriverState
 from fenics_nl.solvers.result import WorkCounts
 
@@ -28,7 +30,8 @@ class Resumed:
     segment: int  # index of the load segment (0 for equal steps)
     driver: DriverState | None  # None: the segment was complete, start the next one
     steps: list[dict]
-    work: WorkCounts
+    work: WorkCounts  # of the load-controlled segments (an arc's is in its state's path)
+    arc: ArcState | None = None  # under arc-length control: where the path goes on from
 
 
 class CaseCheckpoints:
@@ -66,16 +69,23 @@ class CaseCheckpoints:
     def save(self, segment: int, driver: DriverState, steps: list[dict],
              work: WorkCounts) -> None:
         """The state after the converged step that ended with `driver` (collective)."""
-        arrays = {k: f.x.array for k, f in self._functions().items()}
-        if driver.previous is not None:
-            arrays["previous"] = driver.previous
+        arrays = {} if driver.previous is None else {"previous": driver.previous}
+        self._save({"segment": segment, "t": driver.t, "dt": driver.dt,
+                    "dt_previous": driver.dt_previous,
+                    "has_previous": driver.previous is not None,
+                    "work": dataclasses.asdict(work)}, arrays, steps)
+
+    def save_arc(self, arc: ArcState, steps: list[dict]) -> None:
+        """The state after a converged step of arc-length control (collective)."""
+        self._save({"arc": arc.scalars()}, arc.arrays(), steps)
+
+    def _save(self, state: dict, arrays: dict, steps: list[dict]) -> None:
+        """`state` and `arrays` with the unknown, the internal variables, the contact's."""
+        arrays.update({k: f.x.array for k, f in self._functions().items()})
         if self.problem.contact is not None:
             arrays["active"] = self.problem.solver.contact.active.astype(np.uint8)
         newton = self._newton()
-        state = {"segment": segment, "t": driver.t, "dt": driver.dt,
-                 "dt_previous": driver.dt_previous, "has_previous": driver.previous is not None,
-                 "steps": steps, "work": dataclasses.asdict(work),
-                 "force_reference": newton.force_reference if newton else None}
+        state.update(steps=steps, force_reference=newton.force_reference if newton else None)
         self.store.save(len(steps), state, arrays, self.local)
 
     # -- what a restart reads ----------------------------------------------------------
@@ -94,6 +104,9 @@ class CaseCheckpoints:
         newton = self._newton()
         if newton is not None and state["force_reference"] is not None:
             newton.force_reference = state["force_reference"]
+        if "arc" in state:
+            return Resumed(0, None, state["steps"], WorkCounts(),
+                           ArcState.saved(state["arc"], arrays))
         driver = DriverState(state["t"], state["dt"], state["dt_previous"],
                              arrays["previous"] if state["has_previous"] else None)
         work = WorkCounts(**state["work"])

@@ -14,7 +14,7 @@ from fenics_nl.case.resume import CaseCheckpoints, Resumed
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
-from fenics_nl.solvers.arclength import ArcLength
+from fenics_nl.solvers.arclength import ArcLength, ArcState
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
@@ -34,9 +34,6 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     t0 = time.perf_counter()
     solver = problem.make_solver()
     setup = time.perf_counter() - t0
-    if (checkpoint or restart) and problem.case.arc is not None:
-        raise ValueError("--checkpoint and --restart take load control: arc-length control "
-                         "has no checkpoint yet")
     saving = CaseCheckpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
     resumed = CaseCheckpoints(problem, restart).restore() if restart else None
     if resumed is not None:
@@ -100,7 +97,8 @@ def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
 
     critical = None
     if case.arc is not None:  # the load factor is an unknown: through limit points
-        critical = _follow_path(problem, solver, converged, steps, work, commit, show)
+        critical = _follow_path(problem, solver, converged, steps, work, commit, show,
+                                saving, resumed.arc if resumed else None)
     elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
         if first == 0:
@@ -176,8 +174,12 @@ def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[di
 
 
 def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
-                 work: WorkCounts, commit, show) -> list[dict]:
-    """`loading.control = "arc-length"`: the path to the target; its critical points."""
+                 work: WorkCounts, commit, show, saving: CaseCheckpoints | None,
+                 resume: ArcState | None) -> list[dict]:
+    """`loading.control = "arc-length"`: the path to the target; its critical points.
+
+    `saving`: checkpoints of the continuation's state; `resume`: the state to go on from.
+    """
     arc = problem.case.arc
     mixed = problem.mixed
     continuation = ArcLength(
@@ -185,7 +187,12 @@ def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
         max_arc_length=arc["max_arc_length"], commit=commit, prefix="case_continuation_",
         metric_dofs=mixed.displacement_dofs if mixed else None,
         multipliers=mixed.pressure_dofs if mixed else 0)
-    path = continuation.run(arc["target"], arc["max_steps"], progress=show, on_step=converged)
+    on_state = None
+    if saving is not None:
+        def on_state(state):
+            saving.save_arc(state, steps)
+    path = continuation.run(arc["target"], arc["max_steps"], progress=show, on_step=converged,
+                            resume=resume, on_state=on_state)
     work.add(path.work)
     for record, negative in zip(steps, path.unstable, strict=True):
         record["negative_eigenvalues"] = negative  # of the tangent: 0 where stable

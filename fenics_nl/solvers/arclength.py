@@ -34,6 +34,7 @@ path had. Without `detect`, limit points are where Δλ changes sign between ste
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -176,6 +177,77 @@ class _Step:
     leave: bool  # ... to be left along its mode
     tangent: PETSc.Vec | None = None  # K⁻¹q at its end (with `detect`)
     landed: bool = False  # it ends on the target
+
+
+@dataclass
+class ArcState:
+    """Where an arc-length path stands after a converged step: enough to go on exactly.
+
+    The walk (λ, the next arc, the tangent's inertia and sense there, the last increment, a
+    critical point being bracketed), the method's scales (u_ref, the round-off scale), and
+    the path so far. A checkpoint saves it (`scalars()` as JSON, `arrays()` per rank: a
+    restart needs the same partition); `ArcLength.run(resume=...)` goes on from it, with
+    u back in the solver.
+    """
+
+    lam: float
+    ds: float
+    count: int
+    sense: float
+    start: float  # λ where the path began
+    sense0: float  # the first step's sense of λ
+    scale: float | None  # 1/u_ref²
+    largest: float
+    last_dlam: float | None
+    previous_dlam: float | None  # with previous_du: the last step's (Δu, Δλ)
+    bracket: tuple[float, float, int] | None
+    path: dict  # ContinuationPath's record (`_path_record`)
+    previous_du: np.ndarray | None = None
+    tangent: np.ndarray | None = None
+    kick: np.ndarray | None = None
+
+    VECTORS = ("previous_du", "tangent", "kick")
+
+    def scalars(self) -> dict:
+        """Everything but the vectors, JSON-able."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
+                if f.name not in self.VECTORS}
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """This rank's vectors (those the walk has)."""
+        return {k: getattr(self, k) for k in self.VECTORS if getattr(self, k) is not None}
+
+    @classmethod
+    def saved(cls, scalars: dict, arrays: dict[str, np.ndarray]) -> ArcState:
+        """The state from `scalars()` and `arrays()` read back."""
+        bracket = scalars["bracket"]
+        return cls(**{**scalars, "bracket": tuple(bracket) if bracket else None},
+                   **{k: arrays.get(k) for k in cls.VECTORS})
+
+
+def _path_record(path: ContinuationPath) -> dict:
+    """What a restart needs of the path so far (its steps' iterations, not their norms)."""
+    return {"factors": path.factors, "iterations": [r.iterations for r in path.results],
+            "arc_lengths": path.arc_lengths, "unstable": path.unstable,
+            "critical_points": [dataclasses.asdict(c) for c in path.critical_points],
+            "switched": path.switched, "failures": path.failures,
+            "bracketing_steps": path.bracketing_steps,
+            "inertia_factorizations": path.inertia_factorizations,
+            "work": dataclasses.asdict(path.work)}
+
+
+def _path_from(record: dict) -> ContinuationPath:
+    return ContinuationPath(
+        factors=list(record["factors"]),
+        results=[SolveResult(True, "converged (before the restart)", its, [], WorkCounts())
+                 for its in record["iterations"]],
+        arc_lengths=list(record["arc_lengths"]), unstable=list(record["unstable"]),
+        critical_points=[CriticalPoint(c["kind"], c["factor"], c["step"], tuple(c["between"]))
+                         for c in record["critical_points"]],
+        switched=record["switched"], failures=record["failures"],
+        bracketing_steps=record["bracketing_steps"],
+        inertia_factorizations=record["inertia_factorizations"],
+        work=WorkCounts(**record["work"]))
 
 
 class ArcLength:
@@ -433,13 +505,18 @@ class ArcLength:
 
     def run(self, target: float, max_steps: int = 100, *, start: float = 0.0,
             on_step: Callable[[float, SolveResult], None] | None = None,
-            progress: Callable[[str], None] | None = None) -> ContinuationPath:
+            progress: Callable[[str], None] | None = None,
+            resume: ArcState | None = None,
+            on_state: Callable[[ArcState], None] | None = None) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
 
         The step that crosses it is then solved at λ = target exactly (Newton at fixed λ,
         from the nearer of its two ends). ContinuationError if the target is not crossed
         within `max_steps` converged steps, or if the arc is cut below its minimum (a step
         that does not converge, or turns back onto the path it came along).
+        `on_state(state)` after each converged step but the last, with what a restart
+        needs; `resume`: go on from such a state (u, and the internal variables, back in
+        place): the path then takes the steps the uninterrupted run would have taken.
         """
         if not math.isfinite(target) or target == start:
             raise ValueError(f"target load factor must be finite and differ from the start "
@@ -447,18 +524,22 @@ class ArcLength:
         if max_steps < 1:
             raise ValueError(f"max_steps must be >= 1, got {max_steps}")
         say = progress or (lambda message: None)
-        path = ContinuationPath()
-        self.set_load(start)
-        self._largest = 0.0
-        self._sense0 = math.copysign(1.0, target - start)  # the first step heads for it
         if self.metric_dofs is not None:
             x = self.solver.u.x.petsc_vec
             self._weights = x.duplicate()
             self._weights.set(0.0)
             self._weights.array[self.metric_dofs[self.metric_dofs < x.getLocalSize()]] = 1.0
-        count = self._stability(path)[0] if self.detect else 0
-        sense = self._sense0
-        walk = _Walk(start, self.arc_length, self.solver.u.x.petsc_vec.copy(), count, sense)
+        if resume is None:
+            path = ContinuationPath()
+            self.set_load(start)
+            self._largest = 0.0
+            self._sense0 = math.copysign(1.0, target - start)  # the first step heads for it
+            count = self._stability(path)[0] if self.detect else 0
+            walk = _Walk(start, self.arc_length, self.solver.u.x.petsc_vec.copy(), count,
+                         self._sense0)
+        else:
+            path, walk, start = _path_from(resume.path), self._walk_from(resume), resume.start
+            self.set_load(walk.lam)
         try:
             while len(path.factors) < max_steps:
                 step = self._attempt(walk, path, target, say)
@@ -470,6 +551,8 @@ class ArcLength:
                 if step.landed:
                     return path
                 self._next_arc(walk, step)
+                if on_state:
+                    on_state(self._state_of(walk, path, start))
         finally:
             walk.destroy()
             for v in (self._q, self._weights):
@@ -478,6 +561,35 @@ class ArcLength:
             self._q = self._weights = None
         raise ContinuationError(f"load factor {target:g} not reached in {max_steps} steps "
                                 f"(the path is at λ = {walk.lam:.6g})", reached=walk.lam)
+
+    def _state_of(self, walk: _Walk, path: ContinuationPath, start: float) -> ArcState:
+        """The walk after a converged step, and the path so far, as a restart needs them."""
+        b = walk.bracket
+        return ArcState(
+            walk.lam, walk.ds, walk.count, walk.sense, start, self._sense0, self._scale,
+            self._largest, walk.last_dlam, walk.previous[1] if walk.previous else None,
+            (b.short, b.arc, b.since) if b else None, _path_record(path),
+            walk.previous[0].array.copy() if walk.previous else None,
+            walk.tangent.array.copy() if walk.tangent is not None else None,
+            walk.kick.array.copy() if walk.kick is not None else None)
+
+    def _walk_from(self, state: ArcState) -> _Walk:
+        """The walk of a saved state; u is the solver's (restored by the caller)."""
+        x = self.solver.u.x.petsc_vec
+        self._sense0, self._scale, self._largest = state.sense0, state.scale, state.largest
+
+        def vector(values):
+            if values is None:
+                return None
+            v = x.duplicate()
+            v.array[:] = values
+            return v
+
+        previous = (None if state.previous_du is None else
+                    (vector(state.previous_du), state.previous_dlam))
+        return _Walk(state.lam, state.ds, x.copy(), state.count, state.sense, previous,
+                     state.last_dlam, vector(state.kick), vector(state.tangent),
+                     _Bracket(*state.bracket) if state.bracket else None)
 
     def _attempt(self, walk: _Walk, path: ContinuationPath, target: float, say
                  ) -> _Step | None:
