@@ -122,6 +122,7 @@ def parser():
                     png="deformed bracket coloured by von Mises stress (j2: by the cumulated "
                         "plastic strain), load and supports drawn",
                     plot="load against load-point displacement")
+    cli.add_checkpoints(p)
     return p
 
 
@@ -146,6 +147,9 @@ if args.friction is not None and args.support != "contact":
     p.error("--friction acts between the base and the floor: add --support contact")
 if args.unload and args.compare:
     p.error("--unload goes with one --newton, not --compare")
+if (args.checkpoint or args.restart) and (args.compare or args.friction is not None):
+    p.error("--checkpoint and --restart go with one --newton and no --friction (the slip "
+            "history of the floor is not saved yet)")
 if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
     p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
             f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
@@ -244,6 +248,16 @@ def solve(newton):
             f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
 
     total = 2 * args.steps if args.unload else args.steps
+    # --restart: the checkpoint's displacement, plastic state, floor contact and steps back;
+    # --checkpoint: saved after each converged step of the loading
+    contact = b.solver if args.support == "contact" else None
+    newton = contact.system.newton if contact else b.solver
+    checkpoints = cli.checkpointing(
+        {"unknown": part.unknown, **(material.state_functions() if plastic else {})},
+        newton=newton if newton is not b.solver or args.newton != "snes" else None,
+        contact=contact)
+    steps += [{k: v for k, v in s.items() if k != "load_factor"} for s in checkpoints.steps]
+
     def commit():  # a converged step's state: plastic strains, the floor's slip history
         if plastic:
             material.commit(u)
@@ -252,7 +266,8 @@ def solve(newton):
     t0 = time.perf_counter()
     try:
         solve_incrementally(b.solver, lambda t: b.set_load(t * args.force), args.steps,
-                            adaptive=False, predictor=False, on_step=record, commit=commit)
+                            adaptive=False, predictor=False, on_step=record, commit=commit,
+                            **checkpoints.options)
         if args.unload:
             solve_incrementally(b.solver, lambda t: b.set_load((1 - t) * args.force),
                                 args.steps, adaptive=False, predictor=False, on_step=record,

@@ -97,6 +97,7 @@ def parser():
                         "isochoric plastic flow on coarse meshes; ν = 0.5 allowed")
     cli.add_outputs(p, png="the deformed quarter coloured by the cumulated plastic strain",
                     plot="pressure against inner displacement, with the closed forms")
+    cli.add_checkpoints(p)
     return p
 
 
@@ -240,10 +241,18 @@ else:
     def load(t):
         body.move_inner(t * target)
 
+# a restart (--restart) puts the checkpoint's state back: the displacement, the plastic
+# state, the steps so far; --checkpoint saves it after each converged step of the loading
+# (a run killed while it unloads restarts from the peak: the unloading is redone)
+checkpoints = cli.checkpointing({"unknown": u, **material.state_functions()},
+                                newton=solver if args.newton != "snes" else None)
+for step in checkpoints.steps:
+    path.append((step["pressure"], step["inner_displacement"]))
+    step_iterations.append(step["newton_iterations"])
 t0 = time.perf_counter()
 try:
     run = solve_incrementally(solver, load, args.steps, max_step=1.0 / args.steps,
-                              on_step=record, commit=commit)
+                              on_step=record, commit=commit, **checkpoints.options)
 except LoadStepError as err:
     last = path[-1][0]
     if control == "pressure" and target >= p_lim:

@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -72,15 +71,7 @@ def main(argv=None) -> int:
             pass
         cli.check_output_paths(json=args.json, png=args.png, plot=args.plot,
                                output=args.output, inputs=inputs)
-        if args.restart and args.output and any(Path(args.output).glob("*.bp")):
-            # VTX files are rewritten, not appended to: the first run's fields would be lost
-            p.error(f"--output {args.output} holds fields already (the interrupted run's?): "
-                    "a restart writes its own series, give it another folder")
-        if args.checkpoint:
-            try:
-                cli.check_output_paths(output=args.checkpoint)
-            except ValueError as err:
-                p.error(str(err).replace("--output", "--checkpoint", 1))
+        cli.check_restart_paths(args.checkpoint, args.restart, args.output)
     except ValueError as err:
         p.error(str(err))
     t0 = time.perf_counter()

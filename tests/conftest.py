@@ -17,6 +17,8 @@ import fenics_nl  # noqa: F401
 import itertools
 import json
 import math
+import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -194,3 +196,38 @@ def taylor_remainders(residual, w, scale: float, seed: int,
         rh.axpy(-h, Kdw)
         errs.append(rh.norm())
     return errs, np.diff(np.log(errs)) / np.diff(np.log(steps))
+
+
+# -- killed runs and their restarts ------------------------------------------------------
+
+def run_and_kill(cmd, cwd, after_line: str, ranks=1):
+    """Start `cmd`, SIGKILL it (and its ranks) once its stdout shows `after_line`."""
+    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    for line in proc.stdout:
+        if line.startswith(after_line):
+            os.killpg(proc.pid, signal.SIGKILL)
+            break
+    proc.wait(timeout=600)
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.read()
+
+
+def same_answer(a, b, rel=1e-10):
+    """Every step's load factor, iterations, probes and reactions agree (to `rel` of the
+    largest value): the restart took the same path (predictor, force reference, statuses)."""
+    for key in ("load_factor", "newton_iterations", "active_set_iterations"):
+        assert [s.get(key) for s in a["steps"]] == [s.get(key) for s in b["steps"]], key
+    import numpy as np
+
+    for sa, sb in zip(a["steps"], b["steps"], strict=True):
+        for key in ("probes", "reactions"):
+            x, y = np.array(flatten(sa[key])), np.array(flatten(sb[key]))
+            assert np.abs(x - y).max() <= rel * np.abs(x).max(), key
+
+
+def flatten(x):
+    if isinstance(x, dict):
+        return [v for k in sorted(x) for v in flatten(x[k])]
+    if isinstance(x, list):
+        return [v for item in x for v in flatten(item)]
+    return [float(x)]

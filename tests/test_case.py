@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import read_series
+from conftest import read_series, run_and_kill, same_answer
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
@@ -540,41 +540,6 @@ def j2_path_case(tmp_path, steps=20):
                                                                  "pressure = 75.0")
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
     return write(tmp_path, "path.toml", text)
-
-
-def run_and_kill(cmd, cwd, after_line: str, ranks=1):
-    """Start `cmd`, SIGKILL it (and its ranks) once its stdout shows `after_line`."""
-    import os
-    import signal
-    import subprocess
-
-    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
-    for line in proc.stdout:
-        if line.startswith(after_line):
-            os.killpg(proc.pid, signal.SIGKILL)
-            break
-    proc.wait(timeout=600)
-    assert proc.returncode == -signal.SIGKILL, proc.stderr.read()
-
-
-def same_answer(a, b, rel=1e-10):
-    """Every step's load factor, iterations, probes and reactions agree (to `rel` of the
-    largest value): the restart took the same path (predictor, force reference, statuses)."""
-    for key in ("load_factor", "newton_iterations", "active_set_iterations"):
-        assert [s.get(key) for s in a["steps"]] == [s.get(key) for s in b["steps"]], key
-    for sa, sb in zip(a["steps"], b["steps"], strict=True):
-        for key in ("probes", "reactions"):
-            x, y = np.array(flatten(sa[key])), np.array(flatten(sb[key]))
-            assert np.abs(x - y).max() <= rel * np.abs(x).max(), key
-
-
-def flatten(x):
-    if isinstance(x, dict):
-        return [v for k in sorted(x) for v in flatten(x[k])]
-    if isinstance(x, list):
-        return [v for item in x for v in flatten(item)]
-    return [float(x)]
 
 
 def test_a_killed_run_restarts_from_its_checkpoint_to_the_same_answer(tmp_path, demo):

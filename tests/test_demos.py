@@ -495,6 +495,24 @@ def test_bracket_j2_loaded_and_unloaded(demo):
     assert d["max_cumulated_plastic_strain"] > 0 and 0 < d["plastic_volume_fraction"] < 1
 
 
+def test_a_bracket_on_the_floor_in_j2_restarts_on_the_same_path(tmp_path, demo):
+    # the plastic state, the floor's active set and the steps so far come back: restarted
+    # one saved step short of the loading's end, the same JSON key by key (times aside)
+    import json
+
+    from test_vessel import same_run
+
+    args = ["--material", "j2", "--support", "contact", "--size", "20", "--steps", "3"]
+    whole = demo.bracket(*args, "--checkpoint", tmp_path / "ck")
+    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": "step-000002"}))
+    resumed = demo.bracket(*args, "--restart", tmp_path / "ck")
+    assert len(resumed["steps"]) == 3
+    same_run(whole, resumed)
+    proc = demo.run(["bracket.py", *args, "--friction", "0.3", "--restart", tmp_path / "ck"],
+                    check=False)
+    assert proc.returncode == 2 and "no --friction" in proc.stderr
+
+
 def test_punch_j2_load_unload_leaves_an_imprint(demo):
     # von Mises plasticity under the punch: the force stays below elastic Hertz, the
     # unloaded surface keeps a dent, the punch leaves it with no force

@@ -103,3 +103,74 @@ def test_mixed_elements_do_not_lock_on_the_same_coarse_mesh(demo):
                   "25", "--steps", "10")
     assert d["mixed"]
     assert d["pressure"] == pytest.approx(d["limit_pressure_exact"], rel=1e-3)
+
+
+# -- checkpoint and restart of a demo ----------------------------------------------------
+
+VESSEL_PATH = ["--pressure-ratio", "0.95", "--steps", "12", "--unload"]  # yields in reverse
+
+
+def same_run(a, b, rel=1e-10):
+    """Key by key the same JSON, times and memory aside: the restart took the same path.
+
+    Counts and words exactly, numbers to `rel` of their own size (two uninterrupted runs on
+    2 ranks already differ in the last digit: the order of parallel sums).
+    """
+    times = {k for k in a if k.endswith(("time_s", "_mb"))}
+    assert set(a) == set(b)
+
+    def same(x, y, where):
+        if isinstance(x, dict):
+            assert set(x) == set(y), where
+            for k in x:
+                same(x[k], y[k], f"{where}.{k}")
+        elif isinstance(x, list):
+            assert len(x) == len(y), where
+            for i, (p, q) in enumerate(zip(x, y, strict=True)):
+                same(p, q, f"{where}[{i}]")
+        elif isinstance(x, float):
+            assert y == pytest.approx(x, rel=rel, abs=rel * 1e-300), where
+        else:
+            assert x == y, where
+
+    for key in set(a) - times:
+        same(a[key], b[key], key)
+
+
+@pytest.mark.parametrize("kill_after", ["  step 5:", "  step 15:"])  # loading, unloading
+def test_a_killed_vessel_restarts_to_the_uninterrupted_answer(tmp_path, demo, kill_after):
+    # J2 is path-dependent: the plastic strains at the quadrature points, the predictor's
+    # last two states and Newton's force scale come back with the displacement; killed
+    # while it unloads, the run restarts from the peak (the unloading is not saved)
+    import sys
+
+    from conftest import DEMOS, run_and_kill
+
+    whole = demo.json("pressure_vessel.py", *VESSEL_PATH)
+    run_and_kill([sys.executable, DEMOS / "pressure_vessel.py", *VESSEL_PATH, "--checkpoint",
+                  "ck"], tmp_path, kill_after)
+    latest = int(json.loads((tmp_path / "ck" / "latest.json").read_text())["step"][5:])
+    assert (4 <= latest < 12) if kill_after == "  step 5:" else latest == 12
+    resumed = demo.json("pressure_vessel.py", *VESSEL_PATH, "--restart", tmp_path / "ck")
+    same_run(whole, resumed)
+    # other parameters, or no checkpoint: one line
+    for args, message in ((["--steps", "10"], "is of another run: its command line"),
+                          (["--restart", tmp_path / "none"], "no checkpoint folder")):
+        proc = demo.run(["pressure_vessel.py", *VESSEL_PATH, "--restart", tmp_path / "ck",
+                         *args], check=False)
+        lines = proc.stderr.strip().splitlines()
+        assert proc.returncode == 2 and len(lines) == 1 and message in lines[0], proc.stderr
+
+
+@pytest.mark.spawns_mpi
+def test_a_killed_vessel_on_two_ranks_restarts_to_the_same_answer(tmp_path, demo):
+    import sys
+
+    from conftest import DEMOS, MPIEXEC, run_and_kill
+
+    whole = demo.json("pressure_vessel.py", *VESSEL_PATH, ranks=2)
+    run_and_kill([MPIEXEC, "-n", "2", sys.executable, DEMOS / "pressure_vessel.py",
+                  *VESSEL_PATH, "--checkpoint", "ck"], tmp_path, "  step 5:")
+    resumed = demo.json("pressure_vessel.py", *VESSEL_PATH, "--restart", tmp_path / "ck",
+                        ranks=2)
+    same_run(whole, resumed)

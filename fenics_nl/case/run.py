@@ -10,12 +10,13 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.case.problem import CaseProblem
-from fenics_nl.case.resume import CaseCheckpoints, Resumed
+from fenics_nl.case.resume import case_checkpoints
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength, ArcState
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.restart import PathCheckpoints, Resumed
 from fenics_nl.solvers.result import WorkCounts
 
 
@@ -34,8 +35,8 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     t0 = time.perf_counter()
     solver = problem.make_solver()
     setup = time.perf_counter() - t0
-    saving = CaseCheckpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
-    resumed = CaseCheckpoints(problem, restart).restore() if restart else None
+    saving = case_checkpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
+    resumed = case_checkpoints(problem, restart).restore() if restart else None
     if resumed is not None:
         say(f"restarted from {restart}: {len(resumed.steps)} converged steps, load factor "
             f"{resumed.steps[-1]['load_factor']:.6g}" if resumed.steps else
@@ -59,13 +60,15 @@ def fields(problem: CaseProblem) -> list:
     return functions
 
 
-def _solve(problem: CaseProblem, solver, saving: CaseCheckpoints | None,
+def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
            resumed: Resumed | None) -> dict:
     """The load path of `solve_case`, from its start or from where `resumed` left it."""
     case, steps, work = problem.case, [], WorkCounts()
     first, start = 0, None  # the segment to begin with, and the driver's state in it
     if resumed is not None:
-        steps, first, start = resumed.steps, resumed.segment, resumed.driver
+        steps, first, start = resumed.steps, resumed.phase, resumed.driver
+        if start is not None and start.t >= 1.0 - 1e-12:  # its segment was complete
+            first, start = first + 1, None
         work.add(resumed.work)
         for record in steps:
             cli.converged_step(record)
@@ -174,7 +177,7 @@ def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[di
 
 
 def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
-                 work: WorkCounts, commit, show, saving: CaseCheckpoints | None,
+                 work: WorkCounts, commit, show, saving: PathCheckpoints | None,
                  resume: ArcState | None) -> list[dict]:
     """`loading.control = "arc-length"`: the path to the target; its critical points.
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-FORMAT = 1
+FORMAT = 2  # 2: a phase (was: segment) and the load path so far
 KEEP = 2  # complete steps kept (the last one, and the one before in case it is damaged)
 
 

@@ -76,6 +76,18 @@ def add_outputs(p: argparse.ArgumentParser, *, json: str = "the quantities of in
             p.add_argument(flag, metavar="PATH", help=text)
 
 
+def add_checkpoints(p: argparse.ArgumentParser) -> None:
+    """--checkpoint, --checkpoint-every and --restart: a demo with a path-dependent load path."""
+    p.add_argument("--checkpoint", metavar="DIR",
+                   help="save the state after every converged step of the loading (or every "
+                        "--checkpoint-every N) in DIR, to restart from")
+    p.add_argument("--checkpoint-every", metavar="N", type=at_least(1), default=1,
+                   help="with --checkpoint: save one converged step out of N")
+    p.add_argument("--restart", metavar="DIR",
+                   help="go on from the last checkpoint in DIR (the same parameters, mesh and "
+                        "number of ranks); the steps after it are the uninterrupted run's")
+
+
 def finite(text: str) -> float:
     """argparse type: a finite float (NaN and infinities are refused)."""
     try:
@@ -219,6 +231,8 @@ class _Run:
         self.output: str | None = None  # --output: the fields of every converged step
         self.series = None  # their time series, opened at the first step
         self.failure_writers = None  # out -> writers of a failed run (its pictures)
+        self.path: Path | None = None  # the demo file (a checkpoint's identity)
+        self.args: argparse.Namespace | None = None  # its parameters
 
     def close_series(self) -> None:
         """Close the fields' time series, saying what it holds (collective)."""
@@ -315,6 +329,23 @@ def check_output_paths(json: str | None = None, png: str | None = None,
         _try_writing("--output", target / ".fenics_nl_write_test")
 
 
+def check_restart_paths(checkpoint: str | None, restart: str | None,
+                        output: str | None) -> None:
+    """A --checkpoint folder that can be written; no --output folder with fields to a restart.
+
+    A restart's time series begins at the restart, and VTX files are rewritten, not appended
+    to: an --output folder holding the first run's would lose them.
+    """
+    if restart and output and any(Path(output).glob("*.bp")):
+        raise ValueError(f"--output {output} holds fields already (*.bp, the first run's?): "
+                         "a restart writes its own series, give it another folder")
+    if checkpoint:
+        try:
+            check_output_paths(output=checkpoint)
+        except ValueError as err:
+            raise ValueError(str(err).replace("--output", "--checkpoint", 1)) from None
+
+
 def _try_writing(flag: str, target: Path) -> None:
     """Open `target` for appending on rank 0, removing it if it was not there (collective).
 
@@ -350,6 +381,7 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
     from petsc4py import PETSc
 
     run = _current = _Run(sys.argv[1:] if argv is None else argv)
+    run.path = Path(path)
     t0 = time.perf_counter()
     try:
         runpy.run_path(str(path), run_name="__scene__")
@@ -379,13 +411,77 @@ def arguments(parser: argparse.ArgumentParser,
     if run is not None:
         run.json_path = getattr(args, "json", None)
         run.output = getattr(args, "output", None)
+        run.args = args
         try:
             check_output_paths(*(getattr(args, k, None) for k in ("json", "png", "plot",
                                                                    "output")))
+            check_restart_paths(getattr(args, "checkpoint", None),
+                                getattr(args, "restart", None), run.output)
         except ValueError as err:
             parser.error(str(err))
         run.options = PetscOptions(petsc, prefixes(args) if callable(prefixes) else prefixes)
     return args
+
+
+class Checkpointing:
+    """A demo's --checkpoint and --restart of its loading, as `solve_incrementally` takes them.
+
+    `steps`: the step records a restart took back (they are the run's JSON steps too);
+    `options`: start, path_so_far and on_state for `solve_incrementally` (empty without the
+    flags: a notebook, or a run without them).
+    """
+
+    def __init__(self, steps: list[dict], options: dict):
+        self.steps, self.options = steps, options
+
+
+def checkpointing(functions: dict, *, newton=None, contact=None) -> Checkpointing:
+    """--checkpoint / --restart of the loading of a demo, whose state is `functions`.
+
+    Collective. With --restart the saved state is put back into `functions` (the unknown
+    first, then the internal variables), `newton`'s force reference and `contact`'s active
+    set now. The checkpoint's identity is the demo file and its parameters (the output and
+    checkpoint flags aside), the ranks and the unknowns.
+    """
+    import hashlib
+
+    from fenics_nl.io.output import dofs
+    from fenics_nl.solvers.restart import PathCheckpoints
+    from fenics_nl.solvers.result import WorkCounts
+
+    run = _current
+    args = run.args if run is not None else None
+    folder = getattr(args, "checkpoint", None)
+    restart = getattr(args, "restart", None)
+    if not (folder or restart):
+        return Checkpointing([], {})
+    outputs = {"json", "png", "plot", "output", "checkpoint", "checkpoint_every", "restart"}
+    params = json.dumps({k: v for k, v in sorted(vars(args).items()) if k not in outputs},
+                        default=str)
+    unknown = next(iter(functions.values()))
+    identity = {"demo": run.path.name, "command line": hashlib.sha256(
+        params.encode()).hexdigest(), "dofs": dofs(unknown.function_space)}
+
+    def store(where, every=1):
+        return PathCheckpoints(where, identity, functions, every=every, newton=newton,
+                               contact=contact)
+
+    options, steps = {}, []
+    if restart:
+        resumed = store(restart).restore()
+        steps = resumed.steps
+        run.steps = [dict(s) for s in steps]
+        options.update(start=resumed.driver, path_so_far=resumed.path)
+        say(f"restarted from {restart}: {len(steps)} converged steps" + (
+            f", load factor {steps[-1]['load_factor']:.6g}" if steps else ""))
+    if folder:
+        saving = store(folder, args.checkpoint_every)
+
+        def on_state(driver, path):
+            saving.save(0, driver, run.steps, WorkCounts(), path)
+
+        options["on_state"] = on_state
+    return Checkpointing(steps, options)
 
 
 def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:

@@ -86,17 +86,19 @@ def solve_incrementally(
     commit: Callable[[], None] | None = None,
     restore: Callable[[], None] | None = None,
     start: DriverState | None = None,
+    path_so_far: LoadPath | None = None,
     on_state: Callable[[DriverState, LoadPath], None] | None = None,
 ) -> LoadPath:
     """Drive the load factor from 0 to 1, starting with `steps` equal increments.
 
     `start`: go on from a converged state (a restart: `solver.u` and the internal variables
-    already hold it); `on_state(state, path)` after each converged step, with what a restart
-    needs (a checkpoint) and the path so far.
+    already hold it), `path_so_far` the path before it (the one returned goes on from it);
+    `on_state(state, path)` after each converged step, with what a restart needs (a
+    checkpoint) and the path so far.
     """
     if steps < 1:
         raise ValueError(f"steps must be >= 1, got {steps}")
-    path = LoadPath()
+    path = path_so_far if path_so_far is not None else LoadPath()
     x = solver.u.x.petsc_vec
     saved = x.copy()  # last converged state
     previous, dt_previous = None, None  # the one before, for the predictor

@@ -1,0 +1,133 @@
+"""Checkpoints of a load path, and the restart that goes on exactly as the run would have.
+
+After a converged step a checkpoint holds the Functions of the state (the unknown, with the
+pressure of a mixed form; the internal variables at the quadrature points), the contact's
+active set, Newton's force reference, the step records of the run's JSON, and where the
+driver stands: `loading.DriverState` under load control (with the load path so far, its
+phase: a demo's loading and unloading, a case's segment), or `arclength.ArcState` under
+arc-length control. A restart puts all of it back; the steps after it are then those of the
+uninterrupted run, to round-off.
+
+The identity (JSON-able, the same on every rank: what the run is) and each rank's layout
+(the size of its unknowns and a hash of its mesh nodes) are checked on reading: a restart
+needs the same problem, the same mesh and the same partition (`io.checkpoint` says why).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from dolfinx import fem
+
+from fenics_nl.io.checkpoint import CheckpointError, Checkpoints, fingerprint
+from fenics_nl.solvers.arclength import ArcState
+from fenics_nl.solvers.loading import DriverState, LoadPath
+from fenics_nl.solvers.result import SolveResult, WorkCounts
+
+__all__ = ["PathCheckpoints", "Resumed"]
+
+
+@dataclasses.dataclass
+class Resumed:
+    """Where a restarted run goes on from."""
+
+    phase: int  # the phase (or segment) of the load path the checkpoint was taken in
+    driver: DriverState | None  # where in it (None under arc-length control); t = 1: done
+    steps: list[dict]  # the step records of the JSON so far
+    work: WorkCounts  # of the load-controlled phases (an arc's is in its state's path)
+    arc: ArcState | None = None  # under arc-length control: where the path goes on from
+    path: LoadPath | None = None  # the phase's path so far (its totals go on from it)
+
+
+class PathCheckpoints:
+    """Save the state of a run after converged steps in `folder`, and read it back.
+
+    Args:
+        folder: where the checkpoints go (or come from, for a restart).
+        identity: what the run is (JSON-able, the same on every rank): a checkpoint with
+            another identity is refused.
+        functions: the Functions of the state by name (the unknown first).
+        every: save one converged step out of `every`.
+        newton: the Newton solver whose force reference is kept (None: SNES, nothing kept).
+        contact: an active-set contact whose `active` nodes are kept (None: no contact).
+    """
+
+    def __init__(self, folder: str, identity: dict, functions: dict[str, fem.Function], *,
+                 every: int = 1, newton=None, contact=None):
+        self.functions, self.newton, self.contact = functions, newton, contact
+        unknown = next(iter(functions.values()))
+        msh = unknown.function_space.mesh
+        self.store = Checkpoints(folder, msh.comm, {**identity, "ranks": msh.comm.size}, every)
+        # this rank's unknowns and mesh nodes (a mixed space tabulates no dof coordinates)
+        nodes = msh.geometry.index_map().size_local
+        self.local = {"unknown": int(unknown.x.array.size),
+                      "coordinates": fingerprint(msh.geometry.x[:nodes])}
+
+    # -- what is saved -----------------------------------------------------------------
+
+    def save(self, phase: int, driver: DriverState, steps: list[dict], work: WorkCounts,
+             path: LoadPath | None = None) -> None:
+        """The state after the converged step that ended with `driver` (collective).
+
+        `work`: of the phases before this one; `path`: this phase's so far.
+        """
+        arrays = {} if driver.previous is None else {"previous": driver.previous}
+        self._save({"phase": phase, "t": driver.t, "dt": driver.dt,
+                    "dt_previous": driver.dt_previous,
+                    "has_previous": driver.previous is not None,
+                    "work": dataclasses.asdict(work),
+                    "path": None if path is None else _path_record(path)}, arrays, steps)
+
+    def save_arc(self, arc: ArcState, steps: list[dict]) -> None:
+        """The state after a converged step of arc-length control (collective)."""
+        self._save({"arc": arc.scalars()}, arc.arrays(), steps)
+
+    def _save(self, state: dict, arrays: dict, steps: list[dict]) -> None:
+        """`state` and `arrays` with the Functions, the contact's nodes, the force scale."""
+        arrays.update({k: f.x.array for k, f in self.functions.items()})
+        if self.contact is not None:
+            arrays["active"] = self.contact.active.astype(np.uint8)
+        state.update(steps=steps, force_reference=self.newton.force_reference
+                     if self.newton is not None else None)
+        self.store.save(len(steps), state, arrays, self.local)
+
+    # -- what a restart reads ----------------------------------------------------------
+
+    def restore(self) -> Resumed:
+        """Put the saved state back (collective); where the path goes on from.
+
+        CheckpointError (one line, on every rank) for a missing, damaged or foreign one.
+        """
+        state, arrays = self.store.load(self.local)
+        for name, f in self.functions.items():
+            if name not in arrays or arrays[name].size != f.x.array.size:
+                raise CheckpointError(f"checkpoint {self.store.folder} has no {name} of this "
+                                      "run's size: it is another run's")
+            f.x.array[:] = arrays[name]
+            f.x.scatter_forward()
+        if self.contact is not None:
+            self.contact.active = arrays["active"].astype(bool)
+        if self.newton is not None and state["force_reference"] is not None:
+            self.newton.force_reference = state["force_reference"]
+        if "arc" in state:
+            return Resumed(0, None, state["steps"], WorkCounts(),
+                           ArcState.saved(state["arc"], arrays))
+        driver = DriverState(state["t"], state["dt"], state["dt_previous"],
+                             arrays["previous"] if state["has_previous"] else None)
+        work = WorkCounts(**state["work"])
+        path = None if state.get("path") is None else _path_from(state["path"])
+        return Resumed(state["phase"], driver, state["steps"], work, path=path)
+
+
+def _path_record(path: LoadPath) -> dict:
+    """What a restart needs of a load path so far (its steps' iterations, not their norms)."""
+    return {"factors": path.factors, "iterations": [r.iterations for r in path.results],
+            "failures": path.failures, "work": dataclasses.asdict(path.work)}
+
+
+def _path_from(record: dict) -> LoadPath:
+    return LoadPath(list(record["factors"]),
+                    [SolveResult(True, "converged (before the restart)", its, [], WorkCounts())
+                     for its in record["iterations"]],
+                    record["failures"], WorkCounts(**record["work"]))
