@@ -147,9 +147,8 @@ if args.friction is not None and args.support != "contact":
     p.error("--friction acts between the base and the floor: add --support contact")
 if args.unload and args.compare:
     p.error("--unload goes with one --newton, not --compare")
-if (args.checkpoint or args.restart) and (args.compare or args.friction is not None):
-    p.error("--checkpoint and --restart go with one --newton and no --friction (the slip "
-            "history of the floor is not saved yet)")
+if (args.checkpoint or args.restart) and args.compare:
+    p.error("--checkpoint and --restart go with one --newton, not --compare")
 if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
     p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
             f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
@@ -251,10 +250,9 @@ def solve(newton):
     # --restart: the checkpoint's displacement, plastic state, floor contact and steps back;
     # --checkpoint: saved after each converged step of the loading
     contact = b.solver if args.support == "contact" else None
-    newton = contact.system.newton if contact else b.solver
     checkpoints = cli.checkpointing(
         {"unknown": part.unknown, **(material.state_functions() if plastic else {})},
-        newton=newton if newton is not b.solver or args.newton != "snes" else None,
+        newton=contact.newton if contact else (b.solver if newton != "snes" else None),
         contact=contact)
     steps += [{k: v for k, v in s.items() if k != "load_factor"} for s in checkpoints.steps]
 

@@ -132,6 +132,7 @@ def parser():
                     png="the deformed contact zone (von Mises stress) beside the contact "
                         "pressure, against Hertz",
                     plot="force-indentation and pressure against Hertz")
+    cli.add_checkpoints(p)
     return p
 
 
@@ -272,8 +273,15 @@ def report(t, result):
 
 plastic = args.material == "j2"
 commit = (lambda: material.commit(u, block.kinematics)) if plastic else None
+# --restart: the checkpoint's displacement, plastic state, contact statuses (and slip
+# history) and states back; --checkpoint: saved after each converged step of the loading
+checkpoints = cli.checkpointing(
+    {"unknown": block.unknown, **(material.state_functions() if plastic else {})},
+    newton=punch.contact.newton, contact=punch.contact, kept=load.record)
+if checkpoints.kept is not None:
+    load.take_back(checkpoints.kept)
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
-                    on_step=report, commit=commit)
+                    on_step=report, commit=commit, **checkpoints.options)
 last = states[-1]  # the loaded state: what is checked
 nodes = punch.nodes_in_contact()
 imprint = None

@@ -508,9 +508,26 @@ def test_a_bracket_on_the_floor_in_j2_restarts_on_the_same_path(tmp_path, demo):
     resumed = demo.bracket(*args, "--restart", tmp_path / "ck")
     assert len(resumed["steps"]) == 3
     same_run(whole, resumed)
-    proc = demo.run(["bracket.py", *args, "--friction", "0.3", "--restart", tmp_path / "ck"],
+    proc = demo.run(["bracket.py", *args, "--compare", "--restart", tmp_path / "ck"],
                     check=False)
-    assert proc.returncode == 2 and "no --friction" in proc.stderr
+    assert proc.returncode == 2 and "not --compare" in proc.stderr
+
+
+@pytest.mark.parametrize("args", [
+    ["--material", "j2", "--unload"],  # the plastic state; the unloading redone
+    ["--model", "plane-strain", "--friction", "0.3", "--tangential-ratio", "0.5"],  # slip
+    ["--force", "0.01", "--formulation", "multiplier"]])  # the secant on δ, its last state
+def test_a_punch_restarts_on_the_same_path(tmp_path, demo, args):
+    # restarted one saved step short of the loading's end: the same JSON, key by key, to
+    # 1e-10 (the multiplier form's SNES starts from zero multipliers: round-off apart)
+    import json
+
+    from test_vessel import same_run
+
+    args = [*args, "--refine", "0", "--steps", "3"]
+    whole = demo.punch(*args, "--checkpoint", tmp_path / "ck")
+    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": "step-000002"}))
+    same_run(whole, demo.punch(*args, "--restart", tmp_path / "ck"))
 
 
 def test_punch_j2_load_unload_leaves_an_imprint(demo):

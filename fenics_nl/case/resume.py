@@ -23,6 +23,6 @@ def case_checkpoints(problem, folder: str, every: int = 1) -> PathCheckpoints:
         functions.update(problem.material.state_functions())
     solver = problem.solver
     contact = solver.contact if problem.contact is not None else None
-    newton = contact.system.newton if contact is not None else solver
+    newton = contact.newton if contact is not None else solver
     return PathCheckpoints(folder, identity, functions, every=every, contact=contact,
                            newton=newton if hasattr(newton, "force_reference") else None)

@@ -157,6 +157,21 @@ class ActiveSetContact:
             self.system = MultiplierSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         self.system.set_active(self.active, None)
 
+    @property
+    def newton(self):
+        """The Newton solver of the inner solves (None: the multiplier form's SNES)."""
+        return self.system.newton if isinstance(self.system, EliminationSystem) else None
+
+    # -- a checkpoint ------------------------------------------------------------------
+
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """What a restart needs of the contact after a converged step: the active nodes."""
+        return {"active": self.active.astype(np.uint8)}
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The state of `checkpoint_arrays` back (the next solve starts from it)."""
+        self.active = arrays["active"].astype(bool)
+
     # -- the surface's quantities, for the current state --------------------------------
 
     @property

@@ -108,6 +108,30 @@ class FrictionalContact(ActiveSetContact):
             a.copy() for a in self._committed)
         self.motion = self.committed_motion.copy()
 
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """What the next step's increments start from: the committed state.
+
+        The statuses, slip directions and forces, the obstacle's position and the
+        tangential force.
+        """
+        active, slip, direction, slip_force, spring = self._committed
+        return {"active": active.astype(np.uint8), "slip": slip.astype(np.uint8),
+                "direction": direction, "slip_force": slip_force, "spring": spring,
+                "motion": self.committed_motion,
+                "tangential_force": self.committed_tangential_force}
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The state of `checkpoint_arrays` back, committed (u is the caller's, restored)."""
+        self.active, self.slip = arrays["active"].astype(bool), arrays["slip"].astype(bool)
+        self.direction = arrays["direction"].copy()
+        self.slip_force = arrays["slip_force"].copy()
+        self.spring = arrays["spring"].copy()
+        self.motion = arrays["motion"].copy()
+        self._committed = self._state()
+        self._u_t_committed = self.tangential_displacement()
+        self.committed_motion = self.motion.copy()
+        self.committed_tangential_force = arrays["tangential_force"].copy()
+
     def set_motion(self, d) -> None:
         """The obstacle's tangential displacement d (one value per tangential axis)."""
         self.motion = np.asarray(d, dtype=float).reshape(len(self.axes))

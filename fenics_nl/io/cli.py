@@ -427,21 +427,24 @@ class Checkpointing:
     """A demo's --checkpoint and --restart of its loading, as `solve_incrementally` takes them.
 
     `steps`: the step records a restart took back (they are the run's JSON steps too);
-    `options`: start, path_so_far and on_state for `solve_incrementally` (empty without the
-    flags: a notebook, or a run without them).
+    `kept`: what the demo's `kept()` gave when the checkpoint was saved (None without a
+    restart); `options`: start, path_so_far and on_state for `solve_incrementally` (empty
+    without the flags: a notebook, or a run without them).
     """
 
-    def __init__(self, steps: list[dict], options: dict):
-        self.steps, self.options = steps, options
+    def __init__(self, steps: list[dict], options: dict, kept: dict | None = None):
+        self.steps, self.options, self.kept = steps, options, kept
 
 
-def checkpointing(functions: dict, *, newton=None, contact=None) -> Checkpointing:
+def checkpointing(functions: dict, *, newton=None, contact=None,
+                  kept: Callable[[], dict] | None = None) -> Checkpointing:
     """--checkpoint / --restart of the loading of a demo, whose state is `functions`.
 
     Collective. With --restart the saved state is put back into `functions` (the unknown
-    first, then the internal variables), `newton`'s force reference and `contact`'s active
-    set now. The checkpoint's identity is the demo file and its parameters (the output and
-    checkpoint flags aside), the ranks and the unknowns.
+    first, then the internal variables), `newton`'s force reference and `contact`'s state
+    (its statuses, with friction its slip history) now; `kept()` gives what else the demo
+    needs back (JSON-able). The checkpoint's identity is the demo file and its parameters
+    (the output and checkpoint flags aside), the ranks and the unknowns.
     """
     import hashlib
 
@@ -464,12 +467,12 @@ def checkpointing(functions: dict, *, newton=None, contact=None) -> Checkpointin
 
     def store(where, every=1):
         return PathCheckpoints(where, identity, functions, every=every, newton=newton,
-                               contact=contact)
+                               contact=contact, kept=kept)
 
-    options, steps = {}, []
+    options, steps, restored = {}, [], None
     if restart:
         resumed = store(restart).restore()
-        steps = resumed.steps
+        steps, restored = resumed.steps, resumed.kept
         run.steps = [dict(s) for s in steps]
         options.update(start=resumed.driver, path_so_far=resumed.path)
         say(f"restarted from {restart}: {len(steps)} converged steps" + (
@@ -481,7 +484,7 @@ def checkpointing(functions: dict, *, newton=None, contact=None) -> Checkpointin
             saving.save(0, driver, run.steps, WorkCounts(), path)
 
         options["on_state"] = on_state
-    return Checkpointing(steps, options)
+    return Checkpointing(steps, options, restored)
 
 
 def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:

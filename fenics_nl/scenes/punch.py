@@ -18,6 +18,7 @@ at 10 % (the default, L = 100a, h = a/12).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -461,6 +462,15 @@ class PunchLoad:
     def set_load(self, t: float) -> None:
         """The load factor of the next solve."""
         self.t = t
+
+    def record(self) -> dict:
+        """The converged states and the last load factor, JSON-able (for a checkpoint)."""
+        return {"states": [dataclasses.asdict(s) for s in self.states], "t": self._t_last}
+
+    def take_back(self, record: dict) -> None:
+        """The states of `record()` back, the next solve's guess from the last of them."""
+        self.states[:] = [Indentation(**s) for s in record["states"]]
+        self._t_last = record["t"]
 
     def solve(self) -> SolveResult:
         """The state at the current load factor, from the last one."""

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 from dolfinx import fem
 
 from fenics_nl.io.checkpoint import CheckpointError, Checkpoints, fingerprint
@@ -38,6 +37,7 @@ class Resumed:
     work: WorkCounts  # of the load-controlled phases (an arc's is in its state's path)
     arc: ArcState | None = None  # under arc-length control: where the path goes on from
     path: LoadPath | None = None  # the phase's path so far (its totals go on from it)
+    kept: dict | None = None  # what the run's `kept` gave
 
 
 class PathCheckpoints:
@@ -50,12 +50,15 @@ class PathCheckpoints:
         functions: the Functions of the state by name (the unknown first).
         every: save one converged step out of `every`.
         newton: the Newton solver whose force reference is kept (None: SNES, nothing kept).
-        contact: an active-set contact whose `active` nodes are kept (None: no contact).
+        contact: an active-set contact (frictionless or Coulomb) whose state is kept
+            (`checkpoint_arrays`: its statuses, and with friction the slip history).
+        kept: a function giving what else the run needs back (JSON-able: a demo's list of
+            states), returned by `restore` as `Resumed.kept`.
     """
 
     def __init__(self, folder: str, identity: dict, functions: dict[str, fem.Function], *,
-                 every: int = 1, newton=None, contact=None):
-        self.functions, self.newton, self.contact = functions, newton, contact
+                 every: int = 1, newton=None, contact=None, kept=None):
+        self.functions, self.newton, self.contact, self.kept = functions, newton, contact, kept
         unknown = next(iter(functions.values()))
         msh = unknown.function_space.mesh
         self.store = Checkpoints(folder, msh.comm, {**identity, "ranks": msh.comm.size}, every)
@@ -87,9 +90,11 @@ class PathCheckpoints:
         """`state` and `arrays` with the Functions, the contact's nodes, the force scale."""
         arrays.update({k: f.x.array for k, f in self.functions.items()})
         if self.contact is not None:
-            arrays["active"] = self.contact.active.astype(np.uint8)
+            arrays.update({f"contact.{k}": v for k, v in
+                           self.contact.checkpoint_arrays().items()})
         state.update(steps=steps, force_reference=self.newton.force_reference
-                     if self.newton is not None else None)
+                     if self.newton is not None else None,
+                     kept=self.kept() if self.kept is not None else None)
         self.store.save(len(steps), state, arrays, self.local)
 
     # -- what a restart reads ----------------------------------------------------------
@@ -107,17 +112,19 @@ class PathCheckpoints:
             f.x.array[:] = arrays[name]
             f.x.scatter_forward()
         if self.contact is not None:
-            self.contact.active = arrays["active"].astype(bool)
+            self.contact.restore_arrays({k[len("contact."):]: v for k, v in arrays.items()
+                                         if k.startswith("contact.")})
         if self.newton is not None and state["force_reference"] is not None:
             self.newton.force_reference = state["force_reference"]
         if "arc" in state:
             return Resumed(0, None, state["steps"], WorkCounts(),
-                           ArcState.saved(state["arc"], arrays))
+                           ArcState.saved(state["arc"], arrays), kept=state["kept"])
         driver = DriverState(state["t"], state["dt"], state["dt_previous"],
                              arrays["previous"] if state["has_previous"] else None)
         work = WorkCounts(**state["work"])
         path = None if state.get("path") is None else _path_from(state["path"])
-        return Resumed(state["phase"], driver, state["steps"], work, path=path)
+        return Resumed(state["phase"], driver, state["steps"], work, path=path,
+                       kept=state["kept"])
 
 
 def _path_record(path: LoadPath) -> dict:
