@@ -96,6 +96,7 @@ def parser():
     cli.add_outputs(p, output="the displacement",
                     png="the deformed arch at states along the path",
                     plot="load against midspan rise, FE and closed form")
+    cli.add_checkpoints(p)
     return p
 
 
@@ -145,15 +146,15 @@ solver = NewtonSolver(arch.residual, arch.u, arch.bcs, method=args.newton, rtol=
 continuation = ArcLength(solver, arch.set_load, arc_length=args.arc_length, psi=args.psi,
                          max_arc_length=args.max_arc_length, prefix="arch_continuation_")
 history = [(0.0, args.rise)]  # (q0 / (EI k⁴ r), a/r)
-shapes = [(0.0, arch.centreline())] if args.png else []
+# the shapes the picture draws (kept without --png too: a restart may ask for the picture)
+shapes = [(0.0, arch.centreline())]
 
 
 def record(lam, result):
     history.append((lam, arch.midspan_rise()))
     cli.converged_step({"load_factor": lam, "midspan_rise": history[-1][1],
                         "newton_iterations": result.iterations}, fields=lambda: [arch.u])
-    if args.png:
-        shapes.append((lam, arch.centreline()))
+    shapes.append((lam, arch.centreline()))
 
 
 def progress(message):
@@ -161,9 +162,20 @@ def progress(message):
         say("  " + message)
 
 
+# --restart: the displacement, the continuation's state (the arc, the tangent's inertia,
+# the last increment), the states so far and their shapes back; --checkpoint: saved after
+# each converged step
+checkpoints = cli.checkpointing(
+    {"unknown": arch.u}, newton=solver,
+    kept=lambda: {"shapes": [(lam, None if x is None else x.tolist()) for lam, x in shapes]})
+history += [(s["load_factor"], s["midspan_rise"]) for s in checkpoints.steps]
+if checkpoints.kept is not None:
+    shapes[:] = [(lam, None if comm.rank else np.array(x))
+                 for lam, x in checkpoints.kept["shapes"]]
 target = args.load_ratio * q_limit
 say(f"arc-length path to q0 = {args.load_ratio:g} x the limit load ({args.newton} Newton)")
-path = continuation.run(target, args.max_steps, on_step=record, progress=progress)
+path = continuation.run(target, args.max_steps, on_step=record, progress=progress,
+                        **checkpoints.arc_options)
 # -
 
 # ### Against the closed form

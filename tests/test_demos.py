@@ -348,6 +348,25 @@ def test_snap_through_two_ranks_match_serial(demo):
     assert p["final_rise"] == pytest.approx(s["final_rise"], rel=1e-6)
 
 
+def test_a_killed_snap_through_restarts_on_the_same_path(tmp_path, demo):
+    # arc-length: killed between its two limit points, the restart goes on with the saved
+    # arc, inertia, sense and last increment, and the shapes its picture draws
+    import sys
+
+    from conftest import DEMOS, run_and_kill
+    from test_vessel import same_run
+
+    whole = demo.json("snap_through.py", "--png", "whole.png")
+    run_and_kill([sys.executable, DEMOS / "snap_through.py", "--checkpoint", "ck"], tmp_path,
+                 "  step 20:")
+    latest = int(json.loads((tmp_path / "ck" / "latest.json").read_text())["step"][5:])
+    assert 19 <= latest < len(whole["steps"]) - 5
+    resumed = demo.json("snap_through.py", "--png", "resumed.png", "--restart", "ck")
+    same_run(whole, resumed)
+    # the killed run drew nothing, the restart's picture has every state all the same
+    assert (tmp_path / "resumed.png").read_bytes() == (tmp_path / "whole.png").read_bytes()
+
+
 @pytest.mark.parametrize("args,message", [
     (["--arc-length", "0"], "--arc-length must be > 0"), (["--rise", "1.5"], "--rise"),
     (["--rise", "5"], "antisymmetrically"), (["--elements", "3"], "--elements must be even"),

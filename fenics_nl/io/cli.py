@@ -428,12 +428,15 @@ class Checkpointing:
 
     `steps`: the step records a restart took back (they are the run's JSON steps too);
     `kept`: what the demo's `kept()` gave when the checkpoint was saved (None without a
-    restart); `options`: start, path_so_far and on_state for `solve_incrementally` (empty
-    without the flags: a notebook, or a run without them).
+    restart); `options`: start, path_so_far and on_state for `solve_incrementally`,
+    `arc_options`: resume and on_state for `ArcLength.run` (empty without the flags: a
+    notebook, or a run without them).
     """
 
-    def __init__(self, steps: list[dict], options: dict, kept: dict | None = None):
-        self.steps, self.options, self.kept = steps, options, kept
+    def __init__(self, steps: list[dict], options: dict, arc_options: dict,
+                 kept: dict | None = None):
+        self.steps, self.options, self.arc_options = steps, options, arc_options
+        self.kept = kept
 
 
 def checkpointing(functions: dict, *, newton=None, contact=None,
@@ -457,7 +460,7 @@ def checkpointing(functions: dict, *, newton=None, contact=None,
     folder = getattr(args, "checkpoint", None)
     restart = getattr(args, "restart", None)
     if not (folder or restart):
-        return Checkpointing([], {})
+        return Checkpointing([], {}, {})
     outputs = {"json", "png", "plot", "output", "checkpoint", "checkpoint_every", "restart"}
     params = json.dumps({k: v for k, v in sorted(vars(args).items()) if k not in outputs},
                         default=str)
@@ -469,12 +472,13 @@ def checkpointing(functions: dict, *, newton=None, contact=None,
         return PathCheckpoints(where, identity, functions, every=every, newton=newton,
                                contact=contact, kept=kept)
 
-    options, steps, restored = {}, [], None
+    options, arc_options, steps, restored = {}, {}, [], None
     if restart:
         resumed = store(restart).restore()
         steps, restored = resumed.steps, resumed.kept
         run.steps = [dict(s) for s in steps]
         options.update(start=resumed.driver, path_so_far=resumed.path)
+        arc_options["resume"] = resumed.arc
         say(f"restarted from {restart}: {len(steps)} converged steps" + (
             f", load factor {steps[-1]['load_factor']:.6g}" if steps else ""))
     if folder:
@@ -484,7 +488,8 @@ def checkpointing(functions: dict, *, newton=None, contact=None,
             saving.save(0, driver, run.steps, WorkCounts(), path)
 
         options["on_state"] = on_state
-    return Checkpointing(steps, options, restored)
+        arc_options["on_state"] = lambda state: saving.save_arc(state, run.steps)
+    return Checkpointing(steps, options, arc_options, restored)
 
 
 def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
