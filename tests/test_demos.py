@@ -521,38 +521,48 @@ def test_a_bracket_on_the_floor_in_j2_restarts_on_the_same_path(tmp_path, demo):
 
     from test_vessel import same_run
 
-    args = ["--material", "j2", "--support", "contact", "--size", "20", "--steps", "3"]
+    args = ["--material", "j2", "--support", "contact", "--size", "20", "--steps", "2"]
     whole = demo.bracket(*args, "--checkpoint", tmp_path / "ck")
-    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": "step-000002"}))
+    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": "step-000001"}))
     resumed = demo.bracket(*args, "--restart", tmp_path / "ck")
-    assert len(resumed["steps"]) == 3
+    assert len(resumed["steps"]) == 2
     same_run(whole, resumed)
     proc = demo.run(["bracket.py", *args, "--compare", "--restart", tmp_path / "ck"],
                     check=False)
     assert proc.returncode == 2 and "not --compare" in proc.stderr
 
 
-@pytest.mark.parametrize("args", [
-    ["--material", "j2", "--unload"],  # the plastic state; the unloading redone
-    ["--model", "plane-strain", "--friction", "0.3", "--tangential-ratio", "0.5"],  # slip
-    ["--force", "0.01", "--formulation", "multiplier"]])  # the secant on δ, its last state
-def test_a_punch_restarts_on_the_same_path(tmp_path, demo, args):
-    # restarted one saved step short of the loading's end: the same JSON, key by key, to
-    # 1e-10 (the multiplier form's SNES starts from zero multipliers: round-off apart)
+def restarted_one_step_short(demo, tmp_path, args, steps):
+    """The punch run with --checkpoint, and again restarted one saved step short of its
+    loading's end: both JSONs."""
     import json
 
+    whole = demo.punch(*args, "--steps", str(steps), "--checkpoint", tmp_path / "ck")
+    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": f"step-{steps - 1:06d}"}))
+    return whole, demo.punch(*args, "--steps", str(steps), "--restart", tmp_path / "ck")
+
+
+@pytest.mark.parametrize("args", [
+    # the slip history, then the tangential load redone
+    ["--model", "plane-strain", "--block", "10", "--friction", "0.3", "--tangential-ratio",
+     "0.5"],
+    ["--force", "0.01", "--formulation", "multiplier"]])  # the secant on δ, its last state
+def test_a_punch_restarts_on_the_same_path(tmp_path, demo, args):
+    # the same JSON, key by key, to 1e-10 (the multiplier form's SNES starts from zero
+    # multipliers: round-off apart)
     from test_vessel import same_run
 
-    args = [*args, "--refine", "0", "--steps", "3"]
-    whole = demo.punch(*args, "--checkpoint", tmp_path / "ck")
-    (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": "step-000002"}))
-    same_run(whole, demo.punch(*args, "--restart", tmp_path / "ck"))
+    same_run(*restarted_one_step_short(demo, tmp_path, [*args, "--refine", "0"], 2))
 
 
-def test_punch_j2_load_unload_leaves_an_imprint(demo):
+def test_punch_j2_load_unload_leaves_an_imprint(tmp_path, demo):
     # von Mises plasticity under the punch: the force stays below elastic Hertz, the
     # unloaded surface keeps a dent, the punch leaves it with no force
-    d = demo.punch("--material", "j2", "--refine", "0", "--steps", "2", "--unload")
+    from test_vessel import same_run
+
+    d, resumed = restarted_one_step_short(demo, tmp_path, ["--material", "j2", "--refine", "0",
+                                                            "--unload"], 2)
+    same_run(d, resumed)  # the plastic state comes back with a restart; the unloading redone
     assert d["force"] < d["hertz_force"]
     assert 0 < d["residual_imprint_depth"] < d["indentation"]
     assert abs(d["unloading"][-1]["force"]) < 1e-9 * d["force"]
