@@ -23,8 +23,8 @@ import ufl
 from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, update_readme
 from dolfinx import fem
 from mpi4py import MPI
+from peers import solve_penalty, solve_snes_vi
 
-from fenics_nl.contact.peers import solve_penalty, solve_snes_vi
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz

@@ -28,8 +28,8 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 from common import machine, options, publish
+from peers import solve_friction_penalty
 
-from fenics_nl.contact.peers import solve_friction_penalty
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz, mindlin

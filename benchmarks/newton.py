@@ -28,9 +28,9 @@ from common import (
 )
 from dolfinx import fem
 from mpi4py import MPI
+from problems import cantilever_3d
 
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes.problems import cantilever_3d
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
 

@@ -28,6 +28,8 @@ from mpi4py import MPI
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMOS = ROOT / "demos"
+# the ready-made problems and the contact peers that tests share with the benchmarks
+sys.path.append(str(ROOT / "benchmarks"))
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 if MPI.COMM_WORLD.size > 1:

@@ -244,7 +244,8 @@ def test_friction_bad_input_is_one_line(demo, args, words):
 def test_the_penalty_peer_converges_to_the_active_set(model, block, Q_bound, q_bound):
     # pressed in one step (ν = 0.3), then moved: the nodal traction and Q of the penalty
     # peer approach the active set's answer as k grows
-    from fenics_nl.contact.peers import solve_friction_penalty
+    from peers import solve_friction_penalty  # benchmarks/peers.py
+
     from fenics_nl.materials.laws import LinearElastic
     from fenics_nl.scenes.punch import build_punch
 

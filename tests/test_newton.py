@@ -5,9 +5,9 @@ import pytest
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
+from problems import cantilever_3d
 
 from fenics_nl.materials.laws import PowerLaw
-from fenics_nl.scenes.problems import cantilever_3d
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
 from fenics_nl.solvers.snes import EventCounter, SnesSolver

@@ -8,12 +8,12 @@ import pytest
 import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
+from problems import cantilever_3d
 
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.mesh_check import bad_cells
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes.problems import cantilever_3d
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
 

@@ -11,6 +11,8 @@ from fenics_nl.case.spec import Case, CaseError
 from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.domain.meshes import start_model
 
+__all__ = ["load_mesh"]
+
 
 def load_mesh(case: Case, comm: MPI.Comm = MPI.COMM_WORLD) -> gmshio.MeshData:
     """MeshData of the case's mesh (physical groups by name), or CaseError naming the key."""

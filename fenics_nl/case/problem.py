@@ -31,6 +31,8 @@ from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import SnesSolver
 
+__all__ = ["CaseProblem", "ContactSteps"]
+
 PREFIX = "case_"
 FLOAT_RANGE = 1e150  # a load beyond it has no square in double precision (max ~1.8e308)
 
@@ -54,7 +56,7 @@ class CaseProblem:
         # mixed, or beside J2's out-of-plane strain in plane stress); `displacement()`: a
         # Function of it to probe, draw and write
         self.plane_stress = None
-        if case.model == "plane_stress" and getattr(self.material, "path_dependent", False):
+        if case.model == "plane_stress" and self.material.path_dependent:
             f = self.plane_stress = plane_stress.PlaneStressUnknown(msh, case.degree, q)
         else:
             f = unknowns(msh, case.degree, case.formulation == "mixed")
@@ -66,7 +68,7 @@ class CaseProblem:
         self.dx = kinematics.quadrature_measure("dx", msh, q)
         self.ds = kinematics.quadrature_measure("ds", msh, q + 1, subdomain_data=tags)
         self.weight = kinematics.measure_weight(msh, self.model)
-        if getattr(self.material, "path_dependent", False):  # its state on dx's points
+        if self.material.path_dependent:  # its state on dx's points
             self.material.bind(msh, q)
         self.residual = self._residual(data)
         self.force_scale = self._load_magnitude(data)

@@ -13,13 +13,15 @@ import hashlib
 
 from fenics_nl.solvers.restart import PathCheckpoints
 
+__all__ = ["case_checkpoints"]
+
 
 def case_checkpoints(problem, folder: str, every: int = 1) -> PathCheckpoints:
     """The checkpoints of `problem`'s run in `folder` (to save in, or restart from)."""
     identity = {"case file": hashlib.sha256(problem.case.path.read_bytes()).hexdigest(),
                 "dofs": problem.dofs}
     functions = {"unknown": problem.unknown}
-    if getattr(problem.material, "path_dependent", False):
+    if problem.material.path_dependent:
         functions.update(problem.material.state_functions())
     solver = problem.solver
     contact = solver.contact if problem.contact is not None else None

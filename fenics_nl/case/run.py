@@ -19,6 +19,8 @@ from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.restart import PathCheckpoints, Resumed
 from fenics_nl.solvers.result import WorkCounts
 
+__all__ = ["fields", "load_path_plot", "solve_case", "step_record", "warnings", "write_outputs"]
+
 
 def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
                checkpoint_every: int = 1, restart: str | None = None) -> dict:
@@ -53,7 +55,7 @@ def fields(problem: CaseProblem) -> list:
     functions = [problem.displacement(), problem.von_mises()]
     if problem.mixed:
         functions.append(problem.mixed.pressure())
-    if getattr(problem.material, "path_dependent", False):
+    if problem.material.path_dependent:
         functions += problem.material.output_fields()
     if problem.contact is not None:
         functions += problem.solver.contact.fields(problem.weight)
@@ -90,7 +92,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
         return checkpoint
 
     commit = None
-    if getattr(problem.material, "path_dependent", False):  # committed when a step converges
+    if problem.material.path_dependent:  # committed when a step converges
         def commit():
             problem.commit()
 

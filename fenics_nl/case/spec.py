@@ -18,6 +18,8 @@ from pathlib import Path
 from fenics_nl.materials import laws
 from fenics_nl.materials.plasticity import J2Plasticity
 
+__all__ = ["Case", "CaseError", "Condition", "Probe", "read_case"]
+
 FORMAT = """\
 [mesh]
 file = "part.geo"        # .msh, or .geo meshed by gmsh at run time (path relative to the case)

@@ -45,6 +45,8 @@ from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
+__all__ = ["ActiveSetContact", "ContactError", "EliminationSystem"]
+
 log = logging.getLogger(__name__)
 
 FORMULATIONS = ("elimination", "multiplier")

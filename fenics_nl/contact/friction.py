@@ -43,6 +43,8 @@ from fenics_nl.contact.active_set import ActiveSetContact, ContactError, log
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
+__all__ = ["FrictionalContact"]
+
 
 class FrictionalContact(ActiveSetContact):
     """The active-set loop with Coulomb friction (coefficient `friction`), elimination only.

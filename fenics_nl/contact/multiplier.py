@@ -40,6 +40,8 @@ from fenics_nl.solvers.snes import (
     unless_set,
 )
 
+__all__ = ["MultiplierSystem", "dofs_at"]
+
 
 class MultiplierSystem:
     """Block (u, λ) Newton solve for a given active set; used by ActiveSetContact."""

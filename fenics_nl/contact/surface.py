@@ -21,6 +21,8 @@ from petsc4py import PETSc
 
 from fenics_nl.materials.mixed import collapsed
 
+__all__ = ["ContactSurface", "nodal_quadrature", "vertex_of_dof"]
+
 
 class ContactSurface:
     """Nodes of S_C for the displacement space V, and the obstacle's gap at them.

@@ -1,1 +1,5 @@
-"""Meshes, their checks, and boundary conditions and reactions."""
+"""Meshes and what is written on them.
+
+Meshes (`meshes`, gmsh), their checks (`mesh_check`), boundary conditions and reactions
+(`boundary`), and point values of fields (`probes`).
+"""

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from dolfinx import fem
 
+__all__ = ["component", "fixed", "reactions"]
+
 
 def fixed(V: fem.FunctionSpace, facets: np.ndarray) -> fem.DirichletBC:
     """u = 0 on `facets` (V may be the displacement part of a mixed space)."""

@@ -13,6 +13,8 @@ import numpy as np
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
+__all__ = ["bad_cells", "check_cells"]
+
 
 def _facet_plane(xf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit normals and a point of each facet (rows of xf: facet, vertex, coordinate)."""

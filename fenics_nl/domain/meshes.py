@@ -6,6 +6,8 @@ import gmsh
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
+__all__ = ["graded_block", "quarter_annulus", "start_model"]
+
 
 def start_model(name: str) -> None:
     """A new model `name` in gmsh, with gmsh's default options.

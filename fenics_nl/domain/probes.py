@@ -13,6 +13,8 @@ import numpy as np
 from dolfinx import fem, geometry
 from mpi4py import MPI
 
+__all__ = ["Probes"]
+
 
 class Probes:
     """Points located once in a mesh; `outside` lists the indices of points it misses."""

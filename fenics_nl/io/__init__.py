@@ -1,1 +1,5 @@
-"""What a run hands its user: command line, VTX fields, pictures."""
+"""What a run hands its user.
+
+The command line (`cli`), VTX fields (`output`), pictures (`pictures`) and checkpoints
+(`checkpoint`).
+"""

@@ -29,6 +29,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+__all__ = ["CheckpointError", "Checkpoints", "fingerprint", "layout"]
+
 FORMAT = 2  # 2: a phase (was: segment) and the load path so far
 KEEP = 2  # complete steps kept (the last one, and the one before in case it is damaged)
 

@@ -32,6 +32,33 @@ from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
 
+__all__ = [
+    "ArgumentParser",
+    "Checkpointing",
+    "HelpFormatter",
+    "PetscOptions",
+    "add_checkpoints",
+    "add_outputs",
+    "arguments",
+    "at_least",
+    "check_output_paths",
+    "check_restart_paths",
+    "checkpointing",
+    "converged_step",
+    "error",
+    "finite",
+    "known",
+    "material_flags",
+    "on_failure",
+    "parse_with_petsc_options",
+    "parser",
+    "positive",
+    "results",
+    "run_file",
+    "run_scene",
+    "say",
+]
+
 # Errors that end a run with one line: bad parameters, solvers that cannot converge, a load
 # that cannot be reached (and PETSc refusing an option). Anything else is a bug and keeps
 # its traceback.

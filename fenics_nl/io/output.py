@@ -17,6 +17,17 @@ from pathlib import Path
 import numpy as np
 from dolfinx import fem
 
+__all__ = [
+    "FieldSeries",
+    "Grid",
+    "dofs",
+    "gather_grid",
+    "owned_cell_values",
+    "section",
+    "vertex_interpolant",
+    "write_fields",
+]
+
 
 def dofs(V: fem.FunctionSpace) -> int:
     """Global number of scalar unknowns of V (what the scenes report as `dofs`)."""

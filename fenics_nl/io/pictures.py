@@ -10,6 +10,15 @@ from dolfinx import fem
 from fenics_nl.io.output import gather_grid, owned_cell_values, vertex_interpolant
 from fenics_nl.parallel import gather_rows
 
+__all__ = [
+    "bracket_picture",
+    "deformed_picture",
+    "facet_points",
+    "off_screen",
+    "pyplot",
+    "save_figure",
+]
+
 
 def pyplot():
     """matplotlib.pyplot on the Agg backend: figures are files, no display is needed."""

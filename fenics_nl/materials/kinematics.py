@@ -10,6 +10,17 @@ from __future__ import annotations
 
 import ufl
 
+__all__ = [
+    "check_model",
+    "deformation_gradient",
+    "displacement_gradient",
+    "domain",
+    "green_lagrange",
+    "measure_weight",
+    "quadrature_measure",
+    "small_strain",
+]
+
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 
 

@@ -17,6 +17,19 @@ import ufl
 
 from fenics_nl.materials import kinematics
 
+__all__ = [
+    "FiniteStrain",
+    "Isotropic",
+    "LinearElastic",
+    "Material",
+    "NeoHookean",
+    "PowerLaw",
+    "SmallStrain",
+    "StVenantKirchhoff",
+    "check_range",
+    "von_mises_of",
+]
+
 
 def check_range(name: str, value: float, low: float, high: float) -> None:
     """Raise ValueError unless low < value < high (a bound may be ±inf)."""
@@ -99,10 +112,13 @@ class Material(ABC):
 
     `is_linear`: the residual is linear in u (Newton converges in one step, no line
     search needed). `finite_strain`: the energy is written in the Green–Lagrange strain.
+    `path_dependent`: the law has internal variables (`state_functions`, `commit` after a
+    converged step, `output_fields`), as J2 plasticity.
     """
 
     finite_strain: bool = False
     is_linear: bool = False
+    path_dependent: bool = False
 
     def modified_newton_tangent(self, u, model: str, dx):
         """The tangent modified Newton and BFGS keep: for an elastic law, "initial".

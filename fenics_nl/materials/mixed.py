@@ -32,6 +32,20 @@ from dolfinx import fem
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import von_mises_of
 
+__all__ = [
+    "DisplacementUnknown",
+    "MixedUnknown",
+    "cauchy_stress",
+    "collapsed",
+    "internal_work",
+    "modified_newton_tangent",
+    "preconditioner",
+    "taylor_hood",
+    "unknowns",
+    "von_mises",
+    "von_mises_expression",
+]
+
 
 def collapsed(V: fem.FunctionSpace):
     """(the collapsed space of the sub-space V, the parent dof of each of its dofs).
@@ -117,7 +131,7 @@ def modified_newton_tangent(material, unknown: MixedUnknown, model: str, dx):
 
     For a path-dependent law: the tangent of the same mixed form with Hooke's law (E, ν).
     """
-    if not getattr(material, "path_dependent", False):
+    if not material.path_dependent:
         return "initial"
     from fenics_nl.materials.laws import LinearElastic
 

@@ -28,6 +28,15 @@ from dolfinx import fem
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.materials.mixed import collapsed
 
+__all__ = [
+    "PlaneStressUnknown",
+    "elastic_tangent",
+    "internal_work",
+    "pointwise_element",
+    "stress",
+    "whole_strain",
+]
+
 
 def whole_strain(u, ez):
     """ε₃ of the in-plane displacement `u` and the out-of-plane strain `ez` (UFL)."""

@@ -29,7 +29,36 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
+__all__ = ["J2Plasticity", "PlasticState"]
+
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
+
+
+@dataclass(eq=False)
+class PlasticState:
+    """J2's committed state at the quadrature points, and its compiled update.
+
+    Empty until `bind`: the parameters of a `J2Plasticity` are frozen, its state is not.
+    """
+
+    eps_p: object = None  # the plastic strain ε_p (quadrature Function, 3x3)
+    p: object = None  # the cumulated plastic strain (quadrature Function)
+    points: object = None  # the quadrature points (reference cell)
+    commit: tuple | None = None  # (ε_p, p) of the return map as fem.Expressions, compiled once
+
+    def bind(self, mesh, degree: int) -> None:
+        """Zero ε_p and p at the quadrature points of `degree` on `mesh`."""
+        import basix.ufl
+        from dolfinx import fem
+
+        cell = mesh.basix_cell()
+        T = fem.functionspace(mesh, basix.ufl.quadrature_element(
+            cell, value_shape=(3, 3), scheme="default", degree=degree))
+        S = fem.functionspace(mesh, basix.ufl.quadrature_element(
+            cell, value_shape=(), scheme="default", degree=degree))
+        self.eps_p = fem.Function(T, name="plastic_strain")
+        self.p = fem.Function(S, name="cumulated_plastic_strain")
+        self.points, self.commit = T.element.interpolation_points, None
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,7 +73,7 @@ class J2Plasticity(Isotropic, SmallStrain):
     sigma0: float = 1.0
     H: float = 0.0
     C: float = 0.0
-    _state: dict | None = field(default=None, repr=False, compare=False)
+    state: PlasticState = field(default_factory=PlasticState, repr=False, compare=False)
 
     path_dependent = True
 
@@ -58,18 +87,7 @@ class J2Plasticity(Isotropic, SmallStrain):
 
     def bind(self, mesh, degree: int) -> None:
         """Create the state (zero) at the quadrature points of `degree` on `mesh`."""
-        import basix.ufl
-        from dolfinx import fem
-
-        cell = mesh.basix_cell()
-        T = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(3, 3), scheme="default", degree=degree))
-        S = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(), scheme="default", degree=degree))
-        state = {"eps_p": fem.Function(T, name="plastic_strain"),
-                 "p": fem.Function(S, name="cumulated_plastic_strain"),
-                 "points": T.element.interpolation_points, "commit": None}
-        object.__setattr__(self, "_state", state)  # the parameters stay frozen
+        self.state.bind(mesh, degree)
 
     def modified_newton_tangent(self, u, model: str, dx):
         """The course's choice for plasticity: Hooke's tangent (E, ν), factorized once.
@@ -84,18 +102,18 @@ class J2Plasticity(Isotropic, SmallStrain):
     def reset(self) -> None:
         """Back to the virgin state (a new load path on the same forms)."""
         st = self._bound()
-        st["eps_p"].x.array[:] = 0.0
-        st["p"].x.array[:] = 0.0
+        st.eps_p.x.array[:] = 0.0
+        st.p.x.array[:] = 0.0
 
     @property
     def plastic_strain(self):
         """The committed plastic strain ε_p (quadrature Function, 3x3)."""
-        return self._bound()["eps_p"]
+        return self._bound().eps_p
 
     @property
     def cumulated_plastic_strain(self):
         """The committed cumulated plastic strain p (quadrature Function)."""
-        return self._bound()["p"]
+        return self._bound().p
 
     def cumulated_plastic_strain_per_cell(self):
         """The largest committed p of each cell's quadrature points (DG0 Function)."""
@@ -110,7 +128,7 @@ class J2Plasticity(Isotropic, SmallStrain):
     def state_functions(self) -> dict:
         """The committed state's quadrature Functions by name (to checkpoint and restore)."""
         st = self._bound()
-        return {"plastic_strain": st["eps_p"], "cumulated_plastic_strain": st["p"]}
+        return {"plastic_strain": st.eps_p, "cumulated_plastic_strain": st.p}
 
     def output_fields(self) -> list:
         """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0."""
@@ -129,17 +147,17 @@ class J2Plasticity(Isotropic, SmallStrain):
         f.x.scatter_forward()
         return f
 
-    def _bound(self) -> dict:
-        if self._state is None:
+    def _bound(self) -> PlasticState:
+        if self.state.eps_p is None:
             raise ValueError("J2Plasticity has no state: call bind(mesh, quadrature degree) "
                              "before writing a form with it")
-        return self._state
+        return self.state
 
     def return_map(self, eps):
         """(ε_p, p, Δp) at the strain ε from the committed state (UFL, radial return)."""
         self.require_3x3(eps)
         st = self._bound()
-        eps_p_n, p_n = st["eps_p"], st["p"]
+        eps_p_n, p_n = st.eps_p, st.p
         mu = self.mu
         eps_e = eps - eps_p_n
         # dev σ_tr = 2μ dev ε_e: the bulk modulus (∞ at ν = 1/2) does not enter the return
@@ -188,9 +206,9 @@ class J2Plasticity(Isotropic, SmallStrain):
         from dolfinx import fem
 
         st = self._bound()
-        Q = st["p"].function_space
+        Q = st.p.function_space
         at_points = fem.Function(Q)
-        at_points.interpolate(fem.Expression(expression, st["points"]))
+        at_points.interpolate(fem.Expression(expression, st.points))
         f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
         _per_cell(at_points, f, np.mean)
         return f
@@ -207,17 +225,17 @@ class J2Plasticity(Isotropic, SmallStrain):
         from dolfinx import fem
 
         st = self._bound()
-        if st["commit"] is None:  # compiled once
+        if st.commit is None:  # compiled once
             eps_p, p, _ = self.return_map(strain)
-            st["commit"] = (fem.Expression(eps_p, st["points"]), fem.Expression(p, st["points"]))
-        new_eps_p, new_p = st["commit"]
+            st.commit = (fem.Expression(eps_p, st.points), fem.Expression(p, st.points))
+        new_eps_p, new_p = st.commit
         # evaluate both before storing: each reads the committed state
-        a = fem.Function(st["eps_p"].function_space)
+        a = fem.Function(st.eps_p.function_space)
         a.interpolate(new_eps_p)
-        b = fem.Function(st["p"].function_space)
+        b = fem.Function(st.p.function_space)
         b.interpolate(new_p)
-        st["eps_p"].x.array[:] = a.x.array
-        st["p"].x.array[:] = b.x.array
+        st.eps_p.x.array[:] = a.x.array
+        st.p.x.array[:] = b.x.array
 
 
 def _per_cell(at_points, cells, reduce) -> None:

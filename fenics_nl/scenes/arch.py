@@ -20,6 +20,8 @@ from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import StVenantKirchhoff
 
+__all__ = ["ShallowArch"]
+
 MODEL = "plane_stress"
 
 

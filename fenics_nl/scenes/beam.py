@@ -32,6 +32,8 @@ from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
 from fenics_nl.theory import elastica
 from fenics_nl.theory.elastica import euler_load
 
+__all__ = ["Beam", "Cantilever", "build_beam"]
+
 MATERIALS = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}
 # A load path that ends unstable is redone with 4x the steps, up to this many: small steps
 # through P_cr let the imperfection pick the buckled branch.

@@ -32,6 +32,8 @@ from fenics_nl.scenes import bracket_geometry
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
 
+__all__ = ["Bracket", "BracketPart", "build_bracket", "load_mesh"]
+
 GROUPS = ("bolts", "load", "base")
 THICKNESS_MM = bracket_geometry.THICK  # the base plate's thickness
 

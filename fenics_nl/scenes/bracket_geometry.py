@@ -17,6 +17,8 @@ import gmsh
 
 from fenics_nl.domain.meshes import start_model
 
+__all__ = ["build"]
+
 LENGTH, WIDTH, THICK, HEIGHT = 100.0, 60.0, 10.0, 80.0
 FILLET, BOLT_R, BOLT_X, LOAD_R, LOAD_Z = 8.0, 6.0, 70.0, 8.0, 60.0
 GROUPS = ("bolts", "load", "base")

@@ -40,6 +40,16 @@ from fenics_nl.parallel import gather_rows, global_max
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
 
+__all__ = [
+    "Indentation",
+    "Punch",
+    "PunchBlock",
+    "PunchLoad",
+    "Traction",
+    "build_punch",
+    "check_contact_resolution",
+]
+
 MODELS = ("axisymmetric", "3d", "plane-strain")
 MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
 FEW_NODES = 10  # below this, a and p0 are coarse: say so

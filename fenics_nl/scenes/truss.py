@@ -18,6 +18,8 @@ from mpi4py import MPI
 from fenics_nl.domain import boundary
 from fenics_nl.solvers.newton import NewtonSolver
 
+__all__ = ["VonMisesTruss"]
+
 
 class VonMisesTruss:
     """Half-span `a`, rise `h`, axial stiffness `EA`, reference apex load `P` (downwards)."""

@@ -26,6 +26,8 @@ from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
 
+__all__ = ["VesselBody"]
+
 SHAPES = ("sphere", "cylinder")
 
 

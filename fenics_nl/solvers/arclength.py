@@ -47,8 +47,10 @@ from petsc4py import PETSc
 
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.buckling import mode_nearest_zero, unstable_directions
-from fenics_nl.solvers.newton import NewtonSolver, _LinearSolveFailed
+from fenics_nl.solvers.newton import LinearSolveError, NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
+
+__all__ = ["ArcLength", "ArcState", "ContinuationError", "ContinuationPath", "CriticalPoint"]
 
 log = logging.getLogger(__name__)
 
@@ -157,6 +159,29 @@ class _Walk:
                   self.tangent):
             if v is not None:
                 v.destroy()
+
+
+@dataclass
+class _Corrector:
+    """What the corrector iterations of one step hold fixed."""
+
+    x0: PETSc.Vec  # u_n, where the step starts
+    lam0: float  # λ_n
+    q: PETSc.Vec  # the load vector q = −∂R/∂λ
+    q_norm: float
+    dq: PETSc.Vec | None  # K⁻¹q, renewed with the tangent (None at fixed λ)
+    ds: float | None  # the arc (None: at fixed λ, Newton under load control)
+
+
+@dataclass
+class _Increment:
+    """A converged increment from (u_n, λ_n), before it is classified."""
+
+    du: PETSc.Vec
+    dlam: float
+    iterations: int
+    ds: float | None  # the arc it used (shortened when aimed at the target)
+    aimed: bool = False  # its predictor was aimed at the target
 
 
 @dataclass
@@ -322,29 +347,20 @@ class ArcLength:
             w.destroy()
         return value * (self._scale or 1.0)
 
-    def _solve(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
-        """out = K⁻¹ rhs with the variant's tangent (BFGS: its corrected inverse)."""
-        s = self.solver
-        if s.bfgs:
-            s.bfgs.direction(rhs, s.du, lambda b: s._linear_solve(b, work))
-        else:
-            s._linear_solve(rhs, work)
-        s.du.copy(out)
-
     def _load_vector(self, lam: float, q: PETSc.Vec, work: WorkCounts) -> None:
-        """q = R(u, λ) − R(u, λ + 1); leaves R(u, λ) in the solver's b."""
+        """q = R(u, λ) − R(u, λ + 1); leaves R(u, λ) in the solver's residual vector."""
         s = self.solver
         self.set_load(lam + 1.0)
-        s._residual(work)
-        s.b.copy(q)
+        s.residual(work)
+        s.residual_vector.copy(q)
         self.set_load(lam)
-        s._residual(work)
-        q.aypx(-1.0, s.b)
+        s.residual(work)
+        q.aypx(-1.0, s.residual_vector)
 
     # -- one step ----------------------------------------------------------------------
 
     def _step(self, lam0: float, ds: float, previous, kick, work: WorkCounts, norms: list,
-              target: float | None = None, tangent: PETSc.Vec | None = None):
+              target: float | None = None, tangent: PETSc.Vec | None = None) -> _Increment:
         """From the converged (u_n, λ_n) to the next state at arc length ds.
 
         `previous`: the last step's (Δu, Δλ), for the predictor's sense and the root
@@ -352,14 +368,12 @@ class ArcLength:
         `target` is shortened to end there; `tangent`: K(u_n)⁻¹q if the stability check
         made it: full and periodic Newton, which build a new tangent at the first corrector
         iteration, then need no factorization for the predictor (modified Newton and BFGS
-        factorize K(u_n) here anyway: it is their tangent for the step). Returns (Δu, Δλ,
-        iterations, the arc used, whether it was aimed at the target).
+        factorize K(u_n) here anyway: it is their tangent for the step). Returns the
+        converged increment.
         """
         s = self.solver
         x = s.u.x.petsc_vec
-        s.policy.start_solve()
-        if s.bfgs:
-            s.bfgs.clear()
+        s.start_solve()
         if self._q is None:
             self._q = x.duplicate()
         q, dq = self._q, x.duplicate()
@@ -381,9 +395,8 @@ class ArcLength:
         if kick is None and tangent is not None and s.method in ("full", "periodic"):
             tangent.copy(dq)  # the corrector's first iteration builds its own tangent
         else:
-            if s.policy.needs_tangent(0):
-                s._assemble_tangent(work)
-            self._solve(q, dq, work)
+            s.update_tangent(0, work)
+            s.solve_linear(q, dq, work)
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)
         aimed = False
@@ -400,8 +413,10 @@ class ArcLength:
             dq.copy(du)
             du.scale(dlam)
         try:
-            return (*self._correct(x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms), ds,
-                    aimed)
+            increment = self._correct(_Corrector(x0, lam0, q, q_norm, dq, ds), du, dlam,
+                                      work, norms)
+            increment.aimed = aimed
+            return increment
         except _StepFailed:
             self._back_to(x0, lam0)
             du.destroy()
@@ -410,70 +425,71 @@ class ArcLength:
             for v in (dq, x0):
                 v.destroy()
 
-    def _correct(self, x0, lam0, du, dlam, ds, q, q_norm, dq, work, norms):
-        """Corrector iterations on the arc: (Δu, Δλ, iterations), or _StepFailed.
+    def _correct(self, c: _Corrector, du: PETSc.Vec, dlam: float, work: WorkCounts,
+                 norms: list) -> _Increment:
+        """Corrector iterations from the predictor (u_n + Δu, λ_n + Δλ) back onto the arc.
 
-        `ds` None: at fixed λ (load control: no back-solve for q).
+        At fixed λ (`c.ds` None) to equilibrium. Returns the converged increment (`du`,
+        updated in place), or raises _StepFailed.
         """
         s = self.solver
+        bfgs = s.method == "bfgs"
         x = s.u.x.petsc_vec
-        x0.copy(x)
+        c.x0.copy(x)
         x.axpy(1.0, du)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        lam = lam0 + dlam
-        self.set_load(lam)
+        self.set_load(c.lam0 + dlam)
         dr = x.duplicate()
         b_old, ddu, ddlam = None, None, 0.0  # the last correction, for a BFGS pair
         on_arc = True  # the predictor is on the arc
         try:
             for k in range(s.max_it + 1):
-                rnorm = s._residual(work)
+                rnorm = s.residual(work)
+                b = s.residual_vector
                 norms.append(rnorm)
                 if b_old is not None:  # y = ΔF_int = ΔR + δλ q, s = δu
-                    y = s.b.copy()
+                    y = b.copy()
                     y.axpy(-1.0, b_old)
-                    y.axpy(ddlam, q)
-                    s.bfgs.store_pair(ddu, y)
+                    y.axpy(ddlam, c.q)
+                    s.add_secant_pair(ddu, y)
                     b_old.destroy()
                     b_old = None
                 if not math.isfinite(rnorm) or rnorm > s.divergence_tol * max(norms[0], 1e-300):
                     raise _StepFailed(f"residual {rnorm:.3e} at iteration {k}")
                 self._largest = max(self._largest, norms[0])
-                threshold = max(s.rtol * norms[0], s.atol * q_norm)
+                threshold = max(s.rtol * norms[0], s.atol * c.q_norm)
                 if on_arc and (rnorm <= threshold
                                or _at_round_off(norms, self._largest, threshold)):
-                    return du, dlam, k
+                    return _Increment(du, dlam, k, c.ds)
                 if k == s.max_it:
                     raise _StepFailed(f"no convergence in {s.max_it} iterations "
                                       f"(|R| = {rnorm:.3e})")
-                if s.policy.needs_tangent(k):
-                    s._assemble_tangent(work)
-                    if ds is not None:
-                        self._solve(q, dq, work)
-                elif s.bfgs and k > 0 and ds is not None:
-                    self._solve(q, dq, work)  # H changed with the last pair
-                if s.bfgs:
-                    b_old = s.b.copy()
-                self._solve(s.b, dr, work)  # the correction's part −K⁻¹R is −dr
-                ddlam, on_arc = (0.0, True) if ds is None else self._root(du, dlam, dr, dq,
-                                                                           ds)
+                if s.update_tangent(k, work):
+                    if c.ds is not None:
+                        s.solve_linear(c.q, c.dq, work)
+                elif bfgs and k > 0 and c.ds is not None:
+                    s.solve_linear(c.q, c.dq, work)  # H changed with the last pair
+                if bfgs:
+                    b_old = b.copy()
+                s.solve_linear(b, dr, work)  # the correction's part −K⁻¹R is −dr
+                ddlam, on_arc = ((0.0, True) if c.ds is None else
+                                 self._root(du, dlam, dr, c.dq, c.ds))
                 step = dr.copy()
                 step.scale(-1.0)
                 if ddlam:
-                    step.axpy(ddlam, dq)  # δu = −dr + δλ dq
+                    step.axpy(ddlam, c.dq)  # δu = −dr + δλ dq
                 du.axpy(1.0, step)
                 x.axpy(1.0, step)
                 # U = g on the Dirichlet dofs exactly, whatever the linear solver's accuracy
                 petsc.set_bc(x, s.bcs)
                 x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
                 dlam += ddlam
-                lam = lam0 + dlam
-                self.set_load(lam)
-                if s.bfgs:
+                self.set_load(c.lam0 + dlam)
+                if bfgs:
                     ddu = step
                 else:
                     step.destroy()
-        except _LinearSolveFailed as err:
+        except LinearSolveError as err:
             raise _StepFailed(str(err)) from None
         finally:
             dr.destroy()
@@ -597,9 +613,11 @@ class ArcLength:
         t0 = time.perf_counter()
         work, norms = WorkCounts(), []
         try:
-            du, dlam, its, walk.ds, aimed = self._step(
-                walk.lam, walk.ds, walk.previous, walk.kick, work, norms,
-                None if walk.bracket else target, walk.tangent)
+            increment = self._step(walk.lam, walk.ds, walk.previous, walk.kick, work, norms,
+                                   None if walk.bracket else target, walk.tangent)
+            du, dlam, its, aimed = (increment.du, increment.dlam, increment.iterations,
+                                    increment.aimed)
+            walk.ds = increment.ds
             if walk.kick is None and walk.previous is not None and self._turns_back(
                     du, dlam, walk.previous):
                 du.destroy()
@@ -800,17 +818,15 @@ class ArcLength:
         end = x.copy()
         start = before if abs(target - lam_old) < abs(lam - target) else end
         self._back_to(start, target)
-        s.policy.start_solve()
-        if s.bfgs:
-            s.bfgs.clear()
+        s.start_solve()
         self._load_vector(target, self._q, work)
         du = x.duplicate()
         du.set(0.0)
         origin = start.copy()
         own = []  # its own residual history: its rtol and round-off tests start from it
         try:
-            return self._correct(origin, target, du, 0.0, None, self._q, self._q.norm(),
-                                 None, work, own)[2]
+            return self._correct(_Corrector(origin, target, self._q, self._q.norm(), None,
+                                            None), du, 0.0, work, own).iterations
         except _StepFailed as err:
             log.info("landing at λ = %g failed: %s", target, err)
             self._back_to(end, lam)

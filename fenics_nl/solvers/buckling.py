@@ -17,6 +17,15 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+__all__ = [
+    "critical_loads",
+    "geometric_stiffness",
+    "lowest_tangent_mode",
+    "mode_nearest_zero",
+    "negative_eigenvalues",
+    "unstable_directions",
+]
+
 
 def geometric_stiffness(stress, du, v, gradient=ufl.grad):
     """Integrand of a_G(du, v) = σ₀ : (∇duᵀ·∇v) for a (linear) pre-stress σ₀."""

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+__all__ = ["observed_orders"]
+
 
 def observed_orders(errors: Sequence[float], floor: float = 0.0) -> list[float]:
     """q_k = ln(e_{k+1}/e_k) / ln(e_k/e_{k-1}) over consecutive triples above `floor`.

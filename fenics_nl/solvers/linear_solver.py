@@ -11,6 +11,8 @@ import numpy as np
 from dolfinx import fem, la
 from petsc4py import PETSc
 
+__all__ = ["block_preconditioned_ksp", "create_ksp", "rigid_body_modes"]
+
 KINDS = ("lu", "cholesky", "gamg")
 
 

@@ -27,6 +27,8 @@ import numpy as np
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
+__all__ = ["DriverState", "LoadPath", "LoadStepError", "solve_incrementally"]
+
 log = logging.getLogger(__name__)
 
 

@@ -51,6 +51,16 @@ from fenics_nl.solvers.linear_solver import (
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.supports import RigidMotions, check_supports
 
+__all__ = [
+    "ConvergenceError",
+    "InverseBFGS",
+    "LinearSolveError",
+    "NewtonSolver",
+    "TangentPolicy",
+    "forcing_term",
+    "stalled_at_round_off",
+]
+
 log = logging.getLogger(__name__)
 
 METHODS = ("full", "modified", "periodic", "bfgs")
@@ -205,9 +215,12 @@ class InverseBFGS:
         self.pairs.clear()
 
 
-class _LinearSolveFailed(Exception):
+class LinearSolveError(Exception):
+    """The KSP did not converge (`reason`: its negative converged reason)."""
+
     def __init__(self, reason: int):
         super().__init__(f"linear solver failed (KSP reason {reason})")
+        self.reason = reason
 
 
 class NewtonSolver:
@@ -417,11 +430,9 @@ class NewtonSolver:
         """Run the loop from the current `u`; raise ConvergenceError on failure."""
         t_start = time.perf_counter()
         work = WorkCounts()
-        self.policy.start_solve()
-        if self.bfgs:
-            self.bfgs.clear()
+        self.start_solve()
         lift = self._boundary_moved()  # the first correction carries g − U (see the module)
-        norms = [self._residual(work, lift=lift)]
+        norms = [self.residual(work, lift=lift)]
         elapsed = [time.perf_counter() - t_start]
         k = 0
 
@@ -447,16 +458,12 @@ class NewtonSolver:
                                        f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
                                        result(False, "diverged"))
             try:
-                if self.policy.needs_tangent(k):
-                    self._assemble_tangent(work)
+                self.update_tangent(k, work)
                 if self.forcing:
                     self.ksp.setTolerances(rtol=forcing_term(rnorm / norms[0]))
-                if self.bfgs:
-                    b_old = self.b.copy()
-                    self.bfgs.direction(self.b, self.du, lambda q: self._linear_solve(q, work))
-                else:
-                    self._linear_solve(self.b, work)
-            except _LinearSolveFailed as err:
+                b_old = self.b.copy() if self.bfgs else None
+                self.solve_linear(self.b, self.du, work)
+            except LinearSolveError as err:
                 raise ConvergenceError(f"{err} at iteration {k}", result(False, "ksp")) from None
             alpha, rnorm_new = self._step(rnorm, work, full_step=lift)
             norms.append(rnorm_new)
@@ -467,6 +474,79 @@ class NewtonSolver:
                 b_old.destroy()
             lift = False
             k += 1
+
+    # -- the step interface: what `solve`, arc-length and any other driver are written on --
+
+    def start_solve(self) -> None:
+        """A new solve begins: the variant's tangent policy restarts, BFGS forgets its pairs."""
+        self.policy.start_solve()
+        if self.bfgs:
+            self.bfgs.clear()
+
+    def residual(self, work: WorkCounts, lift: bool = False) -> float:
+        """Assemble R(u) into `residual_vector` (u − g on the Dirichlet rows); its ‖·‖.
+
+        The norm is taken off the Dirichlet rows: a force, the equilibrium imbalance.
+        `lift`: also b −= K (u − g) on the Dirichlet columns, so that the correction
+        δU = −K⁻¹b moves the boundary to g and the interior with it.
+        """
+        with _Timer(work, "residual"):
+            with self.b.localForm() as loc:
+                loc.set(0.0)
+            petsc.assemble_vector(self.b, self._R)
+            x = self.u.x.petsc_vec
+            if lift:
+                petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
+            self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            if self._nodal_load is not None:
+                dofs, values = self._nodal_load
+                self.b.array[dofs] -= values
+            if self._springs is not None:
+                dofs, k, anchor = self._springs
+                stretch = self.u.x.array[dofs] - anchor
+                self.b.array[dofs] += np.einsum("nij,nj->ni", k, stretch)
+            petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
+            work.residual_assemblies += 1
+            return self._force_norm()
+
+    @property
+    def residual_vector(self) -> PETSc.Vec:
+        """The residual of the last `residual` call (read it, do not keep it)."""
+        return self.b
+
+    def update_tangent(self, k: int, work: WorkCounts) -> bool:
+        """Rebuild (and factorize) the tangent at iteration `k` if the variant says so.
+
+        full: always; modified and bfgs: at k = 0 of a solve, or never (a tangent for the
+        solver's life); periodic: every `period` iterations. Returns whether it did.
+        """
+        if not self.policy.needs_tangent(k):
+            return False
+        self._assemble_tangent(work)
+        return True
+
+    def solve_linear(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
+        """out = K⁻¹ rhs with the current operator (BFGS: its corrected inverse H rhs).
+
+        The Newton correction of a residual b is −K⁻¹b. LinearSolveError if the KSP fails.
+        """
+        if self.bfgs:
+            self.bfgs.direction(rhs, self.du, lambda b: self._linear_solve(b, work))
+        else:
+            self._linear_solve(rhs, work)
+        if out is not self.du:
+            self.du.copy(out)
+
+    def add_secant_pair(self, s: PETSc.Vec, y: PETSc.Vec) -> None:
+        """BFGS: keep the pair of a correction, s = δu and y = δR.
+
+        The solver then owns both vectors (the other variants destroy them).
+        """
+        if self.bfgs:
+            self.bfgs.store_pair(s, y)
+        else:
+            s.destroy()
+            y.destroy()
 
     # -- pieces ----------------------------------------------------------------------
 
@@ -488,31 +568,6 @@ class NewtonSolver:
         moved = gap.norm(PETSc.NormType.NORM_INFINITY)
         gap.destroy()
         return moved > 0
-
-    def _residual(self, work: WorkCounts, lift: bool = False) -> float:
-        """b = R(u) with b[bc] = u − g; returns ‖b‖ off the Dirichlet rows (a force).
-
-        `lift`: also b −= K (u − g) on the Dirichlet columns, so that the correction δU = −K⁻¹b
-        moves the boundary to g and the interior with it.
-        """
-        with _Timer(work, "residual"):
-            with self.b.localForm() as loc:
-                loc.set(0.0)
-            petsc.assemble_vector(self.b, self._R)
-            x = self.u.x.petsc_vec
-            if lift:
-                petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
-            self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            if self._nodal_load is not None:
-                dofs, values = self._nodal_load
-                self.b.array[dofs] -= values
-            if self._springs is not None:
-                dofs, k, anchor = self._springs
-                stretch = self.u.x.array[dofs] - anchor
-                self.b.array[dofs] += np.einsum("nij,nj->ni", k, stretch)
-            petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
-            work.residual_assemblies += 1
-            return self._force_norm()
 
     def _force_norm(self) -> float:
         """‖b‖ without the Dirichlet rows: the equilibrium imbalance.
@@ -606,7 +661,7 @@ class NewtonSolver:
             self._factorize(work)
             return self._linear_solve(rhs, work, retry=False)
         if reason < 0:
-            raise _LinearSolveFailed(reason)
+            raise LinearSolveError(reason)
         if self.policy.reuse:  # many iterations: cheaper to refactorize next time
             self.policy.krylov_iterations(its)
 
@@ -647,7 +702,7 @@ class NewtonSolver:
         # inexact CG leaves them off by its tolerance): the residual drops those rows
         petsc.set_bc(x, self.bcs)
         x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-        return self._residual(work)
+        return self.residual(work)
 
     def _critical_point(self, rnorm: float, work: WorkCounts) -> tuple[float, float]:
         """The ``slope`` search of `_step`: α where R(u − α du)·du = 0 (secant, ≤ 6 steps).

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 
 from fenics_nl.solvers.convergence import observed_orders
 
+__all__ = ["SolveResult", "WorkCounts"]
+
 PHASES = ("residual", "tangent", "factorization", "solve")
 
 

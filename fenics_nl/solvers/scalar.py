@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 from fenics_nl.solvers.convergence import observed_orders
 
+__all__ = ["ScalarResult", "ScalarSolveError", "solve"]
+
 METHODS = ("newton", "modified", "secant")
 DIVERGED = 1e8  # |r(u_k)| / |r(u_0)| beyond which the iteration is declared divergent
 

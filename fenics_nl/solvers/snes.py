@@ -20,6 +20,15 @@ from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.supports import RigidMotions, check_supports
 
+__all__ = [
+    "EventCounter",
+    "SnesSolver",
+    "all_event_names",
+    "petsc_work",
+    "scale_absolute_tolerance",
+    "unless_set",
+]
+
 # PETSc event names behind each count; MUMPS factorizations log as Mat*FactorNum.
 EVENTS = {
     "residual_assemblies": "SNESFunctionEval",

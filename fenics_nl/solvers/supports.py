@@ -32,6 +32,8 @@ from petsc4py import PETSc
 
 from fenics_nl.errors import SupportError
 
+__all__ = ["RigidMotions", "check_supports", "constrained_dofs", "free_motions"]
+
 KINEMATIC_TOL = 1e-10  # normalized Gram eigenvalue of a motion the constraints do not touch
 ENERGY_TOL = 1e-10  # ‖K r‖ / (‖r‖ max|K_ii|) of a motion the tangent does not resist
 AXES = "xyz"

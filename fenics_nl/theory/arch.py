@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import math
 
+__all__ = ["limit_load", "limit_rise", "load"]
+
 
 def load(rise: float, initial_rise: float) -> float:
     """q₀/(EI k⁴ r) at midspan rise ā = a/r, for the unloaded rise ē = e/r."""
@@ -37,8 +39,3 @@ def limit_rise(initial_rise: float) -> float:
 def limit_load(initial_rise: float) -> float:
     """q₀/(EI k⁴ r) at the limit point."""
     return load(limit_rise(initial_rise), initial_rise)
-
-
-def symmetric_snap(initial_rise: float) -> bool:
-    """Whether the limit point comes before the antisymmetric bifurcation (ē < √22)."""
-    return initial_rise < math.sqrt(22)

@@ -12,6 +12,8 @@ import math
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
+__all__ = ["euler_load", "load_ratio", "shape", "tip_position", "tip_rotation"]
+
 
 def euler_load(E: float, I: float, L: float) -> float:  # noqa: E741
     """P_cr = π² E I / (4 L²) of a clamped–free column."""

@@ -4,6 +4,14 @@ from __future__ import annotations
 
 import math
 
+__all__ = [
+    "cylinder_from_force",
+    "effective_modulus",
+    "pressure_profile",
+    "sphere_from_force",
+    "sphere_from_indentation",
+]
+
 
 def effective_modulus(E: float, nu: float) -> float:
     """E* = E / (1 − ν²) (rigid indenter)."""

@@ -13,6 +13,14 @@ import math
 
 import numpy as np
 
+__all__ = [
+    "cylinder_stick_half_width",
+    "sphere_stick_radius",
+    "sphere_tangential_displacement",
+    "sphere_tangential_force_within",
+    "traction",
+]
+
 
 def _load_ratio(Q: float, fP: float) -> float:
     if not (fP > 0 and 0 <= Q < fP):

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import math
 
+__all__ = ["limit_displacements", "limit_load", "load"]
+
 
 def load(w: float, EA: float, a: float, h: float) -> float:
     """The apex load P at downward apex displacement w (exact, SVK bars)."""

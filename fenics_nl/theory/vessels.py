@@ -14,6 +14,17 @@ import math
 
 from scipy.optimize import brentq
 
+__all__ = [
+    "elastic_inner_compliance",
+    "elastic_stresses",
+    "limit_pressure",
+    "plastic_radius",
+    "residual_hoop_stress_inner",
+    "sphere_inner_displacement",
+    "von_mises",
+    "yield_onset_pressure",
+]
+
 
 def limit_pressure(shape: str, a: float, b: float, sigma0: float) -> float:
     """The pressure at which the whole wall is plastic."""

@@ -11,6 +11,8 @@ from mpi4py import MPI
 
 from fenics_nl.materials import kinematics
 
+__all__ = ["Problem", "cantilever_3d"]
+
 
 @dataclass
 class Problem:

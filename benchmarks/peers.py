@@ -29,6 +29,8 @@ from fenics_nl.solvers.snes import (
     unless_set,
 )
 
+__all__ = ["solve_friction_penalty", "solve_penalty", "solve_snes_vi"]
+
 
 def _surface_measure(punch):
     fdim = punch.mesh.topology.dim - 1
