@@ -38,7 +38,7 @@ R, DELTA, F, SHIFT = 1.0, 0.01, 0.3, 0.0023
 
 
 def cylinder(refine: int):
-    return build_punch("plane-strain", LinearElastic(1.0, 0.5), R, math.sqrt(R * DELTA),
+    return build_punch("plane_strain", LinearElastic(1.0, 0.5), R, math.sqrt(R * DELTA),
                        refine=refine, block=100.0, mixed=True, tangential=True, friction=F)
 
 

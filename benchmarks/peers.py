@@ -114,7 +114,7 @@ def solve_friction_penalty(punch, delta: float, shift: float, stiffness: float,
     Coulomb bound. Both conditions hold only as k → ∞, at the nodes (a nodal rule on S_C:
     P1 in 3D), so the limit is the active set's discrete problem. The parabolic gap.
     """
-    if punch.model not in ("plane-strain", "3d") or punch.gap_shape != "parabola":
+    if punch.model not in ("plane_strain", "3d") or punch.gap_shape != "parabola":
         raise ValueError("the friction penalty peer is written for the plane-strain "
                          "cylinder and the 3D sphere, with the parabolic gap")
     u, c = punch.u, punch.contact

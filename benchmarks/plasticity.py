@@ -51,8 +51,7 @@ HERE = Path(__file__).resolve().parent
 VESSEL = HERE.parent / "demos" / "pressure_vessel.py"
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 SPHERE_VARIANTS = ("full", "modified", "bfgs", "snes")
-BRACKET_VARIANTS = {"full": "full", "modified": "modified", "bfgs": "quasi-newton",
-                    "snes": "snes"}
+BRACKET_VARIANTS = {"full": "full", "modified": "modified", "bfgs": "bfgs", "snes": "snes"}
 SPHERE_STEPS, BRACKET_STEPS = 10, 4
 
 

@@ -54,7 +54,7 @@ if __name__ == "__main__":  # `python demos/bracket.py [options]`: the cells bel
     sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
 
 comm = MPI.COMM_WORLD
-VARIANTS = ("full", "modified", "periodic", "quasi-newton", "snes")
+VARIANTS = ("full", "modified", "periodic", "bfgs", "snes")
 MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit
 DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README table)
 # -
@@ -76,7 +76,7 @@ def parser():
                "-bracket_ksp_view. An option no solver reads is an error.")
     p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
                    help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
-    p.add_argument("--newton", choices=VARIANTS, default=None,
+    p.add_argument("--newton", choices=VARIANTS, default=None, type=cli.spelling("--newton"),
                    help="non-linear solver (default full)")
     p.add_argument("--compare", action="store_true",
                    help="run every variant on the same mesh and print one table")
@@ -94,10 +94,11 @@ def parser():
                    help="Lagrange degree (P1 is far too stiff here: see the README)")
     p.add_argument("--mixed", action="store_true",
                    help="Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
-                        "--solver iterative: MINRES with a block preconditioner)")
+                        "--solver gamg: MINRES with a block preconditioner)")
     p.add_argument("--mesh", metavar="MSH",
                    help="a .msh file with groups bolts, load, base (in --units; not with --size)")
-    p.add_argument("--solver", choices=["direct", "iterative"], default="direct",
+    p.add_argument("--solver", choices=["lu", "gamg"], default="lu",
+                   type=cli.spelling("--solver"),
                    help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
     p.add_argument("--material", choices=["power-law", "j2", "linear"], default="power-law",
                    help="the power law below; j2: von Mises plasticity (sigma0, --hardening), "
@@ -224,7 +225,7 @@ def solve(newton):
         material.reset()
     b = Bracket(part, material, residual, newton=newton, force_scale=args.force,
                 tolerance=args.tolerance, friction=args.friction,
-                linear_solver="lu" if args.solver == "direct" else "gamg")
+                linear_solver=args.solver)
     say(f"{b.dofs} unknowns (P{args.degree}), {newton} Newton, {args.steps} load steps")
     steps = []
 

@@ -74,10 +74,11 @@ def parser():
         "Rigid spherical punch on an elastic block (Hertz contact, the course's active set). "
         "Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa).",
         epilog="PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
-               "<model> = axisymmetric | 3d | planestrain, <form> = elim (KSP of each "
+               "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
                "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
                "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--model", choices=["axisymmetric", "3d", "plane-strain"],
+    p.add_argument("--model", choices=["axisymmetric", "3d", "plane_strain"],
+                   type=cli.spelling("--model"),
                    default="axisymmetric", help="axisymmetric (r,z), 3D quarter, plane strain")
     p.add_argument("--E", type=cli.positive, default=1.0, help="Young's modulus [stress]")
     p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
@@ -138,7 +139,7 @@ def parser():
 
 p = parser()
 args = cli.arguments(p, prefixes=lambda a: {
-    f"punch_{a.model.replace('-', '')}_{a.formulation[:4]}_":
+    f"punch_{a.model}_{a.formulation[:4]}_":
         "KSP" if a.formulation == "elimination" else "SNES and KSP"})
 # j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
 cli.material_flags(p, args, power_law={"sigma0": 0.01, "n": 0.3},
@@ -167,7 +168,7 @@ if args.tangential_displacement is not None and not args.tangential_displacement
     p.error(f"--tangential-displacement must be > 0 (along +x), got "
             f"{args.tangential_displacement}")
 if moved and args.model == "axisymmetric":
-    p.error("a tangential load breaks the axial symmetry: use --model plane-strain or 3d")
+    p.error("a tangential load breaks the axial symmetry: use --model plane_strain or 3d")
 if args.friction is not None and args.formulation == "multiplier":
     p.error("--friction is written for --formulation elimination")
 if args.tangential_ratio is not None and not 0 <= args.tangential_ratio < 1:
@@ -190,7 +191,7 @@ if args.tangential_force is not None and args.tangential_force < 0:
 E, nu, R = args.E, args.nu, args.radius
 if args.force is None:
     a = math.sqrt(R * abs(args.indentation))
-elif args.model == "plane-strain":
+elif args.model == "plane_strain":
     a = hertz.cylinder_from_force(E, nu, R, args.force)["contact_radius"]
 else:
     a = hertz.sphere_from_force(E, nu, R, args.force)["contact_radius"]
@@ -313,7 +314,7 @@ else:
                                                          "max_pressure") if k in ref}
     checked = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
                f"{100 * e:+.3f} %)" for k, e in errors.items()]
-    if args.model == "plane-strain":  # a cylinder: Hertz's a and p0 for the computed P
+    if args.model == "plane_strain":  # a cylinder: Hertz's a and p0 for the computed P
         checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
     say("; ".join(checked) + f"; h = {block.h:.2g}")
 exponent = None
@@ -321,7 +322,7 @@ loading = states[: args.steps]
 if len(loading) >= 2 and all(s.force > 0 for s in loading):
     exponent = float(np.polyfit(np.log([s.indentation for s in loading]),
                                 np.log([s.force for s in loading]), 1)[0])
-    say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if args.model == "plane-strain"
+    say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if args.model == "plane_strain"
                                                    else " (Hertz: 1.5)"))
 # -
 
@@ -447,7 +448,7 @@ def summary():
            "reactions": punch.reactions(),
            "reactions_of": {"axisymmetric": "the whole body (2πr in the residual)",
                             "3d": "the modelled half" if moved else "the modelled quarter",
-                            "plane-strain": "the whole block, per unit length" if moved
+                            "plane_strain": "the whole block, per unit length" if moved
                             else "the modelled half, per unit length"}[args.model],
            "dofs": punch.dofs, "ranks": comm.size, "warnings": warnings}
     if exponent is not None:
@@ -478,7 +479,7 @@ def summary():
         pq = material.cumulated_plastic_strain
         n_owned = pq.function_space.dofmap.index_map.size_local
         out["max_cumulated_plastic_strain"] = global_max(comm, pq.x.array[:n_owned])
-    if args.model == "plane-strain" and ref is not None:
+    if args.model == "plane_strain" and ref is not None:
         warnings.append("plane strain: the force is not checked (a cylinder's indentation "
                         "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
                         "checked against Hertz for the computed P")
@@ -495,12 +496,12 @@ def plot(punch, states, ref, args):
     d = np.array([0.0] + [s.indentation for s in states])
     P = np.array([0.0] + [s.force for s in states])
     ax1.plot(d, P, "o", label="active set (FE)")
-    if args.model != "plane-strain":
+    if args.model != "plane_strain":
         dd = np.linspace(0, d.max(), 100)
         Es = hertz.effective_modulus(args.E, args.nu)
         ax1.plot(dd, 4 / 3 * Es * np.sqrt(args.radius) * dd**1.5, "-", label="Hertz")
     ax1.set_xlabel("indentation δ [length]")
-    ax1.set_ylabel("force P [force]" + (" per unit length" if args.model == "plane-strain"
+    ax1.set_ylabel("force P [force]" + (" per unit length" if args.model == "plane_strain"
                                         else ""))
     ax1.legend()
     ax1.grid(alpha=0.3)
@@ -523,7 +524,7 @@ def _checked(state, ref, args):
         return f"{args.model} punch: no contact (δ = {state.indentation:.3g})"
     a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
     p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
-    if args.model == "plane-strain":
+    if args.model == "plane_strain":
         return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
                 f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
     if args.force is not None:  # P prescribed: the check is on the indentation it needs

@@ -39,3 +39,20 @@ def test_a_dolfinx_script_that_imports_dolfinx_first_runs_in_the_venv(tmp_path):
     proc = subprocess.run([sys.executable, script], capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 0 and proc.stdout.strip() == "8", proc.stderr
+
+
+def test_an_old_spelling_is_read_said_once_and_never_written(tmp_path, demo):
+    # one vocabulary (fenics_nl.vocabulary): plane_strain, bfgs, lu/gamg; the old spellings
+    # still read, each with one note, and the outputs use the new one
+    import json
+
+    from fenics_nl.vocabulary import OLD_SPELLINGS, canonical
+
+    proc = demo.run(["punch.py", "--model", "plane-strain", "--refine", "0", "--json",
+                     tmp_path / "p.json"])
+    notes = [line for line in proc.stderr.splitlines() if line.startswith("note:")]
+    assert len(notes) == 1 and "'plane_strain'" in notes[0], proc.stderr
+    assert json.loads((tmp_path / "p.json").read_text())["model"] == "plane_strain"
+    assert {canonical(old, "x") for old in OLD_SPELLINGS} == {"bfgs", "plane_strain",
+                                                              "plane_stress", "lu", "gamg"}
+    assert canonical("full", "x") == "full"

@@ -13,10 +13,10 @@ from fenics_nl.contact.friction import FrictionalContact
 
 # the plane-strain cylinder of Cattaneo-Mindlin: a rigid punch (R = 1, δ = 0.01) on an
 # incompressible block (Taylor-Hood), h = a/24, 100 a wide
-INCOMPRESSIBLE_CYLINDER = ("--model", "plane-strain", "--mixed", "--nu", "0.5", "--refine", "0",
+INCOMPRESSIBLE_CYLINDER = ("--model", "plane_strain", "--mixed", "--nu", "0.5", "--refine", "0",
                            "--block", "100", "--friction", "0.3")
 # the same on a compressible P1 block: cheap, but not Cattaneo-Mindlin's (Spence's coupling)
-COMPRESSIBLE_CYLINDER = ("--model", "plane-strain", "--refine", "0", "--block", "100")
+COMPRESSIBLE_CYLINDER = ("--model", "plane_strain", "--refine", "0", "--block", "100")
 
 
 def jenkins_element(k_n, k_t, delta, f):
@@ -105,7 +105,7 @@ def test_force_control_reaches_the_tangential_force_and_coulombs_law_holds():
     from fenics_nl.scenes.punch import build_punch
 
     f = 0.3
-    punch = build_punch("plane-strain", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0,
+    punch = build_punch("plane_strain", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0,
                         block=100.0, tangential=True, friction=f)
     pressed = punch.indent(0.01)
     punch.commit()
@@ -208,7 +208,7 @@ def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
 def test_friction_two_ranks_give_the_serial_answer(demo):
     # a block 10 a wide: there the partition cuts the contact zone (both ranks own stick
     # and slip nodes: `test_friction_on_a_cut_contact_zone` checks it)
-    args = ("--model", "plane-strain", "--refine", "0", "--block", "10", "--friction", "0.3",
+    args = ("--model", "plane_strain", "--refine", "0", "--block", "10", "--friction", "0.3",
             "--tangential-displacement", "0.002")
     s, p = demo.punch(*args), demo.punch(*args, ranks=2)
     assert p["ranks"] == 2
@@ -218,13 +218,13 @@ def test_friction_two_ranks_give_the_serial_answer(demo):
 
 @pytest.mark.parametrize("args,words", [
     (["--friction", "-0.1"], "--friction must be >= 0"),
-    (["--model", "plane-strain", "--tangential-ratio", "0.5"], "needs --friction"),
+    (["--model", "plane_strain", "--tangential-ratio", "0.5"], "needs --friction"),
     (["--friction", "0.3", "--tangential-ratio", "0.5"], "axial symmetry"),
     (["--friction", "0.3", "--formulation", "multiplier"], "elimination"),
-    (["--model", "plane-strain", "--friction", "0.3", "--tangential-ratio", "1"], "slides"),
-    (["--model", "plane-strain", "--refine", "0", "--block", "100", "--friction", "0.3",
+    (["--model", "plane_strain", "--friction", "0.3", "--tangential-ratio", "1"], "slides"),
+    (["--model", "plane_strain", "--refine", "0", "--block", "100", "--friction", "0.3",
       "--tangential-force", "1"], "slides"),
-    (["--model", "plane-strain", "--refine", "0", "--block", "100", "--indentation", "-0.01",
+    (["--model", "plane_strain", "--refine", "0", "--block", "100", "--indentation", "-0.01",
       "--friction", "0.3", "--tangential-displacement", "0.001"], "does not touch"),
 ])
 def test_friction_bad_input_is_one_line(demo, args, words):
@@ -236,7 +236,7 @@ def test_friction_bad_input_is_one_line(demo, args, words):
 @pytest.mark.parametrize("model,block,Q_bound,q_bound", [
     # the two steps with the contact and friction regularised by k: measured Q +3.1e-4 and
     # +2.5e-5, traction 5.4 % and 0.58 % of the largest at k = 10 and 100 E/h
-    ("plane-strain", 100.0, 1e-4, 0.01),
+    ("plane_strain", 100.0, 1e-4, 0.01),
     # 3D, the vector law (the trial force returned to the disc f p_n) on the P1 sphere:
     # measured Q +2.5e-3 and +2.3e-4, traction 12 % and 1.5 %
     ("3d", 10.0, 1e-3, 0.03),
@@ -266,7 +266,7 @@ def test_the_penalty_peer_converges_to_the_active_set(model, block, Q_bound, q_b
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("model", ["plane-strain", "3d"])
+@pytest.mark.parametrize("model", ["plane_strain", "3d"])
 def test_friction_on_a_cut_contact_zone(model):
     # plane strain: the partition cuts S_C inside the contact zone, so sticking and
     # slipping nodes are owned by both ranks and ghosts carry statuses; the answer is the

@@ -280,8 +280,7 @@ class CaseProblem:
 
     def _solver(self):
         case = self.case
-        method = {"quasi-newton": "bfgs"}.get(case.newton, case.newton)
-        linear = "lu" if case.linear == "direct" else "gamg"
+        method, linear = case.newton, case.linear
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": self.line_search(), "force_scale": self.force_scale}
         if linear == "gamg" and self.mixed:  # MINRES with the block preconditioner

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from fenics_nl.materials import laws
 from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.vocabulary import canonical
 
 __all__ = ["Case", "CaseError", "Condition", "Probe", "read_case"]
 
@@ -72,8 +73,8 @@ adaptive = true          # optional: false stops at the first failed step instea
 # max_steps = 100        # optional: steps before the run stops short of the target
 
 [solver]                 # every key optional
-newton = "full"          # full | modified | periodic | quasi-newton | snes
-linear = "direct"        # direct (MUMPS LU) | iterative (CG + GAMG)
+newton = "full"          # full | modified | periodic | bfgs | snes
+linear = "lu"            # lu (MUMPS) | gamg (CG + GAMG)
 tolerance = 1e-9         # |R| <= tolerance x the force scale of the step ends Newton
 max_iterations = 50      # Newton iterations per step
 
@@ -94,8 +95,8 @@ LAWS: dict[str, type[laws.Material]] = {
 # parameters a case may leave out, and their values: J2 without hardening is perfect plasticity
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}}
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
-NEWTON = ("full", "modified", "periodic", "quasi-newton", "snes")
-LINEAR = ("direct", "iterative")
+NEWTON = ("full", "modified", "periodic", "bfgs", "snes")
+LINEAR = ("lu", "gamg")
 CONDITIONS = ("displacement", "traction", "pressure", "contact")
 OBSTACLES = {"plane": ("point", "normal"), "sphere": ("center", "radius")}
 
@@ -146,7 +147,7 @@ class Case:
     arc: dict | None = None  # control = "arc-length": target, arc_length, max_arc_length,
     # max_steps
     newton: str = "full"
-    linear: str = "direct"
+    linear: str = "lu"
     tolerance: float = 1e-9
     max_iterations: int = 50
     probes: list[Probe] = field(default_factory=list)
@@ -204,6 +205,8 @@ class _Reader:
         if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
             self.fail(name, f"must be {_kind_name(kind)}, got {value!r}")
             return default
+        if choices is not None:
+            value = canonical(value, name)  # an old spelling is read, and said
         if choices is not None and value not in choices:
             self.fail(name, f"{value!r} is not one of {', '.join(choices)}")
             return default
@@ -294,18 +297,18 @@ def read_case(path: str | Path) -> Case:
     s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
                 required=False)
     newton = r.get(s, "newton", "solver", str, default="full", choices=NEWTON)
-    linear = r.get(s, "linear", "solver", str, default="direct", choices=LINEAR)
+    linear = r.get(s, "linear", "solver", str, default="lu", choices=LINEAR)
     tolerance = r.get(s, "tolerance", "solver", float, default=1e-9, positive=True)
     if tolerance is not None and tolerance >= 1:
         r.fail("solver.tolerance", f"must be < 1 (relative to the force scale), got {tolerance}")
     max_it = r.get(s, "max_iterations", "solver", int, default=50, minimum=1)
     if newton == "snes" and any(c.kind == "contact" for c in conditions):
         r.fail("solver.newton", '"snes" cannot run the contact active-set loop: use full, '
-                                "modified, periodic or quasi-newton")
+                                "modified, periodic or bfgs")
     if arc is not None:
         if newton == "snes":
             r.fail("solver.newton", '"snes" has no arc-length control: use full, modified, '
-                                    "periodic or quasi-newton")
+                                    "periodic or bfgs")
         for c in conditions:
             if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
                 r.fail(f"{c.key}", "arc-length control scales loads only: a contact or a "
@@ -325,11 +328,10 @@ def _material(r: _Reader, data: dict, model: str | None):
         return None, {}
     law = r.get(m, "law", "material", str, required=True, choices=tuple(LAWS))
     if law is None:  # still name a misspelt key (lawe = ...) beside the missing law
-        every = {f.name for cls in LAWS.values() for f in fields(cls)
-                 if not f.name.startswith("_")}
+        every = {f.name for cls in LAWS.values() for f in fields(cls) if f.init}
         r.unknown(m, "material", ("law", *sorted(every)))
         return None, {}
-    params = [f for f in fields(LAWS[law]) if not f.name.startswith("_")]  # not the state
+    params = [f for f in fields(LAWS[law]) if f.init]  # the parameters, not the state
     accepted = tuple(f.name for f in params)
     r.unknown(m, "material", ("law", *accepted))
     parameters = {}

@@ -29,9 +29,11 @@ S_C whose vertices are all active (`active_facets`), ready to write out.
 
 from __future__ import annotations
 
+import collections
 import logging
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import ufl
@@ -45,7 +47,7 @@ from fenics_nl.parallel import global_max
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
-__all__ = ["ActiveSetContact", "ContactError", "EliminationSystem"]
+__all__ = ["ActiveSetContact", "ContactError", "EliminationSystem", "StatusUpdate"]
 
 log = logging.getLogger(__name__)
 
@@ -107,6 +109,18 @@ class EliminationSystem:
     def normal_forces(self) -> np.ndarray:
         """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
         return self.surface.sign * self.reactions()[self.surface.dofs_V]
+
+
+@dataclass
+class StatusUpdate:
+    """What a status rule made of one solve: the next statuses are in the contact already."""
+
+    changes: int  # nodes whose status changed
+    settled: bool  # a fixed point: the loop ends
+    state: tuple | str  # a fingerprint of the new statuses (for the cycle test)
+    T_n: np.ndarray  # the solve's normal forces (the contact force, once settled)
+    record: dict  # this iteration's counts, for the result's history
+    summary: str  # the statuses in a few words, for the log and the messages
 
 
 class ActiveSetContact:
@@ -251,20 +265,25 @@ class ActiveSetContact:
 
     # -- the loop ----------------------------------------------------------------------
 
-    def solve(self) -> SolveResult:
-        """Run the active-set iteration to a fixed set; raise ContactError if it cannot.
+    # what the loop settles (its messages), and how often a state may come back before it
+    # is a cycle (the frictionless set: never)
+    STATUSES, REVISITS = "active set", 1
 
-        The result counts the Newton iterations and the work of every inner solve, the
-        active-set iterations, and keeps the last inner solve's residual history; the total
-        contact force is left in `force`.
+    def solve(self) -> SolveResult:
+        """Run the course's loop to a fixed point of the statuses; ContactError if it cannot.
+
+        Each iteration solves with the current statuses' conditions (`_set_conditions`),
+        then lets the status rule (`_update_statuses`) set the next ones; the same loop for
+        every rule (frictionless here, Coulomb in `friction`). The result counts the Newton
+        iterations and the work of every inner solve, the loop's iterations, and keeps the
+        last inner solve's residual history; the total contact force is left in `force`.
         """
         t0 = time.perf_counter()
-        seen = set()
-        res = SolveResult(False, "active set", 0, [], WorkCounts())
-        S = self.surface
+        seen = collections.Counter()
+        res = SolveResult(False, self.STATUSES, 0, [], WorkCounts())
         changes = None  # nodes that changed since the last solve (None: unknown, many)
         for k in range(1, self.max_iterations + 1):
-            self.system.set_active(self.active, changes)
+            self._set_conditions(changes)
             try:
                 nr = self.system.solve()
             except SupportError as err:
@@ -272,30 +291,44 @@ class ActiveSetContact:
             res.iterations += nr.iterations
             res.work.add(nr.work)
             res.residual_norms = nr.residual_norms
-            T_n, d = self.normal_forces(), self.normal_gap()
-            # thresholds from the problem's own scales: the largest contact force, and the
-            # obstacle's gap or the motion itself
-            scale_T = global_max(self.comm, np.abs(T_n))
-            scale_u = max(global_max(self.comm, np.abs(S.gamma)),
-                          S.displacement_scale(self.u))
-            leave = self.active & (T_n > 1e-10 * scale_T)
-            join = ~self.active & (d > 1e-10 * scale_u)
-            new = S.sync((self.active & ~leave) | join)
-            changes = S.count(new != self.active)
-            n_active = S.count(new)
-            res.active_set_iterations, res.active_sizes = k, [*res.active_sizes, n_active]
-            res.history.append({"active": n_active, "left": S.count(leave),
-                                "joined": S.count(join), "newton_iterations": nr.iterations})
-            log.info("active set iteration %d: %d active, %d changes", k, n_active, changes)
-            if changes == 0:
-                self.force = self.total_force(T_n)
-                res.converged, res.reason = True, "active set fixed"
+            update = self._update_statuses()
+            changes = update.changes
+            res.active_set_iterations = k
+            res.active_sizes = [*res.active_sizes, self.surface.count(self.active)]
+            res.history.append({**update.record, "newton_iterations": nr.iterations})
+            log.info("%s iteration %d: %s, %d changes", self.STATUSES, k, update.summary,
+                     changes)
+            if update.settled:
+                self.force = self.total_force(update.T_n)
+                res.converged, res.reason = True, f"{self.STATUSES} fixed"
                 res.wall_time = time.perf_counter() - t0
                 return res
-            key = S.fingerprint(new)
-            if key in seen:
-                raise ContactError(f"active set cycles (iteration {k}, {n_active} active nodes)",
-                                   res)
-            seen.add(key)
-            self.active = new
-        raise ContactError(f"active set did not settle in {self.max_iterations} iterations", res)
+            if changes:
+                seen[update.state] += 1
+                if seen[update.state] > self.REVISITS:
+                    raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
+                                       f"{update.summary})", res)
+        raise ContactError(f"{self.STATUSES} did not settle in {self.max_iterations} "
+                           "iterations", res)
+
+    def _set_conditions(self, changes: int | None) -> None:
+        """The next solve's conditions from the statuses: u_n = γ on the active nodes."""
+        self.system.set_active(self.active, changes)
+
+    def _update_statuses(self) -> StatusUpdate:
+        """The frictionless rule: leave where T_n > 0, join where u_n > γ."""
+        S = self.surface
+        T_n, d = self.normal_forces(), self.normal_gap()
+        # thresholds from the problem's own scales: the largest contact force, and the
+        # obstacle's gap or the motion itself
+        scale_T = global_max(self.comm, np.abs(T_n))
+        scale_u = max(global_max(self.comm, np.abs(S.gamma)), S.displacement_scale(self.u))
+        leave = self.active & (T_n > 1e-10 * scale_T)
+        join = ~self.active & (d > 1e-10 * scale_u)
+        new = S.sync((self.active & ~leave) | join)
+        changes = S.count(new != self.active)
+        n_active = S.count(new)
+        self.active = new
+        return StatusUpdate(changes, changes == 0, S.fingerprint(new), T_n,
+                            {"active": n_active, "left": S.count(leave),
+                             "joined": S.count(join)}, f"{n_active} active nodes")

@@ -26,22 +26,21 @@ and a spring k (I − s sᵀ) against slip across s, k = f |T_n|/(−Δg·s) fro
 iterate (`NewtonSolver.set_nodal_springs`), the linearization of −f |T_n| Δg/|Δg|; s then
 turns to the node's total tangential force, and at the fixed point the slip is along −s.
 
-The loop stops when no status changes and the friction forces agree with the normal forces
-of the same solve. The slip history lives in the committed tangential displacement; the driver
-commits it after a converged step (`commit`) or goes back to it (`restore`).
+The loop is `ActiveSetContact`'s, with this status rule (`_update_statuses`) and these
+conditions (`_set_conditions`); it stops when no status changes and the friction forces
+agree with the normal forces of the same solve. The slip history lives in the committed
+tangential displacement; the driver commits it after a converged step (`commit`) or goes
+back to it (`restore`).
 """
 
 from __future__ import annotations
 
-import collections
 import math
-import time
 
 import numpy as np
 
-from fenics_nl.contact.active_set import ActiveSetContact, ContactError, log
+from fenics_nl.contact.active_set import ActiveSetContact, StatusUpdate
 from fenics_nl.parallel import global_max
-from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 __all__ = ["FrictionalContact"]
 
@@ -55,7 +54,7 @@ class FrictionalContact(ActiveSetContact):
 
     # a status set may come back while the friction forces still move (they follow the
     # normal forces of the last solve); its third visit is a cycle
-    REVISITS = 2
+    STATUSES, REVISITS = "statuses", 2
 
     def __init__(self, *args, friction: float, **kwargs):
         if not (math.isfinite(friction) and friction >= 0):
@@ -199,79 +198,62 @@ class FrictionalContact(ActiveSetContact):
 
     # -- the loop ----------------------------------------------------------------------
 
-    def solve(self) -> SolveResult:
-        """Statuses to a fixed point, friction forces consistent; ContactError if not."""
-        t0 = time.perf_counter()
-        seen = collections.Counter()
-        res = SolveResult(False, "frictional active set", 0, [], WorkCounts())
+    def _update_statuses(self) -> StatusUpdate:
+        """Coulomb's rule on one solve: open/close as frictionless, stick/slip by |T_t| ≤ f|T_n|.
+
+        Settled when no status changed and the slip forces stopped moving.
+        """
         S = self.surface
-        changes = None
-        for k in range(1, self.max_iterations + 1):
-            self._set_conditions(changes)
-            nr = self.system.solve()
-            res.iterations += nr.iterations
-            res.work.add(nr.work)
-            res.residual_norms = nr.residual_norms
-            r = self.system.reactions()  # one assembly for T_n and T_t
-            T_n, T_t, g = S.sign * r[S.dofs_V], self.tangential_forces(r), self.slip_increment()
-            scale_T = global_max(self.comm, np.abs(T_n))
-            # lengths of the state itself (not the far gap, which grows with the block): the
-            # body's motion and the obstacle's move in this step
-            step = float(np.abs(self.motion - self.committed_motion).max(initial=0.0))
-            tol_T, tol_u = 1e-10 * scale_T, 1e-10 * max(S.displacement_scale(self.u), step)
-            bound = self.f * np.maximum(-T_n, 0.0)
-            size = np.linalg.norm(T_t, axis=1)
-            leave = self.active & (T_n > tol_T)
-            join = ~self.active & (self.normal_gap() > tol_u)
-            to_slip = self.stick & ~leave & (size > bound + tol_T)
-            # (a node that slips with no friction force, f = 0 or T_n = 0, has no reason to)
-            back = (self.slip & ~leave & np.any(self.slip_force, axis=1)
-                    & (np.sum(g * self.direction, axis=1) > tol_u))
-            active = S.sync((self.active & ~leave) | join)
-            # a node touching down within the step cannot stick where it was at the step's
-            # start: it joins slipping, with no friction until its first slip gives a sense
-            slip = S.sync(((self.slip & ~back) | to_slip | join) & active)
-            direction = self.direction.copy()
-            sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
-            direction[to_slip] = T_t[to_slip] / size[to_slip, None]
-            direction[join] = 0.0
-            slid = np.linalg.norm(g, axis=1)
-            first = slip & self.slip & ~sensed & (slid > tol_u)
-            direction[first] = -g[first] / slid[first, None]
-            spring = np.zeros_like(self.spring)
-            if len(self.axes) > 1:  # 3D: the force turns with the spring's share
-                kept = slip & self.slip & sensed & (size > tol_T)
-                direction[kept] = T_t[kept] / size[kept, None]
-                along = -np.sum(g * direction, axis=1)
-                # a node that barely slides (below 1e-6 of the largest slip) gets no spring:
-                # k = f|T_n|/slip would amplify round-off in u into the residual
-                floor = 1e-6 * global_max(self.comm, np.where(kept, along, 0.0))
-                moving = kept & (along > max(tol_u, floor))
-                spring[moving] = bound[moving] / along[moving]
-            slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
-            drift = global_max(self.comm, np.abs(slip_force - self.slip_force))
-            changes = S.count(active != self.active) + S.count(slip != self.slip)
-            n_slip, n_stick = S.count(slip), S.count(active & ~slip)
-            res.active_set_iterations, res.active_sizes = k, [*res.active_sizes, S.count(active)]
-            res.history.append({"stick": n_stick, "slip": n_slip, "changes": changes,
-                                "to_slip": S.count(to_slip), "to_stick": S.count(back),
-                                "opened": S.count(leave), "closed": S.count(join),
-                                "friction_force_change": drift,
-                                "newton_iterations": nr.iterations})
-            log.info("status iteration %d: %d stick, %d slip, %d changes, friction force "
-                     "change %.3e", k, n_stick, n_slip, changes, drift)
-            self.active, self.slip, self.direction = active, slip, direction
-            self.slip_force, self.spring = slip_force, spring
-            if changes == 0 and drift <= 1e-9 * self.f * scale_T:
-                self.force = self.total_force(T_n)
-                res.converged, res.reason = True, "statuses fixed"
-                res.wall_time = time.perf_counter() - t0
-                return res
-            if changes:  # a state: the closed set, the slipping set and its slip senses
-                key = (S.fingerprint(active), S.fingerprint(slip),
-                       S.fingerprint(slip & (direction[:, 0] > 0)))
-                seen[key] += 1
-                if seen[key] > self.REVISITS:
-                    raise ContactError(f"statuses cycle (iteration {k}: {n_stick} stick, "
-                                       f"{n_slip} slip)", res)
-        raise ContactError(f"statuses did not settle in {self.max_iterations} iterations", res)
+        r = self.system.reactions()  # one assembly for T_n and T_t
+        T_n, T_t, g = S.sign * r[S.dofs_V], self.tangential_forces(r), self.slip_increment()
+        scale_T = global_max(self.comm, np.abs(T_n))
+        # lengths of the state itself (not the far gap, which grows with the block): the
+        # body's motion and the obstacle's move in this step
+        step = float(np.abs(self.motion - self.committed_motion).max(initial=0.0))
+        tol_T, tol_u = 1e-10 * scale_T, 1e-10 * max(S.displacement_scale(self.u), step)
+        bound = self.f * np.maximum(-T_n, 0.0)
+        size = np.linalg.norm(T_t, axis=1)
+        leave = self.active & (T_n > tol_T)
+        join = ~self.active & (self.normal_gap() > tol_u)
+        to_slip = self.stick & ~leave & (size > bound + tol_T)
+        # (a node that slips with no friction force, f = 0 or T_n = 0, has no reason to)
+        back = (self.slip & ~leave & np.any(self.slip_force, axis=1)
+                & (np.sum(g * self.direction, axis=1) > tol_u))
+        active = S.sync((self.active & ~leave) | join)
+        # a node touching down within the step cannot stick where it was at the step's
+        # start: it joins slipping, with no friction until its first slip gives a sense
+        slip = S.sync(((self.slip & ~back) | to_slip | join) & active)
+        direction = self.direction.copy()
+        sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
+        direction[to_slip] = T_t[to_slip] / size[to_slip, None]
+        direction[join] = 0.0
+        slid = np.linalg.norm(g, axis=1)
+        first = slip & self.slip & ~sensed & (slid > tol_u)
+        direction[first] = -g[first] / slid[first, None]
+        spring = np.zeros_like(self.spring)
+        if len(self.axes) > 1:  # 3D: the force turns with the spring's share
+            kept = slip & self.slip & sensed & (size > tol_T)
+            direction[kept] = T_t[kept] / size[kept, None]
+            along = -np.sum(g * direction, axis=1)
+            # a node that barely slides (below 1e-6 of the largest slip) gets no spring:
+            # k = f|T_n|/slip would amplify round-off in u into the residual
+            floor = 1e-6 * global_max(self.comm, np.where(kept, along, 0.0))
+            moving = kept & (along > max(tol_u, floor))
+            spring[moving] = bound[moving] / along[moving]
+        slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
+        drift = global_max(self.comm, np.abs(slip_force - self.slip_force))
+        changes = S.count(active != self.active) + S.count(slip != self.slip)
+        n_slip, n_stick = S.count(slip), S.count(active & ~slip)
+        self.active, self.slip, self.direction = active, slip, direction
+        self.slip_force, self.spring = slip_force, spring
+        # a state: the closed set, the slipping set and its slip senses
+        state = (S.fingerprint(active), S.fingerprint(slip),
+                 S.fingerprint(slip & (direction[:, 0] > 0)))
+        record = {"stick": n_stick, "slip": n_slip, "changes": changes,
+                  "to_slip": S.count(to_slip), "to_stick": S.count(back),
+                  "opened": S.count(leave), "closed": S.count(join),
+                  "friction_force_change": drift}
+        settled = changes == 0 and drift <= 1e-9 * self.f * scale_T
+        return StatusUpdate(changes, settled, state, T_n, record,
+                            f"{n_stick} stick, {n_slip} slip, friction force change "
+                            f"{drift:.3e}")

@@ -57,6 +57,7 @@ __all__ = [
     "run_file",
     "run_scene",
     "say",
+    "spelling",
 ]
 
 # Errors that end a run with one line: bad parameters, solvers that cannot converge, a load
@@ -132,6 +133,17 @@ def positive(text: str) -> float:
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
     return value
+
+
+def spelling(flag: str):
+    """argparse type: the word in the one spelling (`vocabulary`); an old one is said."""
+    from fenics_nl.vocabulary import canonical
+
+    def parse(text: str) -> str:
+        return canonical(text, flag)
+
+    parse.__name__ = "word"
+    return parse
 
 
 def at_least(minimum: int):

@@ -73,7 +73,8 @@ class J2Plasticity(Isotropic, SmallStrain):
     sigma0: float = 1.0
     H: float = 0.0
     C: float = 0.0
-    state: PlasticState = field(default_factory=PlasticState, repr=False, compare=False)
+    state: PlasticState = field(default_factory=PlasticState, init=False, repr=False,
+                                compare=False)
 
     path_dependent = True
 

@@ -174,7 +174,7 @@ class Bracket:
         part: mesh, space and conditions (`BracketPart`).
         material: the small-strain law of the residual (for σ_eq).
         residual: R(u; v) of the part under its traction (UFL form).
-        newton: full | modified | periodic | quasi-newton | snes.
+        newton: full | modified | periodic | bfgs | snes.
         linear_solver: ``lu`` (MUMPS) or ``gamg`` (CG + GAMG).
         period: tangent rebuilt every `period` iterations (``periodic``).
         force_scale: the force of the absolute tolerance (default: the first residual).
@@ -202,7 +202,7 @@ class Bracket:
         # forces, which reaches 1e-10 of the load at ε_eq ~ 800 ε0 (measured: 20 kN in 10
         # steps on P2, 17k unknowns), hence 1e-9; and an active-set iteration restarts
         # Newton close to equilibrium, where rtol ‖R₀‖ means little
-        method = {"quasi-newton": "bfgs"}.get(newton, newton)
+        method = newton
         opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period}

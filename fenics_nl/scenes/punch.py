@@ -1,7 +1,7 @@
 """A rigid punch (sphere, or cylinder in plane strain) on an elastic block: the Hertz scene.
 
 Models: ``axisymmetric`` (r, z), ``3d`` (quarter block, symmetry planes x = 0 and y = 0),
-``plane-strain`` (half block, symmetry x = 0; a cylinder). The block's top z = 0 (y = 0 in
+``plane_strain`` (half block, symmetry x = 0; a cylinder). The block's top z = 0 (y = 0 in
 2D) is the candidate contact surface S_C, its bottom slides on a rigid base (vertical
 displacement 0). The obstacle's gap along the outward normal +e_z is the parabola
 γ(r) = r²/(2R) − δ of Hertz's theory, or the exact sphere R − √(R² − r²) − δ.
@@ -50,7 +50,7 @@ __all__ = [
     "check_contact_resolution",
 ]
 
-MODELS = ("axisymmetric", "3d", "plane-strain")
+MODELS = ("axisymmetric", "3d", "plane_strain")
 MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
 FEW_NODES = 10  # below this, a and p0 are coarse: say so
 
@@ -124,14 +124,14 @@ class PunchBlock:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         if tangential and model == "axisymmetric":
             raise ValueError("a tangential load breaks the axial symmetry: use --model "
-                             "plane-strain or 3d")
+                             "plane_strain or 3d")
         if refine < 0 or block < 10:
             raise ValueError("refine must be >= 0 and block >= 10 (block size in contact radii)")
         self.model, self.a = model, a
         dim = 3 if model == "3d" else 2
         self.vertical = dim - 1
         # plane strain: the half-width is about half of √(Rδ), so the mesh is twice as fine
-        self.h = a / ({"axisymmetric": 20, "3d": 6, "plane-strain": 40}[model] * 2**refine)
+        self.h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**refine)
         growth = growth if growth is not None else (0.10 if dim == 3 else 0.05)
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth, both_sides=tangential)
@@ -163,7 +163,7 @@ class PunchBlock:
             self.bcs.append(boundary.component(self.V, 1, facets("symmetry_y")))
         self.contact_facets = facets("contact")
         # force of the whole body from the modelled part (2πr is in the weight)
-        self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane-strain": 2.0}[model]
+        self.symmetry_factor = {"axisymmetric": 1.0, "3d": 4.0, "plane_strain": 2.0}[model]
         if tangential:
             self.symmetry_factor /= 2
 
@@ -230,8 +230,8 @@ class Punch:
         # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length)
         a, model = block.a, block.model
         E_star = hertz.effective_modulus(material.E, material.nu)
-        force = (np.pi / 4 if model == "plane-strain" else 4 / 3) * E_star * a**3 / radius
-        if model == "plane-strain":
+        force = (np.pi / 4 if model == "plane_strain" else 4 / 3) * E_star * a**3 / radius
+        if model == "plane_strain":
             force /= a
         opts = {"line_search": not material.is_linear,
                 "force_scale": force / self.block.symmetry_factor}
@@ -240,7 +240,7 @@ class Punch:
         opts.update(newton_options or {})
         contact = dict(normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
                        initial="penetrating", newton_options=opts,
-                       prefix=f"punch_{model.replace('-', '')}_",
+                       prefix=f"punch_{model}_",
                        displacement_space=block.V if block.mixed else None)
         self.friction = friction
         if friction is None:
@@ -447,7 +447,7 @@ class Punch:
     def hertz(self, state: Indentation) -> dict[str, float]:
         """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""
         E, nu = self.material.E, self.material.nu
-        if self.model == "plane-strain":  # a cylinder: no force-indentation law to check
+        if self.model == "plane_strain":  # a cylinder: no force-indentation law to check
             return hertz.cylinder_from_force(E, nu, self.R, state.force)
         return hertz.sphere_from_indentation(E, nu, self.R, state.indentation)
 
