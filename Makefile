@@ -50,7 +50,7 @@ test: test-serial test-mpi
 # the serial suite on both cores (pytest-xdist), then the tests that start mpiexec
 # themselves, alone (their ranks need the cores), then the mpi suite under mpiexec
 test-serial: $(VENV)/.installed
-	$(PY) -m pytest -m "not mpi and not spawns_mpi" -q -n 2
+	$(PY) -m pytest -m "not mpi and not spawns_mpi" -q -n 2 --dist worksteal
 	$(PY) -m pytest -m "spawns_mpi" -q
 
 test-mpi: $(VENV)/.installed
