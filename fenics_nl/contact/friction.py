@@ -9,7 +9,7 @@ obstacle's. Each iteration solves (elimination) with
 * open nodes free;
 * sticking nodes: u_n = γ and Δg = 0 (all their components are Dirichlet rows);
 * slipping nodes: u_n = γ and the tangential nodal force f |T_n| s, s the unit direction of
-  the friction force on the body (`NewtonSolver.set_nodal_load`), T_n from the last solve;
+  the friction force on the body (`NewtonSolver.nodal`, `solvers.nodal`), T_n from the last solve;
 
 then updates the statuses by the course's rules, extended to friction:
 
@@ -23,7 +23,7 @@ then updates the statuses by the course's rules, extended to friction:
 In 3D the direction s of a slipping node is a unit vector, which the loop finds by Newton's
 method rather than by substitution (s ← −Δg/|Δg| chatters): the node carries f |T_n| s
 and a spring k (I − s sᵀ) against slip across s, k = f |T_n|/(−Δg·s) from the last
-iterate (`NewtonSolver.set_nodal_springs`), the linearization of −f |T_n| Δg/|Δg|; s then
+iterate (`NodalTerms.set_springs`), the linearization of −f |T_n| Δg/|Δg|; s then
 turns to the node's total tangential force, and at the fixed point the slip is along −s.
 
 The loop is `ActiveSetContact`'s, with this status rule (`_update_statuses`) and these
@@ -176,7 +176,7 @@ class FrictionalContact(ActiveSetContact):
         dofs = np.concatenate([S.tangential(i)[0][on]
                                for i, on in zip(self.axes, loaded, strict=True)])
         values = np.concatenate([self.slip_force[on, k] for k, on in enumerate(loaded)])
-        self.system.newton.set_nodal_load(dofs, values)
+        self.newton.nodal.set_load(dofs, values)
         if len(self.axes) > 1:
             self._set_springs(target)
 
@@ -194,7 +194,7 @@ class FrictionalContact(ActiveSetContact):
         free = self.free[on]
         k *= free[:, :, None] * free[:, None, :]  # no spring on a component a support holds
         dofs = np.column_stack([S.tangential(i)[0][on] for i in self.axes])
-        self.system.newton.set_nodal_springs(dofs, k, target[on])
+        self.newton.nodal.set_springs(dofs, k, target[on])
 
     # -- the loop ----------------------------------------------------------------------
 

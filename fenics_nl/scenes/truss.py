@@ -4,7 +4,7 @@ Each bar is one interval element of a mesh embedded in 2D; its free energy is EA
 unit reference length, e = (|t + ∂u/∂S|² − 1)/2 the Green–Lagrange strain along the bar (t
 its unit tangent, S its arc length). P1 is exact here: the strain of a straight two-node bar
 is uniform. The supports are pinned; the apex carries the dead load λ P downwards, a nodal
-force (`NewtonSolver.set_nodal_load`). `theory.truss` has the exact curve.
+force (`NewtonSolver.nodal`). `theory.truss` has the exact curve.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ class VonMisesTruss:
 
     def set_load(self, lam: float) -> None:
         """The apex load λ P, downwards."""
-        self.solver.set_nodal_load(self._apex_dof, np.full(len(self._apex_dof), -lam * self.P))
+        self.solver.nodal.set_load(self._apex_dof, np.full(len(self._apex_dof), -lam * self.P))
 
     def apex_deflection(self) -> float:
         """w: the apex's downward displacement."""

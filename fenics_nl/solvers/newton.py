@@ -48,6 +48,7 @@ from fenics_nl.solvers.linear_solver import (
     create_ksp,
     rigid_body_modes,
 )
+from fenics_nl.solvers.nodal import NodalTerms
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.supports import RigidMotions, check_supports
 
@@ -341,8 +342,10 @@ class NewtonSolver:
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
-        self._nodal_load = None  # (dofs, values): point forces (`set_nodal_load`)
-        self._springs = None  # (dofs, stiffness, anchor): nodal springs (`set_nodal_springs`)
+        # point forces and nodal springs (friction, a truss's apex load): the one hook for
+        # terms that no integral gives
+        self.nodal = NodalTerms(V, V.mesh.comm)
+        self._nodal_version = 0  # the springs the tangent was built with
         self._M = None  # the block preconditioner of a mixed unknown's iterative solve
         if linear_solver == "gamg" and V.ufl_element().is_mixed:
             if preconditioner is None:
@@ -396,33 +399,6 @@ class NewtonSolver:
         self.bcs = list(bcs)
         self.policy.bcs_changed(small_change)
         self._supports_checked = False
-
-    def set_nodal_load(self, dofs: np.ndarray, values: np.ndarray) -> None:
-        """External point forces: R(u) − F, F = `values` at `dofs` (owned, local indices).
-
-        For loads that no integral gives exactly, e.g. the friction force of a slipping
-        contact node. Replaces the previous ones; the tangent does not depend on them.
-        """
-        self._nodal_load = (np.asarray(dofs, dtype=np.int32), np.asarray(values, dtype=float))
-
-    def set_nodal_springs(self, dofs: np.ndarray, stiffness: np.ndarray,
-                          anchor: np.ndarray) -> None:
-        """Nodal springs: R(u) + k (u − a) at each node's dofs, and k added to the tangent.
-
-        `dofs` (n, m): owned local indices of n nodes' m components, `stiffness` (n, m, m)
-        each node's symmetric spring, `anchor` (n, m) where it is unstretched. For a
-        slipping contact node in 3D: the Newton linearization of its friction force's
-        direction. Replaces the previous ones; the tangent is rebuilt.
-        """
-        dofs = np.asarray(dofs, dtype=np.int32)
-        # collective: every rank rebuilds the tangent if any rank has (or had) springs
-        comm = self.u.function_space.mesh.comm
-        had, has = self._springs is not None, comm.allreduce(bool(dofs.size), op=MPI.LOR)
-        if had or has:
-            self.policy.bcs_changed(small=False)
-            self._supports_checked = False
-        self._springs = (dofs, np.asarray(stiffness, dtype=float),
-                         np.asarray(anchor, dtype=float)) if has else None
 
     # -- the loop --------------------------------------------------------------------
 
@@ -498,13 +474,7 @@ class NewtonSolver:
             if lift:
                 petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
             self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            if self._nodal_load is not None:
-                dofs, values = self._nodal_load
-                self.b.array[dofs] -= values
-            if self._springs is not None:
-                dofs, k, anchor = self._springs
-                stretch = self.u.x.array[dofs] - anchor
-                self.b.array[dofs] += np.einsum("nij,nj->ni", k, stretch)
+            self.nodal.add_to_residual(self.u.x.array, self.b.array)
             petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
             work.residual_assemblies += 1
             return self._force_norm()
@@ -520,6 +490,10 @@ class NewtonSolver:
         full: always; modified and bfgs: at k = 0 of a solve, or never (a tangent for the
         solver's life); periodic: every `period` iterations. Returns whether it did.
         """
+        if self.nodal.version != self._nodal_version:  # new springs: the tangent is stale
+            self._nodal_version = self.nodal.version
+            self.policy.bcs_changed(small=False)
+            self._supports_checked = False
         if not self.policy.needs_tangent(k):
             return False
         self._assemble_tangent(work)
@@ -597,8 +571,7 @@ class NewtonSolver:
                 petsc.assemble_matrix(self.A, self._K_used, bcs=self.bcs, diag=1.0)
                 self.A.assemble()
                 work.tangent_assemblies += 1
-            if self._springs is not None:
-                self._add_springs()
+            self.nodal.add_to_tangent(self.A)
             if self._M is not None:  # its Dirichlet rows follow the tangent's
                 self._M.zeroEntries()
                 petsc.assemble_matrix(self._M, self._M_form, bcs=self.bcs, diag=1.0)
@@ -610,17 +583,6 @@ class NewtonSolver:
         if self.policy.needs_factorization():
             self._factorize(work)
         self.policy.assembled()
-
-    def _add_springs(self) -> None:
-        """A += each nodal spring's stiffness (owned rows; collective, as A.assemble())."""
-        dofs, k, _ = self._springs
-        bs = self.u.function_space.dofmap.index_map_bs
-        lg = self.u.function_space.dofmap.index_map.local_to_global
-        for node, block in zip(dofs, k, strict=True):
-            blocks = lg(np.asarray(node // bs, dtype=np.int32))
-            rows = (blocks * bs + node % bs).astype(PETSc.IntType)
-            self.A.setValues(rows, rows, block, addv=PETSc.InsertMode.ADD_VALUES)
-        self.A.assemble()
 
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
         """A = K with the Dirichlet rows and columns replaced by the identity (no assembly)."""

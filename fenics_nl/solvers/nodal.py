@@ -1,0 +1,69 @@
+"""Nodal terms: point forces and nodal springs that no integral gives, added to R and K.
+
+A `NewtonSolver` holds one `NodalTerms` (`solver.nodal`), its one hook for them: the
+friction force of a slipping contact node and, in 3D, its spring against slip across the
+force's direction (`contact.friction` sets both before each solve); the apex load of the
+von Mises truss (`scenes.truss`). The solver adds them to every residual and tangent it
+assembles, and rebuilds its tangent when the springs change.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+__all__ = ["NodalTerms"]
+
+
+class NodalTerms:
+    """Point forces and nodal springs on the dofs of a function space (owned, local)."""
+
+    def __init__(self, V, comm: MPI.Comm):
+        self.V, self.comm = V, comm
+        self.load = None  # (dofs, values)
+        self.springs = None  # (dofs, stiffness, anchor)
+        self.version = 0  # grows when the springs change: the tangent is then stale
+
+    def set_load(self, dofs: np.ndarray, values: np.ndarray) -> None:
+        """Point forces F = `values` at `dofs`: R(u) − F.
+
+        Replaces the previous ones; the tangent does not depend on them.
+        """
+        self.load = (np.asarray(dofs, dtype=np.int32), np.asarray(values, dtype=float))
+
+    def set_springs(self, dofs: np.ndarray, stiffness: np.ndarray, anchor: np.ndarray) -> None:
+        """Nodal springs: R(u) + k (u − a) at each node's dofs, k added to the tangent.
+
+        `dofs` (n, m): n nodes' m components, `stiffness` (n, m, m) each node's symmetric
+        spring, `anchor` (n, m) where it is unstretched. Replaces the previous ones.
+        Collective: every rank's tangent is rebuilt if any rank has (or had) springs.
+        """
+        dofs = np.asarray(dofs, dtype=np.int32)
+        had, has = self.springs is not None, self.comm.allreduce(bool(dofs.size), op=MPI.LOR)
+        if had or has:
+            self.version += 1
+        self.springs = (dofs, np.asarray(stiffness, dtype=float),
+                        np.asarray(anchor, dtype=float)) if has else None
+
+    def add_to_residual(self, u: np.ndarray, b: np.ndarray) -> None:
+        """b −= F, b += k (u − a): on the local arrays, after the residual's assembly."""
+        if self.load is not None:
+            dofs, values = self.load
+            b[dofs] -= values
+        if self.springs is not None:
+            dofs, k, anchor = self.springs
+            b[dofs] += np.einsum("nij,nj->ni", k, u[dofs] - anchor)
+
+    def add_to_tangent(self, A: PETSc.Mat) -> None:
+        """A += each spring's stiffness (collective, as A.assemble(); nothing without)."""
+        if self.springs is None:
+            return
+        dofs, k, _ = self.springs
+        bs = self.V.dofmap.index_map_bs
+        lg = self.V.dofmap.index_map.local_to_global
+        for node, block in zip(dofs, k, strict=True):
+            blocks = lg(np.asarray(node // bs, dtype=np.int32))
+            rows = (blocks * bs + node % bs).astype(PETSc.IntType)
+            A.setValues(rows, rows, block, addv=PETSc.InsertMode.ADD_VALUES)
+        A.assemble()
