@@ -299,7 +299,6 @@ def test_friction_on_a_cut_contact_zone(model):
 BRACKET_ON_FLOOR = ("--support", "contact", "--size", "20", "--steps", "2")
 
 
-@pytest.mark.spawns_mpi
 def test_bracket_on_a_rough_floor(demo):
     # f = 0 is the frictionless floor; at f = 0.3 the floor takes a tangential force (the
     # bolts no longer hold exactly the pull), within Coulomb's cone as a whole, and holds
@@ -315,6 +314,11 @@ def test_bracket_on_a_rough_floor(demo):
     assert abs(by + fy) < 1e-8 * 8e3 and abs(bz + fz) < 1e-8 * 8e3
     assert 0 < rough["floor_friction_ratio"] <= 1 + 1e-9
     assert rough["load_point_displacement"] < free["load_point_displacement"]
+
+
+@pytest.mark.spawns_mpi
+def test_bracket_on_a_rough_floor_on_two_ranks(demo):
+    rough = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0.3")
     two = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0.3", ranks=2)
     assert two["load_point_displacement"] == pytest.approx(rough["load_point_displacement"],
                                                            rel=1e-8)
