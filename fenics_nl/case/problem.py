@@ -107,16 +107,8 @@ class CaseProblem:
     def _residual(self, data) -> ufl.Form:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
         tag = {n: g.tag for n, g in data.physical_groups.items()}
-        if self.mixed:
-            m = self.mixed
-            v = m.v
-            R = mixed_form.internal_work(self.material, m.u, m.p, m.v, m.q, self.model) * self.dx
-        elif self.plane_stress:
-            v = self.plane_stress.v
-            R = plane_stress.internal_work(self.material, self.plane_stress) * self.dx
-        else:
-            v = ufl.TestFunction(self.V)
-            R = self.material.internal_work(self.u, v, self.model) * self.dx
+        v = self.fields.v  # the displacement's test function (a part, if mixed)
+        R = self.fields.internal_work(self.material, self.model) * self.dx
         w = self.weight
         for c in self.case.conditions:
             ds = self.ds(tag[c.group])
@@ -287,15 +279,8 @@ class CaseProblem:
             opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed,
                                                                self.model, self.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            if self.mixed:
-                tangent = mixed_form.modified_newton_tangent(self.material, self.mixed,
-                                                             self.model, self.dx)
-            elif self.plane_stress:
-                tangent = plane_stress.elastic_tangent(self.material, self.plane_stress,
-                                                       self.dx)
-            else:
-                tangent = self.material.modified_newton_tangent(self.u, self.model, self.dx)
-            opts["constant_tangent"] = tangent
+            opts["constant_tangent"] = self.fields.constant_tangent(self.material, self.model,
+                                                                    self.dx)
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(

@@ -160,6 +160,10 @@ def preconditioner(material, unknown: MixedUnknown, model: str, dx):
 class DisplacementUnknown:
     """The displacement formulation's unknown, with `MixedUnknown`'s attributes.
 
+    Every unknown (this one, `MixedUnknown`, `plane_stress.PlaneStressUnknown`) gives the
+    internal work of a material in its formulation and the constant tangent of modified
+    Newton: the one composition path from an unknown, a material and a model to a residual.
+
     `w` and `u` are the same Function, `V` = `W` its space; `p`, `q` are None.
     """
 
@@ -176,6 +180,14 @@ class DisplacementUnknown:
     def displacement(self) -> fem.Function:
         """The displacement Function itself."""
         return self.w
+
+    def internal_work(self, material, model: str):
+        """Integrand of the internal virtual work in the direction of the test function."""
+        return material.internal_work(self.u, self.v, model)
+
+    def constant_tangent(self, material, model: str, dx):
+        """What modified Newton and BFGS keep (`NewtonSolver`'s `constant_tangent`)."""
+        return material.modified_newton_tangent(self.u, model, dx)
 
 
 class MixedUnknown:
@@ -210,6 +222,14 @@ class MixedUnknown:
         """The current pressure field p (a copy in the collapsed P1 space)."""
         self._p.x.array[:] = self.w.x.array[self._p_dofs]
         return self._p
+
+    def internal_work(self, material, model: str):
+        """Integrand of δΠ(u, p; v, q) (`internal_work` of this module)."""
+        return internal_work(material, self.u, self.p, self.v, self.q, model)
+
+    def constant_tangent(self, material, model: str, dx):
+        """What modified Newton and BFGS keep (`modified_newton_tangent` of this module)."""
+        return modified_newton_tangent(material, self, model, dx)
 
 
 def unknowns(mesh, degree: int = 2, mixed: bool = False

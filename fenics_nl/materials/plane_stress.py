@@ -85,6 +85,14 @@ class PlaneStressUnknown:
         self._ez.x.array[:] = self.w.x.array[self._ez_dofs]
         return self._ez
 
+    def internal_work(self, material, model: str = "plane_stress"):
+        """Integrand of δ∫ψ(ε₃) (`internal_work` of this module)."""
+        return internal_work(material, self)
+
+    def constant_tangent(self, material, model: str, dx):
+        """Hooke's tangent in (u, ε_zz) (`elastic_tangent` of this module)."""
+        return elastic_tangent(material, self, dx)
+
 
 def pointwise_element(cell, quadrature: int):
     """The DG element with as many functions per cell as the rule has points (Legendre).

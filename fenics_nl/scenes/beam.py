@@ -161,10 +161,7 @@ class Beam:
         """
         f, W = self.fields, self.u.function_space
         lin = LinearElastic(self.material.E, self.material.nu)
-        if f.mixed:
-            work = mixed.internal_work(lin, f.u, f.p, f.v, f.q, self.model)
-        else:
-            work = lin.internal_work(f.u, f.v, self.model)
+        work = f.internal_work(lin, self.model)
         a = ufl.derivative(work * self.dx, f.w)  # Hooke's tangent: the same at any state
         # pre-stress of a unit compressive load: one linear solve
         w0 = fem.Function(W)
