@@ -42,7 +42,6 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -191,14 +190,8 @@ plastic = args.material == "j2"
 
 # +
 u = part.u
-if args.mixed:
-    m = part.mixed
-    v = m.v
-    internal = mixed.internal_work(material, m.u, m.p, m.v, m.q, "3d")
-else:
-    v = ufl.TestFunction(part.V)
-    eps = kinematics.small_strain
-    internal = ufl.inner(material.stress(eps(u)), eps(v))
+v = part.fields.v  # the displacement's test function (a part of (v, q) if mixed)
+internal = part.fields.internal_work(material, "3d")  # in either formulation
 residual = internal * part.dx - ufl.dot(part.traction, v) * part.ds_load
 # -
 

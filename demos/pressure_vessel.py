@@ -38,7 +38,6 @@ from mpi4py import MPI
 from fenics_nl.errors import SolveError
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import mixed
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
@@ -140,13 +139,8 @@ material.bind(body.mesh, body.quadrature_degree)
 
 # +
 u, w = body.unknown, body.weight  # u: what the solver updates
-if args.mixed:
-    m = body.mixed
-    v = m.v
-    internal = mixed.internal_work(material, m.u, m.p, m.v, m.q, body.model)
-else:
-    v = ufl.TestFunction(body.V)
-    internal = material.internal_work(u, v, body.model)
+v = body.fields.v  # the displacement's test function (a part of (v, q) if mixed)
+internal = body.fields.internal_work(material, body.model)  # in either formulation
 residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * body.ds_inner
 # -
 
@@ -162,8 +156,7 @@ residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * bo
 control = "pressure" if args.inner_displacement is None else "displacement"
 bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
-elastic_tangent = (mixed.modified_newton_tangent(material, body.mixed, body.model, body.dx)
-                   if args.mixed else material.modified_newton_tangent(u, body.model, body.dx))
+elastic_tangent = body.fields.constant_tangent(material, body.model, body.dx)
 
 
 def make_solver(bcs):

@@ -154,14 +154,9 @@ def build_bracket(material, *, size: float = 5.0, mesh_file: str | None = None,
     part = BracketPart(size=size, mesh_file=mesh_file, support=support, degree=degree,
                        length_scale=length_scale, quadrature_degree=quadrature_degree,
                        mixed=mixed, comm=comm)
-    if mixed:
-        m = part.mixed
-        residual = (mixed_form.internal_work(material, m.u, m.p, m.v, m.q, "3d") * part.dx
-                    - ufl.dot(part.traction, m.v) * part.ds_load)
-    else:
-        eps, v = kinematics.small_strain, ufl.TestFunction(part.V)
-        residual = (ufl.inner(material.stress(eps(part.u)), eps(v)) * part.dx
-                    - ufl.dot(part.traction, v) * part.ds_load)
+    f = part.fields
+    residual = (f.internal_work(material, "3d") * part.dx
+                - ufl.dot(part.traction, f.v) * part.ds_load)
     return Bracket(part, material, residual, **options)
 
 
@@ -210,9 +205,7 @@ class Bracket:
             opts["preconditioner"] = mixed_form.preconditioner(material, part.mixed, "3d",
                                                                part.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
-            opts["constant_tangent"] = (
-                mixed_form.modified_newton_tangent(material, part.mixed, "3d", part.dx)
-                if part.mixed else material.modified_newton_tangent(self.u, "3d", part.dx))
+            opts["constant_tangent"] = part.fields.constant_tangent(material, "3d", part.dx)
         if part.support == "contact":
             # the floor z = 0 under the base: outward normal −e_z, gap 0
             # with friction each base node is open, sticking or slipping on the floor
