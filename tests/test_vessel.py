@@ -110,33 +110,16 @@ def test_mixed_elements_do_not_lock_on_the_same_coarse_mesh(demo):
 VESSEL_PATH = ["--pressure-ratio", "0.95", "--steps", "12", "--unload"]  # yields in reverse
 
 
-def same_run(a, b, rel=1e-10):
+def same_run(a, b):
     """Key by key the same JSON, times and memory aside: the restart took the same path.
 
-    Counts and words exactly; a number to `rel` of its size, a vector's components to `rel`
-    of its largest (a reaction's round-off component). Two uninterrupted runs on 2 ranks
-    already differ in the last digit: the order of parallel sums.
+    Counts and words exactly, a number to 1e-10 of its size, a vector's components to
+    1e-10 of its largest (`benchmarks/demo_snapshot.py`'s comparison). Two uninterrupted
+    runs on 2 ranks already differ in the last digit: the order of parallel sums.
     """
-    times = {k for k in a if k.endswith(("time_s", "_mb"))}
-    assert set(a) == set(b)
+    from demo_snapshot import differences  # benchmarks/, on the tests' path
 
-    def same(x, y, where, scale=0.0):
-        if isinstance(x, dict):
-            assert set(x) == set(y), where
-            for k in x:
-                same(x[k], y[k], f"{where}.{k}")
-        elif isinstance(x, list):
-            assert len(x) == len(y), where
-            numbers = [abs(v) for v in x if isinstance(v, float)]
-            for i, (p, q) in enumerate(zip(x, y, strict=True)):
-                same(p, q, f"{where}[{i}]", max(numbers, default=0.0))
-        elif isinstance(x, float):
-            assert abs(y - x) <= rel * max(abs(x), scale), (where, x, y)
-        else:
-            assert x == y, where
-
-    for key in set(a) - times:
-        same(a[key], b[key], key)
+    assert differences(a, b, "json") == []
 
 
 def test_a_killed_vessel_restarts_to_the_uninterrupted_answer(tmp_path, demo):

@@ -264,8 +264,7 @@ def _path_record(path: ContinuationPath) -> dict:
 def _path_from(record: dict) -> ContinuationPath:
     return ContinuationPath(
         factors=list(record["factors"]),
-        results=[SolveResult(True, "converged (before the restart)", its, [], WorkCounts())
-                 for its in record["iterations"]],
+        results=[SolveResult.restored(its) for its in record["iterations"]],
         arc_lengths=list(record["arc_lengths"]), unstable=list(record["unstable"]),
         critical_points=[CriticalPoint(c["kind"], c["factor"], c["step"], tuple(c["between"]))
                          for c in record["critical_points"]],

@@ -135,6 +135,5 @@ def _path_record(path: LoadPath) -> dict:
 
 def _path_from(record: dict) -> LoadPath:
     return LoadPath(list(record["factors"]),
-                    [SolveResult(True, "converged (before the restart)", its, [], WorkCounts())
-                     for its in record["iterations"]],
+                    [SolveResult.restored(its) for its in record["iterations"]],
                     record["failures"], WorkCounts(**record["work"]))

@@ -53,6 +53,14 @@ class SolveResult:
     active_sizes: list[int] = field(default_factory=list)  # active nodes after each
     history: list[dict] = field(default_factory=list)  # per active-set iteration
 
+    @classmethod
+    def restored(cls, iterations: int) -> SolveResult:
+        """A step converged before a restart: its iteration count, no norms.
+
+        Its work is in the totals of the path it came back with.
+        """
+        return cls(True, "converged (before the restart)", iterations, [], WorkCounts())
+
     @property
     def orders(self) -> list[float]:
         """Observed orders from the residual norms (round-off tail excluded)."""
