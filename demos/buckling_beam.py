@@ -43,12 +43,10 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
-import ufl
 from mpi4py import MPI
 
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics, mixed
 from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
@@ -151,15 +149,7 @@ material = MATERIALS[args.material](args.E, args.nu)
 # Lagrangian $\Pi(u, p) = \int \tilde\varphi(e) + p\,g(e) - p^2/(2k)$
 # (`fenics_nl.materials.mixed`).
 
-# +
-f = cantilever.fields
-if args.mixed:
-    internal = mixed.internal_work(material, f.u, f.p, f.v, f.q, cantilever.model)
-else:
-    grad_v = kinematics.displacement_gradient(f.v, cantilever.model)
-    internal = ufl.inner(material.first_piola(f.u, cantilever.model), grad_v)
-residual = internal * cantilever.dx - ufl.dot(cantilever.traction, f.v) * cantilever.ds_end
-# -
+residual = cantilever.residual(material)  # fields.internal_work(material, model) * dx − t·v ds
 beam = Beam(cantilever, material, residual)
 say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
     f"{args.material}, plane {args.plane}{', mixed Q2-Q1' if args.mixed else ''}")

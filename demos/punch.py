@@ -40,13 +40,11 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
-import ufl
 from mpi4py import MPI
 
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import cli, output, pictures
 from fenics_nl.io.cli import say
-from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -225,14 +223,7 @@ else:
 
 # +
 u = block.u
-if args.mixed:
-    m = block.mixed
-    residual = mixed.internal_work(material, m.u, m.p, m.v, m.q, block.kinematics) * block.dx
-else:
-    v = ufl.TestFunction(block.V)
-    eps = kinematics.small_strain
-    residual = (ufl.inner(material.stress(eps(u, block.kinematics)), eps(v, block.kinematics))
-                * block.weight * block.dx)
+residual = block.residual(material)  # block.fields.internal_work(material, model) * dx
 # -
 
 # ### The active-set loop, in load steps
@@ -255,7 +246,7 @@ states = load.states
 
 def fields():
     """What --output writes at every converged step (a time series)."""
-    state = [block.displacement(), *([m.pressure()] if args.mixed else []),
+    state = [block.displacement(), *([block.fields.pressure()] if args.mixed else []),
              *punch.contact_fields(), punch.von_mises()]
     return state + (material.output_fields() if args.material == "j2" else [])
 

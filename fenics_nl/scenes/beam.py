@@ -92,6 +92,15 @@ class Cantilever:
         """Global number of scalar unknowns (with the pressure's, if mixed)."""
         return output.dofs(self.unknown.function_space)
 
+    def residual(self, material) -> ufl.Form:
+        """R(u; v) of a finite-strain `material` under the end's dead traction.
+
+        The unknown's internal work (`materials.mixed`): P(u) : ∇v, or δΠ(u, p) if mixed.
+        """
+        f = self.fields
+        return (f.internal_work(material, self.model) * self.dx
+                - ufl.dot(self.traction, f.v) * self.ds_end)
+
     def set_load(self, P: float) -> None:
         """Dead end load: axial compression P and the lateral imperfection ε P."""
         self.traction.value[:] = [-P / self.h, self.imperfection * P / self.h]
@@ -113,14 +122,7 @@ def build_beam(length: float, thickness: float, E: float, nu: float, *,
         raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
     cantilever = Cantilever(length, thickness, **options)
     law = MATERIALS[material](E, nu)
-    f, model = cantilever.fields, cantilever.model
-    if f.mixed:
-        work = mixed.internal_work(law, f.u, f.p, f.v, f.q, model)
-    else:
-        work = ufl.inner(law.first_piola(f.u, model),
-                         kinematics.displacement_gradient(f.v, model))
-    residual = work * cantilever.dx - ufl.dot(cantilever.traction, f.v) * cantilever.ds_end
-    return Beam(cantilever, law, residual)
+    return Beam(cantilever, law, cantilever.residual(law))
 
 
 class Beam:

@@ -167,6 +167,14 @@ class PunchBlock:
         if tangential:
             self.symmetry_factor /= 2
 
+    def residual(self, material) -> ufl.Form:
+        """R(u; v) of `material` in this block's unknown and model, with no external load.
+
+        The unknown's internal work (`materials.mixed`): δΠ(u, p) in the mixed formulation,
+        σ(ε(u)) : ε(v) (times 2πr in the axisymmetric model) in the displacement one.
+        """
+        return self.fields.internal_work(material, self.kinematics) * self.dx
+
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""
         return self.fields.displacement()
@@ -186,16 +194,7 @@ def build_punch(model: str, material, radius: float, a: float, *, refine: int = 
     """
     body = PunchBlock(model, a, refine=refine, block=block, growth=growth, comm=comm,
                       mixed=mixed, degree=degree, tangential=tangential)
-    if mixed:
-        m = body.mixed
-        residual = mixed_form.internal_work(material, m.u, m.p, m.v, m.q,
-                                            body.kinematics) * body.dx
-    else:
-        eps = kinematics.small_strain
-        v = ufl.TestFunction(body.V)
-        residual = (ufl.inner(material.stress(eps(body.u, body.kinematics)),
-                              eps(v, body.kinematics)) * body.weight * body.dx)
-    return Punch(body, material, residual, radius, **options)
+    return Punch(body, material, body.residual(material), radius, **options)
 
 
 class Punch:
