@@ -240,6 +240,10 @@ class NewtonSolver:
     only when CG needed more than REUSE_ITERATIONS iterations. Where the tangent changes by
     a low-rank term (a few constrained rows), CG converges in a handful of iterations.
 
+    The options, keyword-only, come in three groups, in this order below: the variant (which
+    tangent, when it is rebuilt: `method` to `line_search`), convergence (`rtol` to
+    `divergence_tol`) and the linear solver (`linear_solver` to `prefix`).
+
     Args:
         residual: the residual form R(u; v), linear in the test function v.
         u: the unknown; its current value is the starting point and holds the solution.
@@ -252,21 +256,26 @@ class NewtonSolver:
             material with internal variables gives its elastic tangent this way: K(0) would
             read its current state).
         period: iterations between tangent rebuilds of ``periodic``.
-        linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
-        prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...).
+        bfgs_memory: pairs kept by ``bfgs``.
+        line_search: True (or ``residual``): backtracking (halving, at most 10 times) until
+            ‖R‖ falls; ``slope``: the full step if ‖R‖ fell, else secant steps to the
+            energy's minimum along the step (for a minimised smooth energy, a hyperelastic
+            law: see `_step`).
         rtol: convergence when ‖R‖ ≤ rtol ‖R₀‖ ...
         atol: ... or ‖R‖ ≤ atol F, F = `force_scale` (relative too).
         force_scale: a force of the problem (the load); default the largest ‖R₀‖ seen.
         max_it: iterations before ConvergenceError.
         divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ stops with ConvergenceError.
-        line_search: True (or ``residual``): backtracking (halving, at most 10 times) until
-            ‖R‖ falls; ``slope``: the full step if ‖R‖ fell, else secant steps to the
-            energy's minimum along the step (for a minimised smooth energy, a hyperelastic
-            law: see `_step`).
-        bfgs_memory: pairs kept by ``bfgs``.
+        linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
+        prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
+            above can be overridden from the command line.
+
+    Terms that no integral gives (point forces, the springs of friction's slip) reach the
+    tangent and the residual through one hook, `nodal` (`solvers.nodal.NodalTerms`), owned
+    by whoever sets them.
 
     Example::
 
@@ -281,21 +290,24 @@ class NewtonSolver:
         u: fem.Function,
         bcs: Sequence[fem.DirichletBC] = (),
         *,
+        # the variant
         method: str = "full",
         tangent: ufl.Form | None = None,
         constant_tangent: str | ufl.Form = "initial",
         period: int = 3,
-        linear_solver: str = "lu",
-        prefix: str = "newton_",
+        bfgs_memory: int = 30,
+        line_search: bool | str = False,
+        # convergence
         rtol: float = 1e-10,
         atol: float = 1e-10,
         force_scale: float | None = None,
         max_it: int = 50,
         divergence_tol: float = 1e8,
-        line_search: bool | str = False,
-        bfgs_memory: int = 30,
+        # the linear solver
+        linear_solver: str = "lu",
         reuse_factorization: bool = False,
         preconditioner: ufl.Form | None = None,
+        prefix: str = "newton_",
     ):
         if method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
