@@ -30,7 +30,6 @@
 # +
 import math
 import resource
-import sys
 import time
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
@@ -48,9 +47,6 @@ from fenics_nl.parallel import global_max
 from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket, BracketPart
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import stalled_at_round_off
-
-if __name__ == "__main__":  # `python demos/bracket.py [options]`: the cells below, run by
-    sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
 
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "bfgs", "snes")

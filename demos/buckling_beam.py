@@ -36,7 +36,6 @@
 
 # +
 import math
-import sys
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -50,9 +49,6 @@ from fenics_nl.io.cli import say
 from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
-
-if __name__ == "__main__":  # `python demos/buckling_beam.py [options]`: the cells below,
-    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
 
 comm = MPI.COMM_WORLD
 # -

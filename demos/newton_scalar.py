@@ -21,16 +21,12 @@
 
 # +
 import math
-import sys
 
 import mpmath
 import numpy as np
 
 from fenics_nl.io import cli
 from fenics_nl.solvers import scalar
-
-if __name__ == "__main__":  # `python demos/newton_scalar.py [options]`: the cells below, run
-    sys.exit(cli.run_file(__file__))  # by cli.run_file (one-line errors, the JSON written)
 
 # Each function: r(u), a starting point, and what it models.
 

@@ -24,7 +24,6 @@
 
 # +
 import math
-import sys
 import time
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
@@ -44,9 +43,6 @@ from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
 from fenics_nl.theory import vessels
-
-if __name__ == "__main__":  # `python demos/pressure_vessel.py [options]`: the cells below,
-    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
 
 comm = MPI.COMM_WORLD
 # -

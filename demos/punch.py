@@ -33,7 +33,6 @@
 
 # +
 import math
-import sys
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -51,9 +50,6 @@ from fenics_nl.parallel import global_max
 from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz, mindlin
-
-if __name__ == "__main__":  # `python demos/punch.py [options]`: the cells below, run by
-    sys.exit(cli.run_file(__file__))  # cli.run_file (one-line errors, the JSON written first)
 
 comm = MPI.COMM_WORLD
 MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns

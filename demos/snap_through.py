@@ -29,7 +29,6 @@
 
 # +
 import math
-import sys
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -44,9 +43,6 @@ from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as theory
-
-if __name__ == "__main__":  # `python demos/snap_through.py [options]`: the cells below,
-    sys.exit(cli.run_file(__file__))  # run by cli.run_file (one-line errors, JSON first)
 
 comm = MPI.COMM_WORLD
 # -

@@ -2,9 +2,12 @@
 
 import json
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
+from conftest import DEMOS
 
 from fenics_nl.theory import vessels
 
@@ -162,3 +165,18 @@ def test_a_killed_vessel_on_two_ranks_restarts_to_the_same_answer(tmp_path, demo
     resumed = demo.json("pressure_vessel.py", *VESSEL_PATH, "--restart", tmp_path / "ck",
                         ranks=2)
     same_run(whole, resumed)
+
+
+def test_as_a_script_a_failed_run_is_one_line_and_keeps_its_steps(tmp_path):
+    # the demo run by `python`, as a user does (the other tests run its cells in-process):
+    # the script's own run (io.cli.arguments) ends a library error with one line, status 2
+    # and the JSON of the steps that converged
+    proc = subprocess.run([sys.executable, str(DEMOS / "pressure_vessel.py"),
+                           "--pressure-ratio", "1.1", "--steps", "5", "--size", "12.5",
+                           "--json", "failed.json"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "the limit load was reached" in lines[0]
+    d = json.loads((tmp_path / "failed.json").read_text())
+    assert d["status"] == "failed" and d["converged_steps"] == len(d["steps"]) >= 5

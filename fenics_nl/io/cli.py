@@ -1,12 +1,14 @@
 """Command-line plumbing shared by the demos: argument types, PETSc options, the run itself.
 
-A demo is a script of top-level cells. Its ``if __name__ == "__main__"`` line hands the file
-to `run_file`, which runs the cells again: the first calls `arguments` (flags from
-`parser(...)`: every default shown once, numeric flags that refuse NaN and infinities by
-name; PETSc options accepted only under the run's own prefixes), the last `results`.
-`run_file` turns the library's errors into one line and a non-zero exit, writes the JSON
-first and then every other output, each on its own, so that a failing picture never loses
-the numbers, and reports a PETSc option that no solver read.
+A demo is a plain script of top-level cells (jupytext's light format), run once, top to
+bottom. Its first cell calls `arguments` (flags from `parser(...)`: every default shown
+once, numeric flags that refuse NaN and infinities by name; PETSc options accepted only
+under the run's own prefixes), its last `results`. Run as a script, `arguments` starts the
+run: the library's errors end it with one line and status 2, `results` writes the JSON first
+and then every other output, each on its own, so that a failing picture never loses the
+numbers, and reports a PETSc option that no solver read. In a notebook the same cells run
+with the defaults (or the flags in the environment variable FENICS_NL_ARGS). `run_file`
+runs a demo's cells in this process under the same contract (the tests do).
 
 Nothing computed is lost: the output paths are checked before anything is solved, and each
 converged step a scene reports (`converged_step`) is kept, so that a run that fails after
@@ -22,6 +24,7 @@ import math
 import os
 import re
 import runpy
+import shlex
 import sys
 import time
 import traceback
@@ -49,6 +52,7 @@ __all__ = [
     "finite",
     "known",
     "material_flags",
+    "notebook_results",
     "on_failure",
     "parse_with_petsc_options",
     "parser",
@@ -261,6 +265,8 @@ class _Run:
 
     def __init__(self, argv: Sequence[str]):
         self.argv = list(argv)
+        self.t0 = time.perf_counter()
+        self.script = False  # started by `arguments` in a script (not by run_file)
         self.options: PetscOptions | None = None
         self.json_path: str | None = None
         self.out: dict | None = None
@@ -410,18 +416,18 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
     """Run a demo file's top-level cells under the scene contract; returns the exit status.
 
     A demo is a script (jupytext light format) whose cells call `arguments` first and
-    `results` last; its ``if __name__ == "__main__"`` line hands the file to this function,
-    which executes it again (as ``__scene__``) with `argv` (default: the command line).
+    `results` last; this function executes it in this process (as ``__scene__``) with
+    `argv` (default: the command line), as the tests do: its compiled forms stay loaded.
     Library errors end the run with one line and status 2; the JSON is written first, then
     every writer on its own (a failing one: status 1); a PETSc option no solver read:
-    status 2. Outside `run_file` (a notebook, an import), `arguments` gives the defaults.
+    status 2, as when the demo runs as a script.
     """
     global _current
     from petsc4py import PETSc
 
     run = _current = _Run(sys.argv[1:] if argv is None else argv)
     run.path = Path(path)
-    t0 = time.perf_counter()
+    t0 = run.t0
     try:
         runpy.run_path(str(path), run_name="__scene__")
     except SystemExit as stop:  # argparse: --help, or a bad flag (already said)
@@ -437,16 +443,25 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
     return _finish(run, t0)
 
 
+NOTEBOOK_ARGS = "FENICS_NL_ARGS"  # a demo's flags in a notebook (e.g. "--size 20")
+
+
 def arguments(parser: argparse.ArgumentParser,
               prefixes: dict[str, str] | Callable[[argparse.Namespace], dict[str, str]]
               ) -> argparse.Namespace:
-    """The demo's parameters: its command line inside `run_file`, else the defaults.
+    """The demo's parameters: its command line in a script or `run_file`, else the defaults.
 
+    Called by a script (``python demos/punch.py ...``), it starts the run (`_script_run`).
+    In a notebook: the defaults, or the flags in the environment variable FENICS_NL_ARGS.
     `prefixes` (or a function of the parsed arguments giving them): the PETSc options
     prefixes of the run's solvers, with what reads each; an option outside them is refused.
     """
+    caller = sys._getframe(1).f_globals
+    if _current is None and caller.get("__name__") == "__main__" and "__file__" in caller:
+        _script_run(Path(caller["__file__"]))
     run = _current
-    args, petsc = parse_with_petsc_options(parser, run.argv if run else [])
+    argv = run.argv if run else shlex.split(os.environ.get(NOTEBOOK_ARGS, ""))
+    args, petsc = parse_with_petsc_options(parser, argv)
     if run is not None:
         run.json_path = getattr(args, "json", None)
         run.output = getattr(args, "output", None)
@@ -532,9 +547,70 @@ def checkpointing(functions: dict, *, newton=None, contact=None,
 
 
 def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
-    """The run's quantities (the JSON) and its output writers, for `run_file` to write."""
-    if _current is not None:
-        _current.out, _current.writers = out, writers
+    """The run's quantities (the JSON) and its output writers.
+
+    A script's run ends here: the JSON first, then each writer, and the exit status (a
+    non-zero one ends the script). Inside `run_file`, it writes them; in a notebook, they are
+    kept for `notebook_results` (nothing is written).
+    """
+    global _current, _notebook_results
+    run = _current
+    if run is None:
+        _notebook_results = out
+        return
+    run.out, run.writers = out, writers
+    if not run.script:
+        return
+    _current = None
+    sys.excepthook = sys.__excepthook__
+    run.close_series()
+    status = _finish(run, run.t0)
+    if status:
+        sys.exit(status)
+
+
+_notebook_results: dict | None = None
+
+
+def notebook_results() -> dict | None:
+    """The quantities the last demo run in this kernel gave `results` (None: none yet)."""
+    return _notebook_results
+
+
+def _script_run(path: Path) -> None:
+    """Start the run of a demo called as a script: its command line, and its way out.
+
+    An error of the library (bad input, a solve that cannot converge) that reaches the top
+    of the script ends it with one line, the JSON of the converged steps and status 2, on
+    every rank; any other error keeps its traceback (a bug). The exit is immediate
+    (`os._exit` after MPI_Finalize): Python's own exit would give status 1.
+    """
+    global _current
+    run = _current = _Run(sys.argv[1:])
+    run.path, run.script = path, True
+
+    def one_line_exit(kind, err, tb):
+        global _current
+        from petsc4py import PETSc
+
+        _current = None
+        sys.excepthook = sys.__excepthook__
+        if not isinstance(err, (*EXPECTED_ERRORS, PETSc.Error)):
+            run.close_series()
+            _forget(run.options)
+            sys.__excepthook__(kind, err, tb)
+            return
+        try:
+            status = _failed(run, err, run.t0)
+        finally:
+            run.close_series()
+        sys.stdout.flush()
+        sys.stderr.flush()
+        if MPI.Is_initialized() and not MPI.Is_finalized():
+            MPI.Finalize()
+        os._exit(status)
+
+    sys.excepthook = one_line_exit
 
 
 def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
