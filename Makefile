@@ -7,7 +7,7 @@ MPIEXEC := $(VENV)/bin/mpiexec
 PYTHON ?= $(firstword $(wildcard $(shell pyenv root 2>/dev/null)/versions/3.1[2-9]*/bin/python3) \
 	$(wildcard $(HOME)/.pyenv/versions/3.1[2-9]*/bin/python3) $(shell command -v python3.12))
 
-.PHONY: demo test test-serial test-mpi bench bench-large lint clean
+.PHONY: demo test test-serial test-mpi docs docs-check bench bench-large lint clean
 
 $(VENV)/.installed: pyproject.toml
 	@if [ -z "$(PYTHON)" ]; then \
@@ -17,6 +17,11 @@ $(VENV)/.installed: pyproject.toml
 	$(PY) -m pip install --quiet -e ".[test]"
 	@# `import dolfinx` first works in this venv too (see the file)
 	cp fenics_nl/_import_order.pth "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/fenics_nl_import_order.pth"
+	@touch $@
+
+# the documentation's extra: Sphinx, MyST-NB, the theme, MathJax's files, Playwright
+$(VENV)/.docs-installed: $(VENV)/.installed
+	$(PY) -m pip install --quiet -e ".[test,docs]"
 	@touch $@
 
 # the benchmarks' extra: numba and the J2 peer (see pyproject.toml's bench extra)
@@ -71,8 +76,21 @@ bench-large: $(VENV)/.installed
 	$(PY) benchmarks/bracket.py --large --update-readme
 	$(PY) benchmarks/reading.py --update-readme
 
+# the site in docs/_build/html (open index.html): every demo executed as a notebook first
+# (docs/notebooks.py, ~20 s), then Sphinx, warnings as errors; no network needed
+docs: $(VENV)/.docs-installed
+	$(PY) docs/notebooks.py
+	$(PY) -m sphinx -b html -q -W --keep-going docs docs/_build/html
+	@echo "make docs: open $(CURDIR)/docs/_build/html/index.html"
+
+# every page of the built site in headless Chromium (Debian's package chromium): failed
+# requests, images that do not load, formulas not typeset, broken links; screenshots of the
+# landing page and a demo page in docs/screenshots/
+docs-check: docs
+	$(PY) docs/check.py
+
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 
 clean:
-	rm -rf $(VENV) *.egg-info results
+	rm -rf $(VENV) *.egg-info results docs/_build docs/demos docs/screenshots

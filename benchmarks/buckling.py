@@ -8,7 +8,7 @@ C. Step control: fixed steps against growing steps (with the end-state stability
 
 Writes benchmarks/results/buckling.json, buckling.png (error against wall time for each
 element; Newton iterations per load step for each variant) and, with --update-readme, the
-README tables.
+tables of docs/benchmarks.md.
 """
 
 import argparse

@@ -1,5 +1,6 @@
 """What every benchmark shares: the machine facts and run time stored with its results,
-the README section it regenerates between `<!-- bench:NAME -->` markers, plotting."""
+the documentation's section it regenerates between `<!-- bench:NAME -->` markers
+(docs/benchmarks.md, a page of `make docs`), plotting."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from pathlib import Path
 
 _START = time.perf_counter()
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+ROOT = Path(__file__).resolve().parents[1]
+TABLES = ROOT / "docs" / "benchmarks.md"  # where --update-readme writes the tables
 
 
 def machine(ranks: int = 1) -> dict:
@@ -51,25 +53,28 @@ def options(doc: str, quick: str):
 def publish(name: str, out: dict, table, args, say=print) -> None:
     """The end of a benchmark: its run time into `out`, `table(out)` shown, and unless
     --quick the results file benchmarks/results/`name`.json and, with --update-readme,
-    the README section `name`."""
+    the section `name` of docs/benchmarks.md."""
     import json
 
     out["benchmark_time_s"] = elapsed()
     text = table(out)
     say(text)
     if not args.quick:
-        (README.parent / "benchmarks" / "results" / f"{name}.json").write_text(
+        (ROOT / "benchmarks" / "results" / f"{name}.json").write_text(
             json.dumps(out, indent=2))
         if args.update_readme:
             update_readme(name, text)
 
 
 def update_readme(name: str, text: str) -> None:
-    """Replace the README's generated section `name` with `text`."""
-    src = README.read_text()
+    """Replace the generated section `name` of docs/benchmarks.md with `text`.
+
+    (The flag keeps its name, --update-readme: the tables were the README's.)
+    """
+    src = TABLES.read_text()
     start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
     i, j = src.index(start) + len(start), src.index(end)
-    README.write_text(src[:i] + "\n" + text + "\n" + src[j:])
+    TABLES.write_text(src[:i] + "\n" + text + "\n" + src[j:])
 
 
 def pyplot():

@@ -1,4 +1,4 @@
-"""Which method when: the README's reading of the benchmarks, written from their results.
+"""Which method when: the reading of the benchmarks in docs/benchmarks.md, from their results.
 
 Every figure and every choice ("fastest", "gave up at") is computed from the JSON files in
 benchmarks/results/, so the text stays true when `make bench` is run again. A benchmark

@@ -1,6 +1,7 @@
 """Numerical-stability stress cases: each ends in the right answer (checked) or a clear error.
 
-The README's stress table lists every case with its expected and observed behaviour.
+The stress table of docs/validation.md lists every case with its expected and observed
+behaviour.
 """
 
 import numpy as np

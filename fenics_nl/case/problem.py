@@ -266,7 +266,7 @@ class CaseProblem:
         return "slope" if minimised else True
 
     def make_solver(self):
-        """The case's solver (compiles the forms; reads the PETSc options under case_)."""
+        """The case's solver (compiles the forms; reads the PETSc options under ``case_``)."""
         self.solver = self._solver()
         return self.solver
 

@@ -234,7 +234,7 @@ class PetscOptions:
         PETSc.Options().insertString(" ".join(argv))
 
     def describe(self) -> str:
-        """'-prefix_ (what reads it), ...' for messages and --help."""
+        """``-prefix_ (what reads it), ...`` for messages and --help."""
         return ", ".join(f"-{p} ({what})" for p, what in self.prefixes.items())
 
     def unused(self) -> list[str]:
@@ -459,9 +459,12 @@ def arguments(parser: argparse.ArgumentParser,
     caller = sys._getframe(1).f_globals
     if _current is None and caller.get("__name__") == "__main__" and "__file__" in caller:
         _script_run(Path(caller["__file__"]))
+    global _notebook_args
     run = _current
     argv = run.argv if run else shlex.split(os.environ.get(NOTEBOOK_ARGS, ""))
     args, petsc = parse_with_petsc_options(parser, argv)
+    if run is None:
+        _notebook_args = args
     if run is not None:
         run.json_path = getattr(args, "json", None)
         run.output = getattr(args, "output", None)
@@ -550,13 +553,15 @@ def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
     """The run's quantities (the JSON) and its output writers.
 
     A script's run ends here: the JSON first, then each writer, and the exit status (a
-    non-zero one ends the script). Inside `run_file`, it writes them; in a notebook, they are
-    kept for `notebook_results` (nothing is written).
+    non-zero one ends the script). Inside `run_file`, it writes them. In a notebook the
+    quantities are kept for `notebook_results` and the pictures asked for (--png, --plot in
+    FENICS_NL_ARGS) are drawn and shown.
     """
     global _current, _notebook_results
     run = _current
     if run is None:
         _notebook_results = out
+        _show_in_notebook(writers)
         return
     run.out, run.writers = out, writers
     if not run.script:
@@ -570,6 +575,24 @@ def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
 
 
 _notebook_results: dict | None = None
+_notebook_args: argparse.Namespace | None = None  # a notebook's parameters
+
+
+def _show_in_notebook(writers: Sequence[Callable[[], None]]) -> None:
+    """Run the writers, each on its own, and show the pictures they wrote (IPython)."""
+    for write in writers:
+        try:
+            write()
+        except Exception as err:  # a picture must not stop the notebook
+            error(f"writing an output failed: {_one_line(err)}")
+    try:
+        from IPython.display import Image, display
+    except ImportError:
+        return
+    for flag in ("png", "plot"):
+        path = getattr(_notebook_args, flag, None)
+        if path and Path(path).suffix.lower() == ".png" and Path(path).is_file():
+            display(Image(filename=path))
 
 
 def notebook_results() -> dict | None:

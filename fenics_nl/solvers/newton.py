@@ -1,7 +1,9 @@
 """The Newton family on PETSc KSP: full, modified, periodic and BFGS, in one loop.
 
-Solves {R(U)} = {0} for a UFL residual with Dirichlet conditions, as in the course:
+Solves {R(U)} = {0} for a UFL residual with Dirichlet conditions, as in the course::
+
     K δU = −R,   U ← U + δU,   until ‖R‖ ≤ max(rtol ‖R₀‖, atol F).
+
 Both tolerances are relative: F is a force of the problem (the load; by default the
 largest first residual the solver has seen, the first load increment's imbalance), so the
 same problem gives the same iterations in any units.

@@ -1,7 +1,9 @@
 """The elastica: post-buckling of an inextensible cantilever under a dead axial load.
 
-With α the tip rotation, k = sin(α/2) and K, E the complete elliptic integrals of modulus k:
+With α the tip rotation, k = sin(α/2) and K, E the complete elliptic integrals of modulus k::
+
     P/P_cr = (2K(k)/π)²,   lateral tip deflection δ/L = 2k/K,   axial tip position x/L = 2E/K − 1,
+
 and P_cr = π²EI/(4L²) (Euler). SciPy's ellipk/ellipe take the parameter m = k².
 """
 

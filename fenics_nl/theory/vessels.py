@@ -1,8 +1,10 @@
 """Thick pressure vessels in perfect J2 plasticity under internal pressure p (small strain).
 
-Hollow sphere a < r < b (exact for every ν: σ_eq = |σ_θ − σ_r|):
+Hollow sphere a < r < b (exact for every ν: σ_eq = |σ_θ − σ_r|)::
+
     yield onset p_e = (2σ0/3)(1 − a³/b³); plastic radius c from
     p = 2σ0 ln(c/a) + (2σ0/3)(1 − c³/b³); limit 2σ0 ln(b/a).
+
 Cylinder, plane strain (Y = 2σ0/√3): limit Y ln(b/a) (exact); yield onset from Lamé with
 σ_z = ν(σ_r + σ_θ) (exact for every ν); c(p) = from p = Y ln(c/a) + (Y/2)(1 − c²/b²),
 which assumes σ_z = (σ_r + σ_θ)/2: exact for ν = 1/2 only.
