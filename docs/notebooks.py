@@ -4,13 +4,16 @@ and executed cell by cell in a Jupyter kernel (nbclient), with its flags in FENI
     python docs/notebooks.py          # docs/demos/<demo>.ipynb, executed, and its pictures
 
 `make docs` runs it before Sphinx (which then executes nothing); tests/test_notebooks.py
-runs the same `execute` and compares each notebook's results with the script's.
+runs the same `execute`, compares each notebook's results with the script's and keeps the
+executed notebook as the page (`save_page`): a page made from the same code (the digest of
+the library, the demos and the pins) with the same flags is not executed again.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -44,6 +47,7 @@ def pictures(name: str) -> list[str]:
 
 def execute(name: str, args: list[str], cwd: Path, timeout: int = 900):
     """Run demos/`name` as a notebook in `cwd` with `args`: (the notebook, its results)."""
+    OUT.mkdir(parents=True, exist_ok=True)
     import jupytext
     import nbformat
     from nbclient import NotebookClient
@@ -65,14 +69,54 @@ def execute(name: str, args: list[str], cwd: Path, timeout: int = 900):
     return nb, json.loads(printed)
 
 
-def main() -> int:
+def source_digest() -> str:
+    """A digest of what a demo's answer depends on: the library, the demos, the pins."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for path in sorted([*ROOT.glob("fenics_nl/**/*.py"), *DEMOS.glob("*.py"),
+                        ROOT / "pyproject.toml"]):
+        h.update(path.relative_to(ROOT).as_posix().encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def page_args(name: str) -> list[str]:
+    """The flags of the documentation's page of demo `name`: its small size, its pictures."""
+    return SMALL[name] + pictures(name)
+
+
+def save_page(nb, name: str, cwd: Path) -> None:
+    """Keep `nb`, executed in `cwd` with `page_args(name)`, and its pictures as the page."""
     import nbformat
 
     OUT.mkdir(parents=True, exist_ok=True)
-    for name, args in SMALL.items():
-        print(f"executing {name} {' '.join(args)}", flush=True)
-        nb, _ = execute(name, args + pictures(name), OUT)
-        nbformat.write(nb, OUT / f"{Path(name).stem}.ipynb")
+    for picture in pictures(name)[1::2]:
+        if cwd != OUT:
+            shutil.copyfile(cwd / picture, OUT / picture)
+    nb.metadata["fenics_nl"] = {"digest": source_digest(), "args": page_args(name)}
+    nbformat.write(nb, OUT / f"{Path(name).stem}.ipynb")
+
+
+def is_current(name: str) -> bool:
+    """Whether the page of `name` was made by this code with these flags."""
+    import nbformat
+
+    path = OUT / f"{Path(name).stem}.ipynb"
+    if not path.is_file() or not all((OUT / p).is_file() for p in pictures(name)[1::2]):
+        return False
+    made = nbformat.read(path, as_version=4).metadata.get("fenics_nl", {})
+    return made == {"digest": source_digest(), "args": page_args(name)}
+
+
+def main() -> int:
+    for name in SMALL:
+        if is_current(name):
+            print(f"{name}: its page is current (executed by the tests)")
+            continue
+        print(f"executing {name} {' '.join(page_args(name))}", flush=True)
+        nb, _ = execute(name, page_args(name), OUT)
+        save_page(nb, name, OUT)
     return 0
 
 
