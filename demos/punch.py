@@ -42,11 +42,12 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.domain.probes import Probes
-from fenics_nl.io import cli, output, pictures
+from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
+from fenics_nl.scenes import punch_pictures
 from fenics_nl.scenes.punch import Punch, PunchBlock, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz, mindlin
@@ -473,186 +474,6 @@ def summary():
     return out
 
 
-def plot(punch, states, ref, args):
-    profile = punch.surface_profile()
-    if comm.rank != 0:
-        return
-    plt = pictures.pyplot()
-
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    d = np.array([0.0] + [s.indentation for s in states])
-    P = np.array([0.0] + [s.force for s in states])
-    ax1.plot(d, P, "o", label="active set (FE)")
-    if args.model != "plane_strain":
-        dd = np.linspace(0, d.max(), 100)
-        Es = hertz.effective_modulus(args.E, args.nu)
-        ax1.plot(dd, 4 / 3 * Es * np.sqrt(args.radius) * dd**1.5, "-", label="Hertz")
-    ax1.set_xlabel("indentation δ [length]")
-    ax1.set_ylabel("force P [force]" + (" per unit length" if args.model == "plane_strain"
-                                        else ""))
-    ax1.legend()
-    ax1.grid(alpha=0.3)
-    if traction is not None and ref is not None:
-        traction_panel(ax2, traction_profile, ref)
-    elif ref is not None:
-        pressure_panel(ax2, profile, states[-1], ref)
-    fig.suptitle(title(states[-1], ref, args))
-    pictures.save_figure(fig, args.plot)
-
-
-def title(state, ref, args):
-    """The material, the load and the key figure, with what is checked against Hertz."""
-    return (f"ν = {args.nu:g}, {'Taylor–Hood P2–P1' if args.mixed else 'P1'}: "
-            + _checked(state, ref, args))
-
-
-def _checked(state, ref, args):
-    if ref is None:
-        return f"{args.model} punch: no contact (δ = {state.indentation:.3g})"
-    a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
-    p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
-    if args.model == "plane_strain":
-        return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
-                f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
-    if args.force is not None:  # P prescribed: the check is on the indentation it needs
-        d_ref = hertz.sphere_from_force(args.E, args.nu, args.radius, state.force)["indentation"]
-        return (f"{args.model} punch, P = {state.force:.4g} (prescribed): δ = "
-                f"{state.indentation:.3g} ({100 * (state.indentation / d_ref - 1):+.2f} % from "
-                f"Hertz), a {a_err:+.1f} %, p0 {p_err:+.1f} %")
-    return (f"{args.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
-            f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
-            f"p0 {p_err:+.1f} %")
-
-
-def traction_panel(ax, profile, ref):
-    """The tangential load against Cattaneo–Mindlin: the traction (2D) or the force inside
-    each radius (3D)."""
-    if args.model == "3d":
-        return sphere_traction_panel(ax, *profile)
-    cylinder_traction_panel(ax, profile, ref)
-
-
-def sphere_traction_panel(ax, rings, within):
-    """Q(r)/Q: the tangential force inside radius r, FE against Mindlin's."""
-    T, f = traction, args.friction
-    H = hertz.sphere_from_force(E, nu, R, T.normal_force)
-    a, p0 = H["contact_radius"], H["max_pressure"]
-    Q = T.tangential_force
-    ax.plot(rings / a, within / Q, "-", color="C0", lw=2, label="FE (sum of nodal forces)")
-    c = mindlin_checks.get("stick_radius_exact")
-    if c is not None:
-        ax.plot(rings / a, mindlin.sphere_tangential_force_within(rings, a, p0, f, c) / Q,
-                "k--", lw=1, label="Mindlin")
-        ax.axvline(c / a, color="k", ls=":", lw=0.8, label="stick radius c (Mindlin)")
-    ax.axvline(T.stick_radius / a, color="C0", ls=":", lw=0.8, label="outermost stick node")
-    ax.set_xlim(0, 1.5)
-    ax.set_xlabel("r / a (Hertz for the computed P)")
-    ax.set_ylabel("Q(r) / Q: tangential force inside r")
-    ax.set_title(f"f = {f:g}, Q = {Q / (f * T.normal_force):.3g} f P, {T.stick_nodes} nodes "
-                 f"stick, {T.slip_nodes} slip", fontsize=9)
-    ax.legend(fontsize=7, loc="upper left")
-    ax.grid(alpha=0.3)
-
-
-def cylinder_traction_panel(ax, profile, ref):
-    """p/p0 and q/(f p0) along x through the axis: FE nodes (stick, slip) against
-    Hertz and Cattaneo-Mindlin (a, p0 of Hertz for the computed P)."""
-    x, p, q, status = profile
-    a, p0, f = ref["contact_radius"], ref["max_pressure"], args.friction
-    c = mindlin_checks.get("stick_radius_exact")
-    xx = np.linspace(-1.5, 1.5, 601)
-    ax.plot(xx, hertz.pressure_profile(1.0, 1.0, xx), color="0.6", lw=1, label="Hertz p/p0")
-    ax.plot(x / a, p / p0, ".", color="0.6", ms=2, label="FE p/p0")
-    if c is not None:
-        ax.plot(xx, mindlin.traction(xx * a, a, p0, f, c) / (f * p0), "k-", lw=1,
-                label="Cattaneo-Mindlin q/(f p0)")
-        for side in (-1, 1):
-            ax.axvline(side * c / a, color="k", ls=":", lw=0.8)
-    for code, name, colour in ((1, "stick", "C0"), (2, "slip", "C1")):
-        on = status == code
-        ax.plot(x[on] / a, q[on] / (f * p0), "o", ms=3, color=colour, label=f"FE q, {name}")
-    ax.set_xlim(-1.5, 1.5)
-    ax.set_ylim(-0.05, 1.25)
-    ax.set_xlabel("x / a (Hertz)")
-    ax.set_ylabel("traction / p0, f p0")
-    ax.set_title(f"f = {f:g}, Q = {traction.tangential_force / (f * traction.normal_force):.3g}"
-                 f" f P: stick zone |x| < c (dotted: c of Cattaneo-Mindlin)", fontsize=9)
-    ax.legend(fontsize=7, loc="upper left")
-    ax.grid(alpha=0.3)
-
-
-def pressure_panel(ax, profile, state, ref):
-    """p/p0 against r/a (Hertz's a and p0), FE nodes against Hertz's ellipse."""
-    r, p, _ = profile
-    a, p0 = ref["contact_radius"], ref["max_pressure"]
-    ax.plot(r / a, p / p0, "o", ms=3, label="FE nodal pressure")
-    rr = np.linspace(0, 1.5, 300)
-    ax.plot(rr, hertz.pressure_profile(1.0, 1.0, rr), "-", label="Hertz")
-    # Hertz's a drawn over the FE one (they coincide on a fine mesh): both stay visible
-    ax.axvline(state.contact_radius / a, color="C3", ls="-", lw=2.5, alpha=0.6,
-               label=f"last active node: a = {state.contact_radius:.3g}")
-    ax.axvline(1.0, color="black", ls=(0, (3, 3)), lw=1.2, zorder=5,
-               label=f"Hertz a = {a:.3g}")
-    ax.set_xlim(0, 1.5)
-    ax.set_ylim(-0.05, 1.25)
-    ax.set_xlabel("r / a (Hertz)")
-    ax.set_ylabel(f"contact pressure p / p0 (Hertz p0 = {p0:.3g})")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-
-
-def picture(punch, vm, state, ref, args):
-    """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
-    section = output.section(block.displacement(), vm, normal_axis=1 if punch.block.vertical == 2
-                             else None)
-    profile = punch.surface_profile()
-    if comm.rank != 0:
-        return
-    plt = pictures.pyplot()
-    x, z, u_x, u_z, triangles, vm = section
-    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * punch.block.h)
-    window = 2.5 * a
-    # the rigid drop of the block is removed (the surface at the window's edge stays put),
-    # and the dent is drawn about a/4 deep
-    at_edge = np.argmin(np.hypot(x - window, z))
-    drop = u_z[at_edge]
-    dent = max(abs(state.indentation + drop), 1e-300)
-    scale = max(1.0, 0.25 * a / dent)
-    xd, zd = x + scale * u_x, z + scale * (u_z - drop)
-    p0 = ref["max_pressure"] if ref else max(state.max_pressure, 1e-300)
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 4.8),
-                                  gridspec_kw={"width_ratios": [1.25, 1]})
-    tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
-                       edgecolors="face", vmin=0)
-    ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
-    rr = np.linspace(-window if block.tangential else 0, window, 600)
-    gap = punch.gap_at(np.abs(rr), state.indentation)
-    ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
-    ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
-    ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
-    if ref:
-        ax.plot([ref["contact_radius"]] * 2, [-0.3 * a, -0.15 * a], color="k", lw=1)
-        ax.annotate("a (Hertz)", (ref["contact_radius"], -0.38 * a), ha="center", fontsize=8)
-    ax.set_xlim(-window if block.tangential else 0, window)
-    ax.set_ylim(-2 * a, 0.5 * a)
-    ax.set_aspect("equal")
-    ax.set_xlabel("r [length]" if args.model == "axisymmetric" else "x [length]")
-    ax.set_ylabel("z [length]" + (" (section y = 0)" if args.model == "3d" else ""))
-    ax.set_title(f"displacement x{scale:.3g}" + (f", rigid drop {-drop:.3g} removed"
-                                                 if abs(drop) > 0.05 * dent else ""),
-                 fontsize=9)
-    cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
-    cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
-    ax.legend(loc="lower right", fontsize=8)
-    if traction is not None and ref is not None:
-        traction_panel(ax2, traction_profile, ref)
-    elif ref is not None:
-        pressure_panel(ax2, profile, state, ref)
-    fig.suptitle(title(state, ref, args), fontsize=10)
-    pictures.save_figure(fig, args.png)
-
-
-
 writers = []
 vm = punch.von_mises() if args.png else None
 # gathered on every rank's call (rank 0 keeps it) before the writers run on rank 0
@@ -663,8 +484,12 @@ if traction is not None and (args.png or args.plot):  # collective: on every ran
         traction_profile = (rings, punch.tangential_force_within(rings))
     else:
         traction_profile = punch.traction_profile()
+run = punch_pictures.PunchRun(
+    punch, states, ref, E, nu, R, mixed=args.mixed, force_controlled=args.force is not None,
+    friction=args.friction, traction=traction, traction_profile=traction_profile,
+    stick_radius_exact=mindlin_checks.get("stick_radius_exact"))
 if args.plot:  # (--output: the fields of every step were written as they converged)
-    writers.append(lambda: plot(punch, states, ref, args))
+    writers.append(lambda: punch_pictures.curves(run, args.plot))
 if args.png:
-    writers.append(lambda: picture(punch, vm, last, ref, args))
+    writers.append(lambda: punch_pictures.section_picture(run, vm, args.png))
 cli.results(summary(), writers)

@@ -1,0 +1,239 @@
+"""The punch's pictures, against the closed forms of Hertz and Cattaneo–Mindlin.
+
+The force–indentation curve, the deformed contact zone in section, and the contact
+pressure (or, with friction, the tangential traction) along the surface.
+
+`curves` and `section_picture` are collective (the surface profile and the section are
+gathered on rank 0, which draws); `PunchRun` is what they read of a run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fenics_nl.io import output, pictures
+from fenics_nl.theory import hertz, mindlin
+
+__all__ = ["PunchRun", "curves", "section_picture"]
+
+
+@dataclass
+class PunchRun:
+    """What the pictures read of a punch run.
+
+    Args:
+        punch: the solved `Punch`.
+        states: the converged load steps (`Indentation` records), loading then unloading.
+        ref: Hertz's values for the last step (None: no contact).
+        E, nu, radius: the material and the punch radius.
+        mixed: Taylor–Hood elements (for the title).
+        force_controlled: the force was prescribed (the check is then on δ).
+        friction: Coulomb's f, or None.
+        traction: the tangential load's `Traction` record, or None.
+        traction_profile: its gathered profile (`Punch.traction_profile`, or in 3D the
+            radii and the force inside each), computed on every rank.
+        stick_radius_exact: Cattaneo–Mindlin's c for the computed load, if known.
+    """
+
+    punch: object
+    states: list
+    ref: dict | None
+    E: float
+    nu: float
+    radius: float
+    mixed: bool = False
+    force_controlled: bool = False
+    friction: float | None = None
+    traction: object = None
+    traction_profile: tuple | None = None
+    stick_radius_exact: float | None = None
+    model: str = field(init=False)
+
+    def __post_init__(self):
+        self.model = self.punch.model
+
+
+def curves(run: PunchRun, path: str) -> None:
+    """P(δ) of every step against Hertz, beside the pressure (or traction) panel."""
+    profile = run.punch.surface_profile()  # collective
+    if run.punch.mesh.comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    d = np.array([0.0] + [s.indentation for s in run.states])
+    P = np.array([0.0] + [s.force for s in run.states])
+    ax1.plot(d, P, "o", label="active set (FE)")
+    if run.model != "plane_strain":
+        dd = np.linspace(0, d.max(), 100)
+        Es = hertz.effective_modulus(run.E, run.nu)
+        ax1.plot(dd, 4 / 3 * Es * np.sqrt(run.radius) * dd**1.5, "-", label="Hertz")
+    ax1.set_xlabel("indentation δ [length]")
+    ax1.set_ylabel("force P [force]" + (" per unit length" if run.model == "plane_strain"
+                                        else ""))
+    ax1.legend()
+    ax1.grid(alpha=0.3)
+    _right_panel(ax2, run, profile, run.states[-1])
+    fig.suptitle(title(run, run.states[-1]))
+    pictures.save_figure(fig, path)
+
+
+def title(run: PunchRun, state) -> str:
+    """The elements, the load and the key figure, with what is checked against Hertz."""
+    return (f"ν = {run.nu:g}, {'Taylor–Hood P2–P1' if run.mixed else 'P1'}: "
+            + _checked(run, state))
+
+
+def _checked(run: PunchRun, state) -> str:
+    ref = run.ref
+    if ref is None:
+        return f"{run.model} punch: no contact (δ = {state.indentation:.3g})"
+    a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
+    p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
+    if run.model == "plane_strain":
+        return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
+                f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
+    if run.force_controlled:  # P prescribed: the check is on the indentation it needs
+        d_ref = hertz.sphere_from_force(run.E, run.nu, run.radius, state.force)["indentation"]
+        return (f"{run.model} punch, P = {state.force:.4g} (prescribed): δ = "
+                f"{state.indentation:.3g} ({100 * (state.indentation / d_ref - 1):+.2f} % from "
+                f"Hertz), a {a_err:+.1f} %, p0 {p_err:+.1f} %")
+    return (f"{run.model} punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
+            f"({100 * (state.force / ref['force'] - 1):+.2f} % from Hertz), a {a_err:+.1f} %, "
+            f"p0 {p_err:+.1f} %")
+
+
+def _right_panel(ax, run: PunchRun, profile, state) -> None:
+    """The traction against Cattaneo–Mindlin with friction, else the pressure (Hertz)."""
+    if run.ref is None:
+        return
+    if run.traction is None:
+        pressure_panel(ax, profile, state, run.ref)
+    elif run.model == "3d":
+        sphere_traction_panel(ax, run)
+    else:
+        cylinder_traction_panel(ax, run)
+
+
+def sphere_traction_panel(ax, run: PunchRun) -> None:
+    """Q(r)/Q: the tangential force inside radius r, FE against Mindlin's."""
+    T, f = run.traction, run.friction
+    rings, within = run.traction_profile
+    H = hertz.sphere_from_force(run.E, run.nu, run.radius, T.normal_force)
+    a, p0 = H["contact_radius"], H["max_pressure"]
+    Q = T.tangential_force
+    ax.plot(rings / a, within / Q, "-", color="C0", lw=2, label="FE (sum of nodal forces)")
+    c = run.stick_radius_exact
+    if c is not None:
+        ax.plot(rings / a, mindlin.sphere_tangential_force_within(rings, a, p0, f, c) / Q,
+                "k--", lw=1, label="Mindlin")
+        ax.axvline(c / a, color="k", ls=":", lw=0.8, label="stick radius c (Mindlin)")
+    ax.axvline(T.stick_radius / a, color="C0", ls=":", lw=0.8, label="outermost stick node")
+    ax.set_xlim(0, 1.5)
+    ax.set_xlabel("r / a (Hertz for the computed P)")
+    ax.set_ylabel("Q(r) / Q: tangential force inside r")
+    ax.set_title(f"f = {f:g}, Q = {Q / (f * T.normal_force):.3g} f P, {T.stick_nodes} nodes "
+                 f"stick, {T.slip_nodes} slip", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
+
+
+def cylinder_traction_panel(ax, run: PunchRun) -> None:
+    """p/p0 and q/(f p0) along x through the axis, FE against Hertz and Cattaneo–Mindlin.
+
+    The FE nodes by status (stick, slip); a and p0 of Hertz for the computed P.
+    """
+    x, p, q, status = run.traction_profile
+    a, p0, f = run.ref["contact_radius"], run.ref["max_pressure"], run.friction
+    c = run.stick_radius_exact
+    xx = np.linspace(-1.5, 1.5, 601)
+    ax.plot(xx, hertz.pressure_profile(1.0, 1.0, xx), color="0.6", lw=1, label="Hertz p/p0")
+    ax.plot(x / a, p / p0, ".", color="0.6", ms=2, label="FE p/p0")
+    if c is not None:
+        ax.plot(xx, mindlin.traction(xx * a, a, p0, f, c) / (f * p0), "k-", lw=1,
+                label="Cattaneo-Mindlin q/(f p0)")
+        for side in (-1, 1):
+            ax.axvline(side * c / a, color="k", ls=":", lw=0.8)
+    for code, name, colour in ((1, "stick", "C0"), (2, "slip", "C1")):
+        on = status == code
+        ax.plot(x[on] / a, q[on] / (f * p0), "o", ms=3, color=colour, label=f"FE q, {name}")
+    ax.set_xlim(-1.5, 1.5)
+    ax.set_ylim(-0.05, 1.25)
+    ax.set_xlabel("x / a (Hertz)")
+    ax.set_ylabel("traction / p0, f p0")
+    T = run.traction
+    ax.set_title(f"f = {f:g}, Q = {T.tangential_force / (f * T.normal_force):.3g}"
+                 f" f P: stick zone |x| < c (dotted: c of Cattaneo-Mindlin)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
+
+
+def pressure_panel(ax, profile, state, ref) -> None:
+    """p/p0 against r/a (Hertz's a and p0), FE nodes against Hertz's ellipse."""
+    r, p, _ = profile
+    a, p0 = ref["contact_radius"], ref["max_pressure"]
+    ax.plot(r / a, p / p0, "o", ms=3, label="FE nodal pressure")
+    rr = np.linspace(0, 1.5, 300)
+    ax.plot(rr, hertz.pressure_profile(1.0, 1.0, rr), "-", label="Hertz")
+    # Hertz's a drawn over the FE one (they coincide on a fine mesh): both stay visible
+    ax.axvline(state.contact_radius / a, color="C3", ls="-", lw=2.5, alpha=0.6,
+               label=f"last active node: a = {state.contact_radius:.3g}")
+    ax.axvline(1.0, color="black", ls=(0, (3, 3)), lw=1.2, zorder=5,
+               label=f"Hertz a = {a:.3g}")
+    ax.set_xlim(0, 1.5)
+    ax.set_ylim(-0.05, 1.25)
+    ax.set_xlabel("r / a (Hertz)")
+    ax.set_ylabel(f"contact pressure p / p0 (Hertz p0 = {p0:.3g})")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+
+
+def section_picture(run: PunchRun, von_mises, path: str) -> None:
+    """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
+    punch, block, state, ref = run.punch, run.punch.block, run.states[-1], run.ref
+    section = output.section(block.displacement(), von_mises,
+                             normal_axis=1 if block.vertical == 2 else None)  # collective
+    profile = punch.surface_profile()
+    if punch.mesh.comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    x, z, u_x, u_z, triangles, vm = section
+    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * block.h)
+    window = 2.5 * a
+    # the rigid drop of the block is removed (the surface at the window's edge stays put),
+    # and the dent is drawn about a/4 deep
+    at_edge = np.argmin(np.hypot(x - window, z))
+    drop = u_z[at_edge]
+    dent = max(abs(state.indentation + drop), 1e-300)
+    scale = max(1.0, 0.25 * a / dent)
+    xd, zd = x + scale * u_x, z + scale * (u_z - drop)
+    p0 = ref["max_pressure"] if ref else max(state.max_pressure, 1e-300)
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 4.8),
+                                  gridspec_kw={"width_ratios": [1.25, 1]})
+    tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
+                       edgecolors="face", vmin=0)
+    ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
+    left = -window if block.tangential else 0
+    rr = np.linspace(left, window, 600)
+    gap = punch.gap_at(np.abs(rr), state.indentation)
+    ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
+    ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
+    ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
+    if ref:
+        ax.plot([ref["contact_radius"]] * 2, [-0.3 * a, -0.15 * a], color="k", lw=1)
+        ax.annotate("a (Hertz)", (ref["contact_radius"], -0.38 * a), ha="center", fontsize=8)
+    ax.set_xlim(left, window)
+    ax.set_ylim(-2 * a, 0.5 * a)
+    ax.set_aspect("equal")
+    ax.set_xlabel("r [length]" if run.model == "axisymmetric" else "x [length]")
+    ax.set_ylabel("z [length]" + (" (section y = 0)" if run.model == "3d" else ""))
+    ax.set_title(f"displacement x{scale:.3g}" + (f", rigid drop {-drop:.3g} removed"
+                                                 if abs(drop) > 0.05 * dent else ""),
+                 fontsize=9)
+    cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
+    cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
+    ax.legend(loc="lower right", fontsize=8)
+    _right_panel(ax2, run, profile, state)
+    fig.suptitle(title(run, state), fontsize=10)
+    pictures.save_figure(fig, path)
