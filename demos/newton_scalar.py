@@ -21,11 +21,14 @@
 
 # +
 import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import mpmath
 import numpy as np
 
 from fenics_nl.io import cli
+from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.solvers import scalar
 
 # Each function: r(u), a starting point, and what it models.
@@ -50,32 +53,30 @@ EXPECTED = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
 # defaults.
 
 # +
-def parser():
-    """The equation, the arithmetic and the outputs."""
-    p = cli.parser("Newton (order 2), modified Newton (order 1) and secant (order 1.618) on a "
-                   "scalar equation r(u) = 0, in many-digit arithmetic so that the orders show.")
-    p.add_argument("--function", choices=FUNCTIONS, default="spring",
-                   help="equation r(u) = 0 to solve (dimensionless): "
-                        + "; ".join(f"{k}: {v[2]}" for k, v in FUNCTIONS.items()))
-    p.add_argument("--u0", type=cli.finite, default=None,
-                   help="starting point (default: the function's own)")
-    p.add_argument("--slope", type=cli.finite, default=None,
-                   help="constant slope K of modified Newton (default: r'(u0))")
-    p.add_argument("--digits", type=cli.at_least(16), default=60,
-                   help="decimal digits of the arithmetic (16 = double precision floats)")
-    p.add_argument("--maxit", type=cli.at_least(1), default=500,
-                   help="iteration limit per method")
-    cli.add_outputs(p, json="orders and iteration counts",
-                    plot="draw |e_k+1| against |e_k| (log-log: the slopes are the orders)")
-    return p
+@dataclass
+class Orders(Parameters):
+    """Newton (order 2), modified Newton (order 1) and secant (order 1.618) on a scalar
+    equation r(u) = 0, in many-digit arithmetic so that the orders show."""
+
+    JSON = "orders and iteration counts"
+    OUTPUTS: ClassVar = {"plot": "draw |e_k+1| against |e_k| (log-log: the slopes are the "
+                                 "orders)"}
+
+    function: str = choice("spring", list(FUNCTIONS), "equation r(u) = 0 to solve "
+                           "(dimensionless): " + "; ".join(f"{k}: {v[2]}"
+                                                           for k, v in FUNCTIONS.items()))
+    u0: float | None = number(None, "starting point (default: the function's own)")
+    slope: float | None = number(None, "constant slope K of modified Newton (default: r'(u0))")
+    digits: int = number(60, "decimal digits of the arithmetic (16 = double precision "
+                         "floats)", at_least=16, at_most=1000)
+    maxit: int = number(500, "iteration limit per method", at_least=1)
+
+    def check(self):
+        if self.slope is not None and self.slope == 0:
+            raise ValueError("--slope must be non-zero")
 
 
-p = parser()
-args = cli.arguments(p, prefixes={})
-if args.digits > 1000:
-    p.error(f"--digits must be in [16, 1000], got {args.digits}")
-if args.slope is not None and args.slope == 0:
-    p.error("--slope must be non-zero")
+args = cli.arguments(Orders, prefixes={})
 r, u0_default, what = FUNCTIONS[args.function]
 u0 = args.u0 if args.u0 is not None else u0_default
 if args.digits > 16:

@@ -25,6 +25,8 @@
 # +
 import math
 import time
+from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -37,6 +39,7 @@ from mpi4py import MPI
 from fenics_nl.errors import SolveError
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
@@ -54,57 +57,56 @@ comm = MPI.COMM_WORLD
 # (`--newton snes`).
 
 # +
-def parser():
-    """Every parameter of the scene, with its unit and default."""
-    p = cli.parser(
-        "Thick sphere or cylinder under internal pressure in J2 plasticity: yield onset, "
-        "plastic zone, limit load and residual stresses against the closed forms. Units are "
-        "the user's, consistent (e.g. N, mm, MPa).",
-        epilog="PETSc options take the prefix -vessel_ (Newton's KSP) or -vessel_snes_ "
-               "(--newton snes), e.g. -vessel_ksp_view.")
-    p.add_argument("--shape", choices=["sphere", "cylinder"], default="sphere",
-                   help="hollow sphere (axisymmetric) or long cylinder (plane strain)")
-    p.add_argument("--inner-radius", type=cli.positive, default=100.0, help="a [length]")
-    p.add_argument("--outer-radius", type=cli.positive, default=200.0, help="b [length]")
-    p.add_argument("--E", type=cli.positive, default=210e3, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--sigma0", type=cli.positive, default=250.0, help="yield stress [stress]")
-    p.add_argument("--hardening", type=cli.finite, default=0.0,
-                   help="linear isotropic hardening modulus H [stress] (0: perfect)")
-    load = p.add_mutually_exclusive_group()
-    load.add_argument("--pressure-ratio", type=cli.positive, default=None,
-                      help="pressure control: final pressure / limit pressure (default 0.9)")
-    load.add_argument("--inner-displacement", type=cli.positive, default=None,
-                      help="displacement control: final radial displacement of the inner "
-                           "surface [length]; the pressure is read from its reaction")
-    p.add_argument("--unload", action="store_true", help="unload to zero afterwards")
-    p.add_argument("--steps", type=cli.at_least(1), default=10,
-                   help="equal load steps from zero to the final load (as many to unload); "
-                        "a step that fails is cut in half")
-    p.add_argument("--newton", choices=["full", "modified", "bfgs", "snes"], default="full",
-                   help="full: consistent tangent; modified: the elastic tangent, factorized "
-                        "once (the course's choice); bfgs: quasi-Newton; snes: PETSc SNES "
-                        "newtonls on the same residual and consistent tangent")
-    p.add_argument("--size", type=cli.positive, default=None,
-                   help="element size [length] (default (b - a)/16)")
-    p.add_argument("--mixed", action="store_true",
-                   help="Taylor–Hood P2–P1 displacement–pressure elements: no locking in the "
-                        "isochoric plastic flow on coarse meshes; ν = 0.5 allowed")
-    cli.add_outputs(p, png="the deformed quarter coloured by the cumulated plastic strain",
-                    plot="pressure against inner displacement, with the closed forms")
-    cli.add_checkpoints(p)
-    return p
+@dataclass
+class Vessel(Parameters):
+    """Thick sphere or cylinder under internal pressure in J2 plasticity: yield onset,
+    plastic zone, limit load and residual stresses against the closed forms. Units are the
+    user's, consistent (e.g. N, mm, MPa)."""
+
+    EPILOG = ("PETSc options take the prefix -vessel_ (Newton's KSP) or -vessel_snes_ "
+              "(--newton snes), e.g. -vessel_ksp_view.")
+    OUTPUTS: ClassVar = {"png": "the deformed quarter coloured by the cumulated plastic strain",
+                         "plot": "pressure against inner displacement, with the closed "
+                                 "forms"}
+    CHECKPOINTS = True
+
+    shape: str = choice("sphere", ["sphere", "cylinder"],
+                        "hollow sphere (axisymmetric) or long cylinder (plane strain)")
+    inner_radius: float = number(100.0, "a", unit="length", above=0)
+    outer_radius: float = number(200.0, "b", unit="length", above=0)
+    E: float = number(210e3, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    sigma0: float = number(250.0, "yield stress", unit="stress", above=0)
+    hardening: float = number(0.0, "linear isotropic hardening modulus H (0: perfect)",
+                              unit="stress", at_least=0)
+    pressure_ratio: float | None = number(
+        None, "pressure control: final pressure / limit pressure (default 0.9)", above=0,
+        group="load")
+    inner_displacement: float | None = number(
+        None, "displacement control: final radial displacement of the inner surface; the "
+        "pressure is read from its reaction", unit="length", above=0, group="load")
+    unload: bool = switch("unload to zero afterwards")
+    steps: int = number(10, "equal load steps from zero to the final load (as many to "
+                        "unload); a step that fails is cut in half", at_least=1)
+    newton: str = choice("full", ["full", "modified", "bfgs", "snes"],
+                         "full: consistent tangent; modified: the elastic tangent, factorized "
+                         "once (the course's choice); bfgs: quasi-Newton; snes: PETSc SNES "
+                         "newtonls on the same residual and consistent tangent")
+    size: float | None = number(None, "element size (default (b - a)/16)", unit="length",
+                                above=0)
+    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements: no locking in the "
+                         "isochoric plastic flow on coarse meshes; ν = 0.5 allowed")
+
+    def check(self):
+        if not self.inner_radius < self.outer_radius:
+            raise ValueError(f"--inner-radius must be below --outer-radius, got "
+                             f"{self.inner_radius:g} and {self.outer_radius:g}")
+        if self.pressure_ratio is None and self.inner_displacement is None:
+            self.pressure_ratio = 0.9
 
 
-p = parser()
-args = cli.arguments(p, prefixes={"vessel_": "Newton's KSP", "vessel_snes_": "SNES"})
+args = cli.arguments(Vessel, prefixes={"vessel_": "Newton's KSP", "vessel_snes_": "SNES"})
 a, b = args.inner_radius, args.outer_radius
-if not a < b:
-    p.error(f"--inner-radius must be below --outer-radius, got {a:g} and {b:g}")
-if args.hardening < 0:
-    p.error(f"--hardening must be >= 0, got {args.hardening:g}")
-if args.pressure_ratio is None and args.inner_displacement is None:
-    args.pressure_ratio = 0.9
 s0, shape = args.sigma0, args.shape
 p_lim = vessels.limit_pressure(shape, a, b, s0)
 p_e_exact = vessels.yield_onset_pressure(shape, a, b, s0, args.nu)

@@ -180,3 +180,19 @@ def test_as_a_script_a_failed_run_is_one_line_and_keeps_its_steps(tmp_path):
     assert "the limit load was reached" in lines[0]
     d = json.loads((tmp_path / "failed.json").read_text())
     assert d["status"] == "failed" and d["converged_steps"] == len(d["steps"]) >= 5
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--inner-radius", "300"], "--inner-radius must be below --outer-radius"),  # check()
+    (["--steps", "0"], "--steps: must be >= 1"),  # a bound of the field
+    (["--E", "nan"], "--E: must be a finite number"),
+    (["--hardening", "-1"], "--hardening: must be >= 0"),
+    (["--pressure-ratio", "0.5", "--inner-displacement", "1"], "not allowed with"),  # group
+    (["--shape", "cube"], "invalid choice"),
+])
+def test_bad_parameters_are_one_line_naming_the_flag(demo, args, words):
+    # the demo's parameters are one dataclass (io.parameters): its fields' bounds, groups
+    # and check() give these errors before anything is solved
+    proc = demo.run(["pressure_vessel.py", *args], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and words in lines[0], proc.stderr

@@ -446,16 +446,20 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
 NOTEBOOK_ARGS = "FENICS_NL_ARGS"  # a demo's flags in a notebook (e.g. "--size 20")
 
 
-def arguments(parser: argparse.ArgumentParser,
-              prefixes: dict[str, str] | Callable[[argparse.Namespace], dict[str, str]]
-              ) -> argparse.Namespace:
+def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], dict[str, str]]):
     """The demo's parameters: its command line in a script or `run_file`, else the defaults.
 
+    `parser`: a `parameters.Parameters` dataclass (its fields make the flags; an instance is
+    returned, checked), or an argparse parser (a Namespace is returned).
     Called by a script (``python demos/punch.py ...``), it starts the run (`_script_run`).
     In a notebook: the defaults, or the flags in the environment variable FENICS_NL_ARGS.
     `prefixes` (or a function of the parsed arguments giving them): the PETSc options
     prefixes of the run's solvers, with what reads each; an option outside them is refused.
     """
+    from fenics_nl.io import parameters
+
+    declared = isinstance(parser, type) and issubclass(parser, parameters.Parameters)
+    cls, parser = (parser, parameters.parser_of(parser)) if declared else (None, parser)
     caller = sys._getframe(1).f_globals
     if _current is None and caller.get("__name__") == "__main__" and "__file__" in caller:
         _script_run(Path(caller["__file__"]))
@@ -463,6 +467,8 @@ def arguments(parser: argparse.ArgumentParser,
     run = _current
     argv = run.argv if run else shlex.split(os.environ.get(NOTEBOOK_ARGS, ""))
     args, petsc = parse_with_petsc_options(parser, argv)
+    if declared:
+        args = parameters.from_namespace(cls, parser, args)
     if run is None:
         _notebook_args = args
     if run is not None:

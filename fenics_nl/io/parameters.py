@@ -1,0 +1,154 @@
+"""A demo's parameters as one small dataclass: its fields make the command line and --help.
+
+Each field says its default, its meaning, its unit and its range, once::
+
+    @dataclass
+    class Vessel(Parameters):
+        \"\"\"Thick sphere or cylinder under internal pressure in J2 plasticity.\"\"\"
+
+        shape: str = choice("sphere", ["sphere", "cylinder"], "hollow sphere or long cylinder")
+        inner_radius: float = number(100.0, "a", unit="length", above=0)
+        steps: int = number(10, "equal load steps", at_least=1)
+        unload: bool = switch("unload to zero afterwards")
+
+        def check(self):  # what involves several fields; a ValueError is one line, status 2
+            if not self.inner_radius < self.outer_radius: raise ValueError("...")
+
+`cli.arguments(Vessel, prefixes)` parses the command line (or, in a notebook, takes the
+defaults) and returns a `Vessel`. `OUTPUTS` and `CHECKPOINTS` add the scene contract's
+output flags (--json always; --png, --plot, --output, --checkpoint where a demo has them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+from collections.abc import Sequence
+from typing import ClassVar
+
+__all__ = ["Parameters", "choice", "number", "parser_of", "switch", "text"]
+
+
+def number(default, meaning: str, *, unit: str | None = None, above: float | None = None,
+           at_least: float | None = None, at_most: float | None = None,
+           group: str | None = None):
+    """A number flag: finite, within the bounds given; an integer if `default` is one.
+
+    Bounds: > `above`, >= `at_least`, <= `at_most`. `default` None: optional (the demo
+    decides what its absence means, said in `meaning`).
+    `group`: flags of one group exclude each other (e.g. force or displacement control).
+    """
+    return dataclasses.field(default=default, metadata={
+        "kind": "number", "meaning": meaning, "unit": unit, "above": above,
+        "at_least": at_least, "at_most": at_most, "group": group})
+
+
+def choice(default: str, options: Sequence[str], meaning: str, *, spelling: bool = False):
+    """One word among `options` (`spelling`: old spellings read, see `vocabulary`)."""
+    return dataclasses.field(default=default, metadata={
+        "kind": "choice", "meaning": meaning, "options": list(options), "spelling": spelling})
+
+
+def switch(meaning: str, *, group: str | None = None):
+    """An on/off flag, off by default."""
+    return dataclasses.field(default=False, metadata={"kind": "switch", "meaning": meaning,
+                                                      "group": group})
+
+
+def text(default: str | None, meaning: str, *, metavar: str = "PATH"):
+    """A word or a path, as given."""
+    return dataclasses.field(default=default, metadata={"kind": "text", "meaning": meaning,
+                                                        "metavar": metavar})
+
+
+@dataclasses.dataclass
+class Parameters:
+    """Base of a demo's parameters; subclasses add their fields and `check`."""
+
+    EPILOG: ClassVar[str | None] = None  # after the flags in --help (the PETSc prefixes)
+    # the output flags: {"png": what it draws, "plot": ..., "output": the fields written}
+    OUTPUTS: ClassVar[dict[str, str]] = {}
+    JSON: ClassVar[str] = "the quantities of interest"
+    CHECKPOINTS: ClassVar[bool] = False
+
+    def check(self) -> None:
+        """Conditions on several fields: raise ValueError (one line, status 2)."""
+
+
+def _number_type(f: dataclasses.Field):
+    m, integer = f.metadata, isinstance(f.default, int) and not isinstance(f.default, bool)
+
+    def parse(word: str):
+        try:
+            value = int(word) if integer else float(word)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"not {'an integer' if integer else 'a number'}: {word!r}") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"must be a finite number, got {word!r}")
+        if m["above"] is not None and not value > m["above"]:
+            raise argparse.ArgumentTypeError(f"must be > {m['above']:g}, got {word}")
+        if m["at_least"] is not None and not value >= m["at_least"]:
+            raise argparse.ArgumentTypeError(f"must be >= {m['at_least']:g}, got {word}")
+        if m["at_most"] is not None and not value <= m["at_most"]:
+            raise argparse.ArgumentTypeError(f"must be <= {m['at_most']:g}, got {word}")
+        return value
+
+    parse.__name__ = "integer" if integer else "number"
+    return parse
+
+
+def _add(target, f: dataclasses.Field) -> None:
+    """The flag of field `f` on the parser (or exclusive group) `target`."""
+    m = f.metadata
+    flag = "--" + f.name.replace("_", "-")
+    meaning = m["meaning"] + (f" [{m['unit']}]" if m.get("unit") else "")
+    if m["kind"] == "number":
+        target.add_argument(flag, dest=f.name, type=_number_type(f), default=f.default,
+                            help=meaning)
+    elif m["kind"] == "choice":
+        from fenics_nl.io.cli import spelling
+
+        target.add_argument(flag, dest=f.name, default=f.default, choices=m["options"],
+                            type=spelling(flag) if m["spelling"] else None, help=meaning)
+    elif m["kind"] == "switch":
+        target.add_argument(flag, dest=f.name, action="store_true", help=meaning)
+    else:
+        target.add_argument(flag, dest=f.name, default=f.default, metavar=m["metavar"],
+                            help=meaning)
+
+
+def parser_of(cls: type[Parameters]) -> argparse.ArgumentParser:
+    """The command line of `cls`: its description, a flag a field, the output flags."""
+    from fenics_nl.io import cli
+
+    description = " ".join((cls.__doc__ or "").split("\n\n")[0].split())
+    p = cli.parser(description, epilog=cls.EPILOG)
+    groups: dict[str, argparse._MutuallyExclusiveGroup] = {}
+    for f in dataclasses.fields(cls):
+        if "kind" not in f.metadata:
+            continue  # the output flags, added below
+        group = f.metadata.get("group")
+        if group and group not in groups:
+            groups[group] = p.add_mutually_exclusive_group()
+        _add(groups[group] if group else p, f)
+    cli.add_outputs(p, json=cls.JSON, **cls.OUTPUTS)
+    if cls.CHECKPOINTS:
+        cli.add_checkpoints(p)
+    return p
+
+
+def from_namespace(cls: type[Parameters], p: argparse.ArgumentParser,
+                   args: argparse.Namespace) -> Parameters:
+    """The parameters parsed into `args`, checked (a failed check: `p.error`, status 2)."""
+    values = cls(**{f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
+                    if hasattr(args, f.name)})
+    for name, value in vars(args).items():  # the output flags: attributes of the instance
+        if not hasattr(values, name):
+            setattr(values, name, value)
+    try:
+        values.check()
+    except ValueError as err:
+        p.error(str(err))
+    return values
