@@ -169,18 +169,9 @@ say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
 # stability check of the end state and, if needed, branch switching (`Beam.solve_path`).
 
 # +
-def progress(steps):
-    """Show about ten of the path's step lines, and every cut or branch switch."""
-    every = max(1, steps // 10)
-
-    def show(message):
-        if message.startswith("step "):
-            k = int(message.split()[1].rstrip(":"))
-            if k % every:
-                return
-        say("  " + message)
-
-    return show
+def progress(message):
+    """The path's step lines (about ten of them: `progress_every`), every cut or switch."""
+    say("  " + message)
 
 
 def centreline(beam):
@@ -222,7 +213,8 @@ redone, critical = [], []
 if args.path == "load":
     say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
     path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                     on_step=record, progress=progress(args.steps))
+                                     on_step=record, progress=progress,
+                                     progress_every=max(1, args.steps // 10))
     if beam.path_steps != args.steps:
         redone.append(f"the {args.steps}-step path ended on the straight (unstable) branch; "
                       f"it was redone with {beam.path_steps} steps")
@@ -230,7 +222,7 @@ else:  # λ = P/P_Euler is an unknown of the arc-length path
     say(f"arc-length path to P/P_Euler = {args.load_ratio:g} (first arc {args.arc_length:g})")
     path = beam.solve_arc_length(args.load_ratio, args.newton, arc_length=args.arc_length,
                                  on_step=lambda lam, r: record(lam / args.load_ratio, r),
-                                 progress=progress(40))
+                                 progress=progress, progress_every=4)
     switched = path.switched
     critical = [{"kind": c.kind, "load_ratio": c.factor, "between": list(c.between)}
                 for c in path.critical_points]

@@ -154,8 +154,7 @@ def record(lam, result):
 
 
 def progress(message):
-    if not message.startswith("step ") or int(message.split()[1].rstrip(":")) % 10 == 0:
-        say("  " + message)
+    say("  " + message)
 
 
 # --restart: the displacement, the continuation's state (the arc, the tangent's inertia,
@@ -171,6 +170,7 @@ if checkpoints.kept is not None:
 target = args.load_ratio * q_limit
 say(f"arc-length path to q0 = {args.load_ratio:g} x the limit load ({args.newton} Newton)")
 path = continuation.run(target, args.max_steps, on_step=record, progress=progress,
+                        progress_every=10,
                         **checkpoints.arc_options)
 # -
 

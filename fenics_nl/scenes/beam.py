@@ -205,7 +205,8 @@ class Beam:
                                    multipliers=self.fields.pressure_dofs)
 
     def solve_path(self, ratio: float, steps: int = 40, method: str = "full", *,
-                   grow: bool = False, on_step=None, progress=None) -> tuple[LoadPath, bool]:
+                   grow: bool = False, on_step=None, progress=None, progress_every: int = 1
+                   ) -> tuple[LoadPath, bool]:
         """Load steps from 0 to ratio·P_Euler, then make sure the end state is stable.
 
         Steps start at 1/steps and are cut on failure; with `grow` they also grow after easy
@@ -227,7 +228,8 @@ class Beam:
             self.u.x.array[:] = 0.0
             path = solve_incrementally(solver, lambda t: self.set_load(t * P), steps=steps,
                                        max_step=1.0 if grow else 1.0 / steps,
-                                       on_step=on_step, progress=progress)
+                                       on_step=on_step, progress=progress,
+                                       progress_every=progress_every)
             lam, mode = self.lowest_mode()
             if lam >= 0:
                 return path, False
@@ -252,7 +254,8 @@ class Beam:
         raise SolveError(f"no stable end state at P/P_cr = {ratio:g} with up to {steps} steps")
 
     def solve_arc_length(self, ratio: float, method: str = "full", *, arc_length: float = 0.2,
-                         max_steps: int = 1000, on_step=None, progress=None
+                         max_steps: int = 1000, on_step=None, progress=None,
+                         progress_every: int = 1
                          ) -> ContinuationPath:
         """Arc-length continuation from 0 to ratio·P_Euler (λ = P/P_Euler).
 
@@ -272,7 +275,8 @@ class Beam:
                         metric_dofs=f.displacement_dofs if f.mixed else None,
                         mass=self._displacement_mass(), multipliers=f.pressure_dofs)
         self.u.x.array[:] = 0.0
-        return arc.run(ratio, max_steps, on_step=on_step, progress=progress)
+        return arc.run(ratio, max_steps, on_step=on_step, progress=progress,
+                       progress_every=progress_every)
 
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""

@@ -521,6 +521,7 @@ class ArcLength:
     def run(self, target: float, max_steps: int = 100, *, start: float = 0.0,
             on_step: Callable[[float, SolveResult], None] | None = None,
             progress: Callable[[str], None] | None = None,
+            progress_every: int = 1,
             resume: ArcState | None = None,
             on_state: Callable[[ArcState], None] | None = None) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
@@ -532,6 +533,8 @@ class ArcLength:
         `on_state(state)` after each converged step but the last, with what a restart
         needs; `resume`: go on from such a state (u, and the internal variables, back in
         place): the path then takes the steps the uninterrupted run would have taken.
+        `progress(message)`: a line for every `progress_every`-th converged step, and for
+        every event (a limit point, a bifurcation, a cut arc).
         """
         if not math.isfinite(target) or target == start:
             raise ValueError(f"target load factor must be finite and differ from the start "
@@ -560,7 +563,7 @@ class ArcLength:
                 step = self._attempt(walk, path, target, say)
                 if step is None:  # cut, or redone shorter to bracket a critical point
                     continue
-                result = self._accept(walk, path, step, start, say)
+                result = self._accept(walk, path, step, start, say, progress_every)
                 if on_step:
                     on_step(walk.lam, result)
                 if step.landed:
@@ -679,8 +682,11 @@ class ArcLength:
         return True
 
     def _accept(self, walk: _Walk, path: ContinuationPath, step: _Step, start: float,
-                say) -> SolveResult:
-        """Record a converged step and the critical point it crossed; move the walk on."""
+                say, every: int) -> SolveResult:
+        """Record a converged step and the critical point it crossed; move the walk on.
+
+        `say` its line if it is an `every`-th step (or switched branch), and every event.
+        """
         if self.commit:
             self.commit()
         between = (walk.lam, step.lam)
@@ -696,8 +702,9 @@ class ArcLength:
         path.arc_lengths.append(walk.ds)
         path.unstable.append(step.count)
         path.work.add(step.work)
-        say(f"step {len(path.factors)}: λ = {step.lam:.6g}, arc {walk.ds:.3g}, {step.its} "
-            f"iterations" + (", branch switched" if switched else ""))
+        if len(path.factors) % every == 0 or switched:
+            say(f"step {len(path.factors)}: λ = {step.lam:.6g}, arc {walk.ds:.3g}, "
+                f"{step.its} iterations" + (", branch switched" if switched else ""))
         if step.turned:  # the extremum of λ over the states around the bracketed step
             near = [start, *path.factors][-3:]
             peak = max(near) if walk.sense > 0 else min(near)

@@ -85,6 +85,7 @@ def solve_incrementally(
     predictor: bool = True,
     on_step: Callable[[float, SolveResult], None] | None = None,
     progress: Callable[[str], None] | None = None,
+    progress_every: int = 1,
     commit: Callable[[], None] | None = None,
     restore: Callable[[], None] | None = None,
     start: DriverState | None = None,
@@ -96,7 +97,8 @@ def solve_incrementally(
     `start`: go on from a converged state (a restart: `solver.u` and the internal variables
     already hold it), `path_so_far` the path before it (the one returned goes on from it);
     `on_state(state, path)` after each converged step, with what a restart needs (a
-    checkpoint) and the path so far.
+    checkpoint) and the path so far. `progress(message)`: a line for every
+    `progress_every`-th converged step, and one for every cut step.
     """
     if steps < 1:
         raise ValueError(f"steps must be >= 1, got {steps}")
@@ -149,7 +151,8 @@ def solve_incrementally(
         path.factors.append(t)
         path.results.append(result)
         path.work.add(result.work)
-        if progress:  # a solver may keep no residual history (a composite load, say)
+        if progress and len(path.factors) % progress_every == 0:
+            # a solver may keep no residual history (a composite load, say)
             norm = (f", |R| = {result.residual_norms[-1]:.2e}" if result.residual_norms
                     else "")
             progress(f"step {len(path.factors)}: t = {t:.4g}, {result.iterations} "
