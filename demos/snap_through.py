@@ -29,6 +29,8 @@
 
 # +
 import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -39,6 +41,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
@@ -53,67 +56,60 @@ comm = MPI.COMM_WORLD
 # defaults. PETSc options take the prefix `-arch_` (`-arch_full_ksp_view`, ...).
 
 # +
-def parser():
-    """Every parameter of the scene, with its unit and default."""
-    p = cli.parser(
-        "Snap-through of a shallow sinusoidal arch under a sinusoidal load, traced by "
-        "arc-length continuation and checked against the shallow-arch closed form. Units "
-        "are the user's, consistent (e.g. N, m, Pa).",
-        epilog="PETSc options take the prefix -arch_<newton>_ (Newton's KSP, e.g. "
-               "-arch_full_ksp_view) and -arch_continuation_ (the stability checks' "
-               "factorizations and eigensolver).")
-    p.add_argument("--span", type=cli.positive, default=1.0, help="span L [length]")
-    p.add_argument("--slenderness", type=cli.positive, default=200.0,
-                   help="L/h, at least 20 (the closed form is a thin-arch theory) [-]")
-    p.add_argument("--rise", type=cli.positive, default=3.0,
-                   help="e/r: the rise over the section's radius of gyration r = h/√12, "
-                        "in (2, √22 = 4.69): a symmetric snap-through [-]")
-    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--load-ratio", type=cli.finite, default=1.5,
-                   help="the path is followed until q0 = ratio × the closed form's limit "
-                        "load [-]")
-    p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"],
-                   default="full", help="Newton variant of the corrector")
-    p.add_argument("--arc-length", type=cli.finite, default=0.2,
-                   help="first arc length Δs, > 0: dimensionless, on a linear path a load "
-                        "increment of Δs/√(1+ψ²) in units of EI k⁴ r (k = π/L) [-]")
-    p.add_argument("--max-arc-length", type=cli.finite, default=1.0,
-                   help="largest arc length (the adaptive Δs grows after easy steps) [-]")
-    p.add_argument("--psi", type=cli.finite, default=1.0,
-                   help="weight of the load factor in the arc, >= 0: 1 spherical, 0 "
-                        "cylindrical [-]")
-    p.add_argument("--max-steps", type=cli.at_least(1), default=300,
-                   help="steps before the run stops short of its target")
-    p.add_argument("--elements", type=cli.at_least(2), default=2,
-                   help="Q2 elements through the thickness, even (a node on the centreline)")
-    p.add_argument("--aspect", type=cli.positive, default=4.0,
-                   help="element length over element height along the span [-]")
-    cli.add_outputs(p, output="the displacement",
-                    png="the deformed arch at states along the path",
-                    plot="load against midspan rise, FE and closed form")
-    cli.add_checkpoints(p)
-    return p
+@dataclass
+class Arch(Parameters):
+    """Snap-through of a shallow sinusoidal arch under a sinusoidal load, traced by
+    arc-length continuation and checked against the shallow-arch closed form. Units are the
+    user's, consistent (e.g. N, m, Pa)."""
+
+    EPILOG = ("PETSc options take the prefix -arch_<newton>_ (Newton's KSP, e.g. "
+              "-arch_full_ksp_view) and -arch_continuation_ (the stability checks' "
+              "factorizations and eigensolver).")
+    OUTPUTS: ClassVar = {"output": "the displacement",
+                         "png": "the deformed arch at states along the path",
+                         "plot": "load against midspan rise, FE and closed form"}
+    CHECKPOINTS = True
+
+    span: float = number(1.0, "span L", unit="length", above=0)
+    slenderness: float = number(200.0, "L/h (the closed form is a thin-arch theory)",
+                                unit="-", at_least=20)
+    rise: float = number(3.0, "e/r: the rise over the section's radius of gyration "
+                         "r = h/√12, in (2, √22 = 4.69): a symmetric snap-through", unit="-")
+    E: float = number(1e3, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    load_ratio: float = number(1.5, "the path is followed until q0 = ratio × the closed "
+                               "form's limit load (not 0)", unit="-")
+    newton: str = choice("full", ["full", "modified", "periodic", "bfgs"],
+                         "Newton variant of the corrector", spelling=True)
+    arc_length: float = number(0.2, "first arc length Δs: dimensionless, on a linear path a "
+                               "load increment of Δs/√(1+ψ²) in units of EI k⁴ r (k = π/L)",
+                               unit="-", above=0)
+    max_arc_length: float = number(1.0, "largest arc length (the adaptive Δs grows after "
+                                   "easy steps), >= --arc-length", unit="-")
+    psi: float = number(1.0, "weight of the load factor in the arc: 1 spherical, 0 "
+                        "cylindrical", unit="-", at_least=0)
+    max_steps: int = number(300, "steps before the run stops short of its target", at_least=1)
+    elements: int = number(2, "Q2 elements through the thickness, even (a node on the "
+                           "centreline)", at_least=2)
+    aspect: float = number(4.0, "element length over element height along the span",
+                           unit="-", above=0)
+
+    def check(self):
+        if not 2 < self.rise < math.sqrt(22):
+            raise ValueError(f"--rise must be in (2, √22 = 4.69), got {self.rise}: at e/r <= 2 "
+                             "the arch never snaps, beyond √22 it buckles antisymmetrically "
+                             "before its limit point, where the closed form does not hold")
+        if self.elements % 2:
+            raise ValueError(f"--elements must be even (a node on the centreline), got "
+                             f"{self.elements}")
+        if not self.max_arc_length >= self.arc_length:
+            raise ValueError(f"--max-arc-length must be >= --arc-length, got "
+                             f"{self.max_arc_length}")
+        if self.load_ratio == 0:
+            raise ValueError("--load-ratio must not be 0 (the path starts there)")
 
 
-p = parser()
-args = cli.arguments(p, prefixes={"arch_": "Newton and the stability checks"})
-if args.slenderness < 20:
-    p.error(f"--slenderness must be >= 20, got {args.slenderness}")
-if not 2 < args.rise < math.sqrt(22):
-    p.error(f"--rise must be in (2, √22 = 4.69), got {args.rise}: at e/r <= 2 the arch never "
-            "snaps, beyond √22 it buckles antisymmetrically before its limit point, where the "
-            "closed form does not hold")
-if args.elements % 2:
-    p.error(f"--elements must be even (a node on the centreline), got {args.elements}")
-if not args.arc_length > 0:
-    p.error(f"--arc-length must be > 0, got {args.arc_length}")
-if not args.max_arc_length >= args.arc_length:
-    p.error(f"--max-arc-length must be >= --arc-length, got {args.max_arc_length}")
-if args.psi < 0:
-    p.error(f"--psi must be >= 0, got {args.psi}")
-if args.load_ratio == 0:
-    p.error("--load-ratio must not be 0 (the path starts there)")
+args = cli.arguments(Arch, prefixes={"arch_": "Newton and the stability checks"})
 # -
 
 # ### The arch

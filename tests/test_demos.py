@@ -368,7 +368,7 @@ def test_a_killed_snap_through_restarts_on_the_same_path(tmp_path, demo):
 
 
 @pytest.mark.parametrize("args,message", [
-    (["--arc-length", "0"], "--arc-length must be > 0"), (["--rise", "1.5"], "--rise"),
+    (["--arc-length", "0"], "--arc-length: must be > 0"), (["--rise", "1.5"], "--rise"),
     (["--rise", "5"], "antisymmetrically"), (["--elements", "3"], "--elements must be even"),
     (["--max-steps", "3"], "not reached in 3 steps"), (["--slenderness", "5"], "slenderness"),
     (["-arch_full_ksp_veiw"], "was read by no solver"),
