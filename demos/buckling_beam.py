@@ -36,6 +36,8 @@
 
 # +
 import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -46,6 +48,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
 from fenics_nl.theory import elastica
@@ -59,64 +62,57 @@ comm = MPI.COMM_WORLD
 # defaults. PETSc options take the prefix `-beam_` (`-beam_full_ksp_view`, ...).
 
 # +
-def parser():
-    """Every parameter of the scene, with its unit and default."""
-    p = cli.parser(
-        "Buckling of a compressed cantilever: SLEPc critical load and the post-buckling path "
-        "against the elastica. Units are the user's, consistent (e.g. N, m, Pa).",
-        epilog="PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
-               "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
-               "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
-               "the pre-stress). An option no solver reads is an error.")
-    p.add_argument("--length", type=cli.positive, default=1.0, help="beam length L [length]")
-    p.add_argument("--thickness", type=cli.positive, default=0.02,
-                   help="beam height h [length]")
-    p.add_argument("--E", type=cli.positive, default=1e3, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--plane", choices=["stress", "strain"], default="stress",
-                   help="plane stress or plane strain (unit width)")
-    p.add_argument("--material", choices=["svk", "neo-hookean"], default="svk",
-                   help="St Venant-Kirchhoff or compressible neo-Hookean (plane strain)")
-    p.add_argument("--load-ratio", type=cli.positive, default=1.5,
-                   help="final load P / P_cr (Euler), at most 20")
-    p.add_argument("--steps", type=cli.at_least(1), default=40,
-                   help="equal load steps to the final load (a failed step is cut in half)")
-    p.add_argument("--newton", choices=["full", "modified", "periodic", "bfgs"], default="full",
-                   help="Newton variant of each load step")
-    p.add_argument("--path", choices=["load", "arc-length"], default="load",
-                   help="load control (steps of P, end state checked and switched with the "
-                        "elastica's deflection if unstable) or arc-length continuation "
-                        "(bifurcation found by the tangent's inertia and left along its mode: "
-                        "no closed form)")
-    p.add_argument("--arc-length", type=cli.finite, default=0.2,
-                   help="with --path arc-length: the first arc length, > 0 (dimensionless, "
-                        "about one load step of Δs/√2 P_Euler on the straight branch) [-]")
-    p.add_argument("--imperfection", type=cli.finite, default=1e-4,
-                   help="lateral end load as a fraction of P [-], in [0, 0.1)")
-    p.add_argument("--refine", type=cli.at_least(0), default=0,
-                   help="mesh: 2·2^refine Q2 elements through the height, square elements")
-    p.add_argument("--mixed", action="store_true",
-                   help="Q2-Q1 Taylor-Hood displacement-pressure elements, for a nearly or "
-                        "exactly incompressible beam (nu up to 0.5; --plane strain)")
-    cli.add_outputs(p, output="the displacement",
-                    png="deformed shapes along the path, with the elastica's",
-                    plot="P/P_cr against tip rotation and deflection")
-    return p
+@dataclass
+class Buckling(Parameters):
+    """Buckling of a compressed cantilever: SLEPc critical load and the post-buckling path
+    against the elastica. Units are the user's, consistent (e.g. N, m, Pa)."""
+
+    EPILOG = ("PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
+              "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
+              "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
+              "the pre-stress). An option no solver reads is an error.")
+    OUTPUTS: ClassVar = {"output": "the displacement",
+                         "png": "deformed shapes along the path, with the elastica's",
+                         "plot": "P/P_cr against tip rotation and deflection"}
+
+    length: float = number(1.0, "beam length L", unit="length", above=0)
+    thickness: float = number(0.02, "beam height h", unit="length", above=0)
+    E: float = number(1e3, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    plane: str = choice("stress", ["stress", "strain"], "plane stress or plane strain (unit "
+                        "width)")
+    material: str = choice("svk", ["svk", "neo-hookean"], "St Venant-Kirchhoff or "
+                           "compressible neo-Hookean (plane strain)")
+    load_ratio: float = number(1.5, "final load P / P_cr (Euler)", above=0, at_most=20)
+    steps: int = number(40, "equal load steps to the final load (a failed step is cut in "
+                        "half)", at_least=1)
+    newton: str = choice("full", ["full", "modified", "periodic", "bfgs"],
+                         "Newton variant of each load step", spelling=True)
+    path: str = choice("load", ["load", "arc-length"], "load control (steps of P, end state "
+                       "checked and switched with the elastica's deflection if unstable) or "
+                       "arc-length continuation (bifurcation found by the tangent's inertia "
+                       "and left along its mode: no closed form)")
+    arc_length: float = number(0.2, "with --path arc-length: the first arc length "
+                               "(dimensionless, about one load step of Δs/√2 P_Euler on the "
+                               "straight branch)", unit="-", above=0)
+    imperfection: float = number(1e-4, "lateral end load as a fraction of P, in [0, 0.1)",
+                                 unit="-", at_least=0)
+    refine: int = number(0, "mesh: 2·2^refine Q2 elements through the height, square "
+                         "elements", at_least=0)
+    mixed: bool = switch("Q2-Q1 Taylor-Hood displacement-pressure elements, for a nearly or "
+                         "exactly incompressible beam (nu up to 0.5; --plane strain)")
+
+    def check(self):
+        if not self.imperfection < 0.1:
+            raise ValueError(f"--imperfection must be in [0, 0.1), got {self.imperfection}")
+        if self.material == "neo-hookean" and self.plane == "stress":
+            raise ValueError("neo-hookean is implemented in plane strain only (--plane strain)")
+        if self.mixed and self.plane == "stress":
+            raise ValueError("--mixed needs --plane strain (in plane stress the out-of-plane "
+                             "strain takes the volume change: nothing locks)")
 
 
-p = parser()
-args = cli.arguments(p, prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
-if args.load_ratio > 20:
-    p.error(f"--load-ratio must be in (0, 20], got {args.load_ratio}")
-if not 0 <= args.imperfection < 0.1:
-    p.error(f"--imperfection must be in [0, 0.1), got {args.imperfection}")
-if args.material == "neo-hookean" and args.plane == "stress":
-    p.error("neo-hookean is implemented in plane strain only (--plane strain)")
-if not args.arc_length > 0:
-    p.error(f"--arc-length must be > 0, got {args.arc_length}")
-if args.mixed and args.plane == "stress":
-    p.error("--mixed needs --plane strain (in plane stress the out-of-plane strain takes "
-            "the volume change: nothing locks)")
+args = cli.arguments(Buckling, prefixes={"beam_": "Newton, SLEPc and pre-stress solvers"})
 
 
 # -
