@@ -31,6 +31,8 @@
 import math
 import resource
 import time
+from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -41,6 +43,7 @@ from mpi4py import MPI
 
 from fenics_nl.io import cli, pictures
 from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number, switch, text
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -61,93 +64,88 @@ DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README
 # `-bracket_elim_` (the floor contact).
 
 # +
-def parser():
-    """Every parameter of the scene, with its unit and default."""
-    p = cli.parser(
-        "3D L-bracket in a power-law material, Newton variants side by side. Lengths in "
-        "--units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa).",
-        epilog="PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
-               "(--newton snes) or -bracket_elim_ (--support contact), e.g. "
-               "-bracket_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--support", choices=["clamped", "contact"], default="clamped",
-                   help="bolt holes fixed, or also the base on a rigid floor (unilateral)")
-    p.add_argument("--newton", choices=VARIANTS, default=None, type=cli.spelling("--newton"),
-                   help="non-linear solver (default full)")
-    p.add_argument("--compare", action="store_true",
-                   help="run every variant on the same mesh and print one table")
-    p.add_argument("--force", type=cli.positive, default=8e3,
-                   help="total load on the arm's hole [N]")
-    p.add_argument("--steps", type=cli.at_least(1), default=4, help="equal load steps")
-    p.add_argument("--tolerance", type=cli.finite, default=1e-9,
-                   help="Newton stops at |R| <= tolerance x force (or 1e-10 |R0|)")
-    p.add_argument("--units", choices=list(MM), default="mm",
-                   help="length unit of the geometry, --size and the results")
-    p.add_argument("--size", type=cli.positive, default=None,
-                   help=f"largest element size (default {DEFAULT_SIZE_MM:g} mm), at most "
-                        f"twice the {THICKNESS_MM:g} mm plate thickness")
-    p.add_argument("--degree", type=int, choices=[1, 2], default=2,
-                   help="Lagrange degree (P1 is far too stiff here: see the README)")
-    p.add_argument("--mixed", action="store_true",
-                   help="Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
-                        "--solver gamg: MINRES with a block preconditioner)")
-    p.add_argument("--mesh", metavar="MSH",
-                   help="a .msh file with groups bolts, load, base (in --units; not with --size)")
-    p.add_argument("--solver", choices=["lu", "gamg"], default="lu",
-                   type=cli.spelling("--solver"),
-                   help="MUMPS LU, or CG + GAMG with rigid-body near-nullspace")
-    p.add_argument("--material", choices=["power-law", "j2", "linear"], default="power-law",
-                   help="the power law below; j2: von Mises plasticity (sigma0, --hardening), "
-                        "path-dependent; or linear elasticity (E, nu)")
-    p.add_argument("--E", type=cli.positive, default=None,
-                   help="Young's modulus (default 200 GPa, in N/unit²)")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--sigma0", type=cli.positive, default=None,
-                   help="power law: reference stress (default 200 MPa, in N/unit²)")
-    p.add_argument("--n", type=cli.positive, default=None,
-                   help="power law exponent [-] (default 0.2)")
-    p.add_argument("--hardening", type=cli.finite, default=None,
-                   help="j2: linear isotropic hardening modulus H (default 13 GPa: the power "
-                        "law's secant at its peak strain, 14 ε0; in N/unit²)")
-    p.add_argument("--friction", type=cli.finite, default=None, metavar="F",
-                   help="Coulomb friction coefficient f >= 0 between the base and the floor "
-                        "(--support contact; default: frictionless)")
-    p.add_argument("--unload", action="store_true",
-                   help="unload in as many steps after loading: the permanent displacement")
-    cli.add_outputs(p, output="displacement, von Mises stress (j2: plastic strains), with "
-                              "--support contact the floor pressure and active set",
-                    png="deformed bracket coloured by von Mises stress (j2: by the cumulated "
-                        "plastic strain), load and supports drawn",
-                    plot="load against load-point displacement")
-    cli.add_checkpoints(p)
-    return p
+@dataclass
+class BracketRun(Parameters):
+    """3D L-bracket in a power-law material, Newton variants side by side. Lengths in
+    --units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa)."""
+
+    EPILOG = ("PETSc options take the prefix -bracket_ (Newton's KSP), -bracket_snes_ "
+              "(--newton snes) or -bracket_elim_ (--support contact), e.g. -bracket_ksp_view. "
+              "An option no solver reads is an error.")
+    OUTPUTS: ClassVar = {
+        "output": "displacement, von Mises stress (j2: plastic strains), with --support "
+                  "contact the floor pressure and active set",
+        "png": "deformed bracket coloured by von Mises stress (j2: by the cumulated plastic "
+               "strain), load and supports drawn",
+        "plot": "load against load-point displacement"}
+    CHECKPOINTS = True
+
+    support: str = choice("clamped", ["clamped", "contact"], "bolt holes fixed, or also the "
+                          "base on a rigid floor (unilateral)")
+    newton: str | None = choice(None, VARIANTS, "non-linear solver (default full)",
+                                spelling=True)
+    compare: bool = switch("run every variant on the same mesh and print one table")
+    force: float = number(8e3, "total load on the arm's hole", unit="N", above=0)
+    steps: int = number(4, "equal load steps", at_least=1)
+    tolerance: float = number(1e-9, "Newton stops at |R| <= tolerance x force (or 1e-10 "
+                              "|R0|)")
+    units: str = choice("mm", list(MM), "length unit of the geometry, --size and the results")
+    size: float | None = number(None, f"largest element size (default {DEFAULT_SIZE_MM:g} mm),"
+                                f" at most twice the {THICKNESS_MM:g} mm plate thickness",
+                                above=0)
+    degree: int = number(2, "Lagrange degree, 1 or 2 (P1 is far too stiff here: see the "
+                         "benchmarks)", at_least=1, at_most=2)
+    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
+                         "--solver gamg: MINRES with a block preconditioner)")
+    mesh: str | None = text(None, "a .msh file with groups bolts, load, base (in --units; not "
+                            "with --size)", metavar="MSH")
+    solver: str = choice("lu", ["lu", "gamg"], "MUMPS LU, or CG + GAMG with rigid-body "
+                         "near-nullspace", spelling=True)
+    material: str = choice("power-law", ["power-law", "j2", "linear"], "the power law below; "
+                           "j2: von Mises plasticity (sigma0, --hardening), path-dependent; or "
+                           "linear elasticity (E, nu)")
+    E: float | None = number(None, "Young's modulus (default 200 GPa, in N/unit²)", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    sigma0: float | None = number(None, "power law: reference stress (default 200 MPa, in "
+                                  "N/unit²)", above=0)
+    n: float | None = number(None, "power law exponent (default 0.2)", unit="-", above=0)
+    hardening: float | None = number(None, "j2: linear isotropic hardening modulus H (default "
+                                     "13 GPa: the power law's secant at its peak strain, "
+                                     "14 ε0; in N/unit²)")
+    friction: float | None = number(None, "Coulomb friction coefficient f between the base "
+                                    "and the floor (--support contact; default: "
+                                    "frictionless)", at_least=0)
+    unload: bool = switch("unload in as many steps after loading: the permanent displacement")
+
+    def check(self):
+        if self.compare and self.newton:
+            raise ValueError("--compare runs every Newton variant: drop --newton")
+        if self.compare and (self.png or self.plot or self.output):
+            raise ValueError("--compare prints a table of the variants: --png, --plot and "
+                             "--output go with one --newton")
+        if self.compare and (self.unload or self.checkpoint or self.restart):
+            raise ValueError("--unload, --checkpoint and --restart go with one --newton, not "
+                             "--compare")
+        self.newton = self.newton or "full"
+        if self.mesh and self.size is not None:
+            raise ValueError("--size and --mesh contradict each other: a mesh file has its "
+                             "own sizes")
+        mm = MM[self.units]
+        self.E = self.E if self.E is not None else 200e3 / mm**2
+        cli.material_flags(self, power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
+                           j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
+        if self.friction is not None and self.support != "contact":
+            raise ValueError("--friction acts between the base and the floor: add --support "
+                             "contact")
+        if self.size is not None and self.size > 2 * THICKNESS_MM * mm:
+            raise ValueError(f"--size {self.size:g} {self.units} is more than twice the plate "
+                             f"thickness ({THICKNESS_MM * mm:g} {self.units}): the plate's "
+                             "bending is not resolved")
 
 
-p = parser()
-args = cli.arguments(p, prefixes={
+args = cli.arguments(BracketRun, prefixes={
     "bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"})
-if args.compare and args.newton:
-    p.error("--compare runs every Newton variant: drop --newton")
-args.newton = args.newton or "full"
-if args.compare and (args.png or args.plot or args.output):
-    p.error("--compare prints a table of the variants: --png, --plot and --output "
-            "go with one --newton")
-if args.mesh and args.size is not None:
-    p.error("--size and --mesh contradict each other: a mesh file has its own sizes")
 mm = MM[args.units]
-args.E = args.E if args.E is not None else 200e3 / mm**2
-cli.material_flags(p, args, power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
-                   j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
-if args.friction is not None and not args.friction >= 0:
-    p.error(f"--friction must be >= 0, got {args.friction}")
-if args.friction is not None and args.support != "contact":
-    p.error("--friction acts between the base and the floor: add --support contact")
-if args.unload and args.compare:
-    p.error("--unload goes with one --newton, not --compare")
-if (args.checkpoint or args.restart) and args.compare:
-    p.error("--checkpoint and --restart go with one --newton, not --compare")
-if args.size is not None and args.size > 2 * THICKNESS_MM * mm:
-    p.error(f"--size {args.size:g} {args.units} is more than twice the plate thickness "
-            f"({THICKNESS_MM * mm:g} {args.units}): the plate's bending is not resolved")
 
 
 # -

@@ -137,8 +137,11 @@ args = cli.arguments(p, prefixes=lambda a: {
     f"punch_{a.model}_{a.formulation[:4]}_":
         "KSP" if a.formulation == "elimination" else "SNES and KSP"})
 # j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
-cli.material_flags(p, args, power_law={"sigma0": 0.01, "n": 0.3},
-                   j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
+try:
+    cli.material_flags(args, power_law={"sigma0": 0.01, "n": 0.3},
+                       j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
+except ValueError as err:
+    p.error(str(err))
 if args.mixed and args.formulation == "multiplier" and args.model == "3d":
     p.error("--mixed --formulation multiplier is 2D and axisymmetric only (no nodal rule with "
             "positive weights on P2 triangles): use --formulation elimination in 3d")
