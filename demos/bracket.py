@@ -65,7 +65,7 @@ DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README
 
 # +
 @dataclass
-class BracketRun(Parameters):
+class BracketParameters(Parameters):
     """3D L-bracket in a power-law material, Newton variants side by side. Lengths in
     --units (mm or m), forces in N, stresses in N per unit length squared (MPa or Pa)."""
 
@@ -143,7 +143,7 @@ class BracketRun(Parameters):
                              "bending is not resolved")
 
 
-args = cli.arguments(BracketRun, prefixes={
+args = cli.arguments(BracketParameters, prefixes={
     "bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"})
 mm = MM[args.units]
 

@@ -33,6 +33,8 @@
 
 # +
 import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -44,6 +46,7 @@ from mpi4py import MPI
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
@@ -63,117 +66,109 @@ MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
 # `-punch_<model>_<form>_`.
 
 # +
-def parser():
-    """Every parameter of the scene, with its unit and default."""
-    p = cli.parser(
-        "Rigid spherical punch on an elastic block (Hertz contact, the course's active set). "
-        "Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa).",
-        epilog="PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
-               "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
-               "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
-               "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
-    p.add_argument("--model", choices=["axisymmetric", "3d", "plane_strain"],
-                   type=cli.spelling("--model"),
-                   default="axisymmetric", help="axisymmetric (r,z), 3D quarter, plane strain")
-    p.add_argument("--E", type=cli.positive, default=1.0, help="Young's modulus [stress]")
-    p.add_argument("--nu", type=cli.finite, default=0.3, help="Poisson's ratio [-]")
-    p.add_argument("--radius", type=cli.positive, default=1.0, help="punch radius R [length]")
-    load = p.add_mutually_exclusive_group()
-    load.add_argument("--indentation", type=cli.finite, default=None,
-                      help="displacement control: indentation δ [length] (default 0.01 R)")
-    load.add_argument("--force", type=cli.positive, default=None,
-                      help="force control: total force P [force] (per unit length in plane "
-                           "strain)")
-    p.add_argument("--steps", type=cli.at_least(1), default=1,
-                   help="load steps from 0 to the load")
-    p.add_argument("--formulation", choices=["elimination", "multiplier"], default="elimination",
-                   help="active normal displacements as Dirichlet rows, or Lagrange multipliers")
-    p.add_argument("--mixed", action="store_true",
-                   help="Taylor–Hood P2–P1 displacement–pressure elements: no locking as ν → "
-                        "1/2, and ν = 0.5 exactly (with the elimination)")
-    p.add_argument("--gap", choices=["parabola", "sphere"], default="parabola",
-                   help="punch shape: Hertz's parabola or the exact sphere")
-    p.add_argument("--material", choices=["linear", "power-law", "j2"], default="linear",
-                   help="linear elastic (Hertz applies), the power law (Newton inside), or "
-                        "j2: von Mises plasticity (path-dependent; --unload for the imprint)")
-    p.add_argument("--sigma0", type=cli.positive, default=None,
-                   help="power law: stress where it turns non-linear [stress] (default 0.01)")
-    p.add_argument("--n", type=cli.positive, default=None,
-                   help="power law exponent [-] (default 0.3)")
-    p.add_argument("--hardening", type=cli.finite, default=None,
-                   help="j2: linear isotropic hardening modulus H [stress] (default 0.1 E)")
-    p.add_argument("--unload", action="store_true",
-                   help="take the punch back up in as many steps (displacement control): the "
-                        "residual imprint")
-    p.add_argument("--refine", type=cli.at_least(0), default=1,
-                   help=f"element size under the punch a/(20·2^refine) (3D: a/(6·2^refine)), "
-                        f"at most {MAX_REFINE}")
-    p.add_argument("--block", type=cli.positive, default=None,
-                   help="block size in contact radii, >= 10 (default 1000, 3D 100)")
-    p.add_argument("--friction", type=cli.finite, default=None, metavar="F",
-                   help="Coulomb friction coefficient f >= 0 (statuses open / stick / slip; "
-                        "default: frictionless)")
-    tangential = p.add_mutually_exclusive_group()
-    tangential.add_argument("--tangential-ratio", type=cli.finite, default=None, metavar="R",
-                            help="after the normal load, a tangential force Q = R f P along x, "
-                                 "0 <= R < 1 (Cattaneo-Mindlin partial slip)")
-    tangential.add_argument("--tangential-force", type=cli.finite, default=None, metavar="Q",
-                            help="after the normal load, the tangential force Q [force] (per "
-                                 "unit length in plane strain), below f P")
-    tangential.add_argument("--tangential-displacement", type=cli.finite, default=None,
-                            metavar="D", help="after the normal load, move the punch by D "
-                                              "[length] along x")
-    cli.add_outputs(p, output="displacement, von Mises stress (j2: plastic strains), contact "
-                              "pressure and active set",
-                    png="the deformed contact zone (von Mises stress) beside the contact "
-                        "pressure, against Hertz",
-                    plot="force-indentation and pressure against Hertz")
-    cli.add_checkpoints(p)
-    return p
+@dataclass
+class PunchParameters(Parameters):
+    """Rigid spherical punch on an elastic block (Hertz contact, the course's active set).
+    Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa)."""
+
+    EPILOG = ("PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
+              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
+              "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
+              "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
+    OUTPUTS: ClassVar = {
+        "output": "displacement, von Mises stress (j2: plastic strains), contact pressure and "
+                  "active set",
+        "png": "the deformed contact zone (von Mises stress) beside the contact pressure, "
+               "against Hertz",
+        "plot": "force-indentation and pressure against Hertz"}
+    CHECKPOINTS = True
+
+    model: str = choice("axisymmetric", ["axisymmetric", "3d", "plane_strain"],
+                        "axisymmetric (r,z), 3D quarter, plane strain", spelling=True)
+    E: float = number(1.0, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    radius: float = number(1.0, "punch radius R", unit="length", above=0)
+    indentation: float | None = number(None, "displacement control: indentation δ, non-zero "
+                                       "(default 0.01 R; negative: the punch stays clear)",
+                                       unit="length", group="load")
+    force: float | None = number(None, "force control: total force P (per unit length in "
+                                 "plane strain)", unit="force", above=0, group="load")
+    steps: int = number(1, "load steps from 0 to the load", at_least=1)
+    formulation: str = choice("elimination", ["elimination", "multiplier"], "active normal "
+                              "displacements as Dirichlet rows, or Lagrange multipliers")
+    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements: no locking as "
+                         "ν → 1/2, and ν = 0.5 exactly (with the elimination)")
+    gap: str = choice("parabola", ["parabola", "sphere"], "punch shape: Hertz's parabola or "
+                      "the exact sphere")
+    material: str = choice("linear", ["linear", "power-law", "j2"], "linear elastic (Hertz "
+                           "applies), the power law (Newton inside), or j2: von Mises "
+                           "plasticity (path-dependent; --unload for the imprint)")
+    sigma0: float | None = number(None, "power law: stress where it turns non-linear "
+                                  "(default 0.01)", unit="stress", above=0)
+    n: float | None = number(None, "power law exponent (default 0.3)", unit="-", above=0)
+    hardening: float | None = number(None, "j2: linear isotropic hardening modulus H "
+                                     "(default 0.1 E)", unit="stress")
+    unload: bool = switch("take the punch back up in as many steps (displacement control): "
+                          "the residual imprint")
+    refine: int = number(1, "element size under the punch a/(20·2^refine) (3D: "
+                         "a/(6·2^refine))", at_least=0, at_most=MAX_REFINE)
+    block: float | None = number(None, "block size in contact radii, >= 10 (default 1000, 3D "
+                                 "100)", above=0)
+    friction: float | None = number(None, "Coulomb friction coefficient f (statuses open / "
+                                    "stick / slip; default: frictionless)", at_least=0,
+                                    metavar="F")
+    tangential_ratio: float | None = number(
+        None, "after the normal load, a tangential force Q = R f P along x, 0 <= R < 1 "
+        "(Cattaneo-Mindlin partial slip)", at_least=0, group="tangential", metavar="R")
+    tangential_force: float | None = number(
+        None, "after the normal load, the tangential force Q (per unit length in plane "
+        "strain), below f P", unit="force", at_least=0, group="tangential", metavar="Q")
+    tangential_displacement: float | None = number(
+        None, "after the normal load, move the punch by D along +x", unit="length", above=0,
+        group="tangential", metavar="D")
+
+    def check(self):
+        # j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
+        cli.material_flags(self, power_law={"sigma0": 0.01, "n": 0.3},
+                           j2={"sigma0": 0.02 * self.E, "hardening": 0.1 * self.E})
+        if self.mixed and self.formulation == "multiplier" and self.model == "3d":
+            raise ValueError("--mixed --formulation multiplier is 2D and axisymmetric only (no "
+                             "nodal rule with positive weights on P2 triangles): use "
+                             "--formulation elimination in 3d")
+        if self.unload and self.force is not None:
+            raise ValueError("--unload takes the punch back up under displacement control: "
+                             "drop --force")
+        if self.indentation is not None and self.indentation == 0:
+            raise ValueError("--indentation must be non-zero (negative: the punch stays clear)")
+        if self.indentation is None and self.force is None:
+            self.indentation = 0.01 * self.radius
+        if self.moved and self.friction is None:
+            raise ValueError("a tangential load needs --friction F: without friction nothing "
+                             "holds the punch")
+        if self.moved and self.unload:
+            raise ValueError("--unload lifts the punch: a tangential load is applied to the "
+                             "loaded punch only (drop --unload)")
+        if self.moved and self.model == "axisymmetric":
+            raise ValueError("a tangential load breaks the axial symmetry: use --model "
+                             "plane_strain or 3d")
+        if self.friction is not None and self.formulation == "multiplier":
+            raise ValueError("--friction is written for --formulation elimination")
+        if self.tangential_ratio is not None and not self.tangential_ratio < 1:
+            raise ValueError(f"--tangential-ratio must be in [0, 1), got "
+                             f"{self.tangential_ratio} (at Q = f P the punch slides: no static "
+                             "equilibrium)")
+
+    @property
+    def moved(self) -> list[float]:
+        """The tangential load given (at most one)."""
+        return [x for x in (self.tangential_ratio, self.tangential_force,
+                            self.tangential_displacement) if x is not None]
 
 
-p = parser()
-args = cli.arguments(p, prefixes=lambda a: {
+args = cli.arguments(PunchParameters, prefixes=lambda a: {
     f"punch_{a.model}_{a.formulation[:4]}_":
         "KSP" if a.formulation == "elimination" else "SNES and KSP"})
-# j2: σ0 = 0.3 p0 of the default indentation, so that a plastic zone forms
-try:
-    cli.material_flags(args, power_law={"sigma0": 0.01, "n": 0.3},
-                       j2={"sigma0": 0.02 * args.E, "hardening": 0.1 * args.E})
-except ValueError as err:
-    p.error(str(err))
-if args.mixed and args.formulation == "multiplier" and args.model == "3d":
-    p.error("--mixed --formulation multiplier is 2D and axisymmetric only (no nodal rule with "
-            "positive weights on P2 triangles): use --formulation elimination in 3d")
-if args.unload and args.force is not None:
-    p.error("--unload takes the punch back up under displacement control: drop --force")
-if args.refine > MAX_REFINE:
-    p.error(f"--refine must be <= {MAX_REFINE}, got {args.refine}")
-if args.indentation is not None and args.indentation == 0:
-    p.error("--indentation must be non-zero (negative: the punch stays clear)")
-if args.indentation is None and args.force is None:
-    args.indentation = 0.01 * args.radius
-moved = [x for x in (args.tangential_ratio, args.tangential_force, args.tangential_displacement)
-         if x is not None]
-if args.friction is not None and args.friction < 0:
-    p.error(f"--friction must be >= 0, got {args.friction}")
-if moved and args.friction is None:
-    p.error("a tangential load needs --friction F: without friction nothing holds the punch")
-if moved and args.unload:
-    p.error("--unload lifts the punch: a tangential load is applied to the loaded punch "
-            "only (drop --unload)")
-if args.tangential_displacement is not None and not args.tangential_displacement > 0:
-    p.error(f"--tangential-displacement must be > 0 (along +x), got "
-            f"{args.tangential_displacement}")
-if moved and args.model == "axisymmetric":
-    p.error("a tangential load breaks the axial symmetry: use --model plane_strain or 3d")
-if args.friction is not None and args.formulation == "multiplier":
-    p.error("--friction is written for --formulation elimination")
-if args.tangential_ratio is not None and not 0 <= args.tangential_ratio < 1:
-    p.error(f"--tangential-ratio must be in [0, 1), got {args.tangential_ratio} (at Q = f P "
-            "the punch slides: no static equilibrium)")
-if args.tangential_force is not None and args.tangential_force < 0:
-    p.error(f"--tangential-force must be >= 0, got {args.tangential_force}")
+moved = args.moved
 # -
 
 # ### The block

@@ -240,7 +240,7 @@ def test_punch_that_never_touches_gives_zero_force(tmp_path, demo):
     (["--bogus", "1"], "unrecognized"), (["--force", "-1"], "--force"),
     (["--indentation", "nan"], "--indentation: must be a finite number"),
     (["--E", "inf"], "--E: must be a finite number"),
-    (["--refine", "30"], "--refine must be <= 6"),
+    (["--refine", "30"], "--refine: must be <= 6"),
     (["--n", "0.5"], "--n set the power law, not --material linear"),
     (["-ksp_view"], "-ksp_view is read by no solver of this run; its options prefixes are "
                     "-punch_axisymmetric_elim_"),

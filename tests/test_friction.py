@@ -218,7 +218,7 @@ def test_friction_two_ranks_give_the_serial_answer(demo):
 
 
 @pytest.mark.parametrize("args,words", [
-    (["--friction", "-0.1"], "--friction must be >= 0"),
+    (["--friction", "-0.1"], "--friction: must be >= 0"),
     (["--model", "plane_strain", "--tangential-ratio", "0.5"], "needs --friction"),
     (["--friction", "0.3", "--tangential-ratio", "0.5"], "axial symmetry"),
     (["--friction", "0.3", "--formulation", "multiplier"], "elimination"),

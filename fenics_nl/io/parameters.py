@@ -32,7 +32,7 @@ __all__ = ["Parameters", "choice", "number", "parser_of", "switch", "text"]
 
 def number(default, meaning: str, *, unit: str | None = None, above: float | None = None,
            at_least: float | None = None, at_most: float | None = None,
-           group: str | None = None):
+           group: str | None = None, metavar: str | None = None):
     """A number flag: finite, within the bounds given; an integer if `default` is one.
 
     Bounds: > `above`, >= `at_least`, <= `at_most`. `default` None: optional (the demo
@@ -41,7 +41,7 @@ def number(default, meaning: str, *, unit: str | None = None, above: float | Non
     """
     return dataclasses.field(default=default, metadata={
         "kind": "number", "meaning": meaning, "unit": unit, "above": above,
-        "at_least": at_least, "at_most": at_most, "group": group})
+        "at_least": at_least, "at_most": at_most, "group": group, "metavar": metavar})
 
 
 def choice(default: str, options: Sequence[str], meaning: str, *, spelling: bool = False):
@@ -106,7 +106,7 @@ def _add(target, f: dataclasses.Field) -> None:
     meaning = m["meaning"] + (f" [{m['unit']}]" if m.get("unit") else "")
     if m["kind"] == "number":
         target.add_argument(flag, dest=f.name, type=_number_type(f), default=f.default,
-                            help=meaning)
+                            metavar=m["metavar"], help=meaning)
     elif m["kind"] == "choice":
         from fenics_nl.io.cli import spelling
 
