@@ -32,15 +32,15 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-import numpy as np
 import ufl
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
-from fenics_nl.io import cli, pictures
+from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.scenes import vessel_pictures
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
@@ -351,63 +351,17 @@ def summary():
     return out
 
 
-def state_title(sep: str = ", ") -> str:
-    """What the run ends in, loaded or unloaded from its peak; `sep` before the radius."""
-    # plain "nu": pyvista's font has no Greek letters (the picture shares this title)
-    closed = "closed form" + (" for nu = 1/2" if shape == "cylinder" else "")
-    radius = f"plastic radius {c_fe:.4g} ({closed} {c_exact:.4g})"
-    if args.unload:
-        return (f"{shape}: unloaded from {loaded / p_lim:.3f} p_lim, permanent u(a) = "
-                f"{path[-1][1]:.4g}{sep}{radius}")
-    return f"{shape}: p = {loaded / p_lim:.3f} p_lim{sep}{radius}"
+outcome = vessel_pictures.VesselRun(
+    shape, a, b, args.E, args.nu, s0, path, loaded, args.unload, p_lim, p_e_exact, c_fe,
+    c_exact, compliance, exact_curve, inner, inner_exact)
+writers = []
+if args.plot:
+    writers.append(lambda: vessel_pictures.pressure_curve(outcome, args.plot))
+if args.png:
+    def picture():
+        vessel_pictures.plastic_zone(outcome, body.displacement(),
+                                     material.cumulated_plastic_strain_per_cell(), args.png)
+        say(f"wrote {args.png}")
 
-
-def plot():
-    """p(u(a)) of the run against the closed forms (loading and elastic unloading)."""
-    if comm.rank != 0:
-        return
-    plt = pictures.pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 4.8))
-    q, d = np.array(path).T
-    if exact_curve:  # the monotonic loading, exact up to the limit
-        ps = np.linspace(0.0, loaded, 200)
-        us = [vessels.sphere_inner_displacement(a, b, args.E, args.nu, s0, x) for x in ps]
-        ax.plot(us, ps / p_lim, "k-", lw=1, label="closed form (loading)")
-    else:  # Lamé up to the yield onset
-        ps = np.array([0.0, min(p_e_exact, loaded)])
-        ax.plot(ps * compliance, ps / p_lim, "k-", lw=1, label="Lamé (elastic)")
-    if args.unload:  # from the closed-form peak (else the computed one), Lamé's compliance
-        peak = inner_exact if inner_exact is not None else inner
-        # the sphere unloads elastically up to 2 p_e (σ_eq(a) goes from σ0 to −σ0); the
-        # cylinder's bound is close to it (exact for ν = 1/2)
-        reverse = loaded > 2 * p_e_exact
-        ax.plot([peak, peak - loaded * compliance], [loaded / p_lim, 0.0], "k--", lw=1,
-                label="elastic unloading (Lamé" + (", reverse yield ignored)" if reverse
-                                                   else ")"))
-    ax.plot(d, q / p_lim, "o", ms=4, mfc="none", color="C0", label="FE, J2 (each step)")
-    ax.axhline(1.0, color="C3", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
-    ax.axhline(p_e_exact / p_lim, color="gray", ls=":", lw=1, label="yield onset")
-    ax.set_xlabel("inner radial displacement u(a) [length]")
-    ax.set_ylabel("p / p_lim")
-    ax.set_ylim(0, 1.08)
-    ax.set_xlim(left=0)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
-    ax.set_title(f"b/a = {b / a:g}, " + state_title("\n"), fontsize=9)
-    pictures.save_figure(fig, args.plot)
-
-
-def picture():
-    """The deformed quarter coloured by the largest cumulated plastic strain of each cell."""
-    theta = np.linspace(0.0, 0.5 * np.pi, 91)
-    arc = {f"closed-form plastic radius {c_exact:.4g}"
-           + (" (for nu = 1/2)" if shape == "cylinder" else ""):
-           np.column_stack([c_exact * np.cos(theta), c_exact * np.sin(theta)])}
-    pictures.deformed_picture(body.displacement(), material.cumulated_plastic_strain_per_cell(),
-                              args.png, state_title(), label="cumulated plastic strain",
-                              curves=arc)
-    say(f"wrote {args.png}")
-
-
-writers = ([plot] if args.plot else []) + ([picture] if args.png else [])
+    writers.append(picture)
 cli.results(summary(), writers)
