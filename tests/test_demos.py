@@ -333,10 +333,20 @@ def test_snap_through_follows_the_shallow_arch_through_both_limit_points(tmp_pat
             counts[abs(p["rise"]) < a_lim].add(p["negative_eigenvalues"])
     assert counts == {True: {1}, False: {0}}
     assert all(abs(e) < 0.02 for e in d["limit_loads_rel_error"])  # the minimum too
+
     (lx, ly), (rx, ry) = d["reactions"]["left pin"], d["reactions"]["right pin"]
     q_total = 2 / math.pi * 1.5 * d["limit_load_reference"]  # ∫ q0 sin(πx/L) dx, L = 1
     assert ly + ry == pytest.approx(q_total, rel=1e-6) and lx == pytest.approx(-rx, rel=1e-6)
     assert (tmp_path / "p.png").stat().st_size > 10_000 and (tmp_path / "s.png").exists()
+
+
+def test_an_arch_whose_second_limit_load_is_zero_says_its_error_in_q_limit(demo):
+    # e/r = 4: the shallow-arch cubic's minimum is q0 = 0 exactly, where a relative error
+    # has no meaning (it raised ZeroDivisionError); the JSON has None there
+    d = demo.json("snap_through.py", "--rise", "4")
+    assert len(d["limit_loads"]) == 2 and d["limit_loads_reference"][1] == 0.0
+    assert d["limit_loads_rel_error"][1] is None and abs(d["limit_loads_rel_error"][0]) < 0.02
+    assert abs(d["limit_loads"][1]) < 0.02 * d["limit_load_reference"]
 
 
 @pytest.mark.spawns_mpi
