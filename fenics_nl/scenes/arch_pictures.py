@@ -23,7 +23,7 @@ class ArchRun:
     Args:
         history: (q0 in units of EI k⁴ r, midspan rise a/r) of every state, from rest.
         shapes: (q0, centreline points) of every state, on rank 0.
-        limits: the limit points found (`CriticalPoint`s); first_limit: the first one's
+        limits: the limit points found (`CriticalPoint` records); first_limit: the first one's
             load factor, or None.
         q_limit, a_limit: the closed form's limit load and its rise.
         rise, slenderness, span: the arch (e/r, L/h, L); newton: the corrector's variant.
