@@ -11,7 +11,7 @@
 # $\varepsilon_{eq} \approx 14\,\varepsilon_0$, where the tangent shear stiffness is
 # ~2.5 % of the elastic one. Quadratic (P2) tetrahedra by default: at these strains the
 # secant shear modulus is a fraction of the bulk modulus and P1 tetrahedra, two through
-# the plate, lock (half the displacement; see the README's mesh-convergence table).
+# the plate, lock (half the displacement; see the mesh-convergence table of the benchmarks page).
 #
 # ## Problem definition
 #
@@ -54,7 +54,7 @@ from fenics_nl.solvers.newton import stalled_at_round_off
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "bfgs", "snes")
 MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit
-DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (README table)
+DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (benchmarks page)
 # -
 
 # ### Parameters
@@ -279,7 +279,7 @@ runs = {n: solve(n) for n in (variants if args.compare else [args.newton])}
 # ### Equilibrium
 #
 # There is no closed form for this part (its |u_load| is checked by mesh convergence in the
-# README); what must hold is equilibrium: the bolts (and the floor) hold the load,
+# benchmarks page); what must hold is equilibrium: the bolts (and the floor) hold the load,
 # $\sum R = (-F, 0, 0)$ to the solver's tolerance.
 
 # +
@@ -343,9 +343,9 @@ def summary(b, steps, wall, args):
 
 
 def resolution_warnings(args):
-    """What the mesh cannot promise (the closed-form checks are in the README tables)."""
+    """What the mesh cannot promise (the convergence checks: the benchmarks page)."""
     notes = ["no closed form for this part: |u_load| is checked by mesh convergence "
-             "(README table), σ_eq peaks at the singular clamped bolt-hole edges"]
+             "(docs/benchmarks.md), σ_eq peaks at the singular clamped bolt-hole edges"]
     if args.mesh:
         notes.append(f"user mesh {args.mesh}: its resolution is not checked")
     elif args.size is not None and args.size / MM[args.units] > DEFAULT_SIZE_MM:

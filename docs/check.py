@@ -3,9 +3,10 @@
     python docs/check.py [--site docs/_build/html] [--shots docs/screenshots]
 
 Every page is opened from disk; a page fails when a request fails (an image, a script, a
-style sheet), an image does not decode (naturalWidth 0), the browser logs an error, a page
-with math has no typeset formula, or a link inside the site points to a missing page or
-anchor. The landing page and one demo page are saved as full-page screenshots to look at.
+style sheet), an image does not decode (naturalWidth 0), the browser logs an error, a
+formula is left untypeset or MathJax cannot read it, or a link inside the site points to a
+missing page or anchor. The landing page and one demo page are saved as full-page
+screenshots to look at.
 """
 
 from __future__ import annotations
@@ -35,7 +36,9 @@ PAGE_STATE = """() => ({
   broken_images: Array.from(document.images)
       .filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src),
   math: document.querySelectorAll('div.math, span.math').length,
-  typeset: document.querySelectorAll('mjx-container').length,
+  typeset: document.querySelectorAll('div.math mjx-container, span.math mjx-container')
+      .length,
+  math_errors: document.querySelectorAll('mjx-merror').length,
   links: Array.from(document.querySelectorAll('a[href]')).map(a => a.href)
       .filter(h => h.startsWith('file:')),
   ids: Array.from(document.querySelectorAll('[id]')).map(e => e.id),
@@ -51,13 +54,19 @@ def check_page(page, path: Path) -> tuple[list[str], dict]:
     page.goto(path.as_uri(), wait_until="load")
     if page.evaluate("() => document.querySelectorAll('div.math, span.math').length"):
         # MathJax typesets after the load event
-        page.wait_for_function("() => window.MathJax && MathJax.startup && "
-                               "MathJax.startup.promise", timeout=20000)
-        page.evaluate("() => MathJax.startup.promise")
+        try:
+            page.wait_for_function("() => window.MathJax && MathJax.startup && "
+                                   "MathJax.startup.promise", timeout=20000)
+            page.evaluate("() => MathJax.startup.promise")
+        except Exception as err:  # Playwright's timeout: said with the rest, not a crash
+            problems.append(f"MathJax did not start ({type(err).__name__})")
     state = page.evaluate(PAGE_STATE)
     problems += [f"image did not load: {src}" for src in state["broken_images"]]
-    if state["math"] and not state["typeset"]:
-        problems.append(f"{state['math']} formulas, none typeset (MathJax)")
+    if state["typeset"] < state["math"]:
+        problems.append(f"{state['math'] - state['typeset']} of {state['math']} formulas not "
+                        "typeset (MathJax)")
+    if state["math_errors"]:
+        problems.append(f"{state['math_errors']} formulas MathJax could not read")
     return problems, state
 
 

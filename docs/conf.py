@@ -35,7 +35,6 @@ napoleon_numpy_docstring = False
 html_theme = "furo"
 html_title = "fenics-nl"
 html_static_path = [str(MATHJAX)]  # copied into _static/
-suppress_warnings = ["myst.header"]  # the README-derived pages start at level 1 or 2
 
 # The docstrings write `name` for code (as Markdown does) and |x| for absolute values and
 # norms: the first is literal text, the second must not be read as an RST substitution.

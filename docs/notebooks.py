@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import shutil
 import sys
 from pathlib import Path
@@ -22,7 +23,7 @@ DEMOS = ROOT / "demos"
 OUT = ROOT / "docs" / "demos"
 
 # each demo at a small size (the one its tests use): the pages show what a laptop runs in
-# seconds; the demos' --help gives the sizes of the README's figures
+# seconds; the README's figures are `make demo`'s runs (the Makefile gives their flags)
 SMALL = {
     "newton_scalar.py": [],
     "punch.py": ["--refine", "0"],
@@ -55,7 +56,7 @@ def execute(name: str, args: list[str], cwd: Path, timeout: int = 900):
     nb = jupytext.read(DEMOS / name)
     nb.cells.append(nbformat.v4.new_code_cell(_RESULTS_CELL))
     before = os.environ.get("FENICS_NL_ARGS")
-    os.environ["FENICS_NL_ARGS"] = " ".join(args)  # the kernel inherits it
+    os.environ["FENICS_NL_ARGS"] = shlex.join(args)  # the kernel inherits it
     try:
         NotebookClient(nb, timeout=timeout, kernel_name="python3",
                        resources={"metadata": {"path": str(cwd)}}).execute()
@@ -65,7 +66,8 @@ def execute(name: str, args: list[str], cwd: Path, timeout: int = 900):
         else:
             os.environ["FENICS_NL_ARGS"] = before
     last = nb.cells.pop()  # the results cell is the harness's, not the page's
-    printed = "".join(o.get("text", "") for o in last.outputs if o.output_type == "stream")
+    printed = "".join(o.get("text", "") for o in last.outputs
+                      if o.output_type == "stream" and o.get("name") == "stdout")
     return nb, json.loads(printed)
 
 

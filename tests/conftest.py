@@ -55,8 +55,8 @@ SOURCE_DIGEST = source_digest()
 class Demos:
     """Runs demos/<name> as a user does, in `tmp_path`.
 
-    Serially the demo's cells run in this process through `cli.run_file`, as its
-    ``__main__`` line does (scikit-fem's test_examples style: no interpreter start, forms
+    Serially the demo's cells run in this process through `cli.run_file`, under the same
+    contract as the script (scikit-fem's test_examples style: no interpreter start, forms
     stay compiled); with ranks > 1 it runs under
     `mpiexec -n ranks` in a subprocess. Either way the result is a CompletedProcess with
     the exit status, stdout and stderr (captured at the file descriptors, so PETSc's own

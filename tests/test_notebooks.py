@@ -27,3 +27,12 @@ def test_the_demo_runs_as_a_notebook_with_the_scripts_answer(name, demo, tmp_pat
     assert in_notebook and differences(
         {k: as_script[k] for k in in_notebook}, in_notebook, name) == []
     save_page(nb, name, tmp_path)  # `make docs` then executes it no more
+
+
+def test_a_notebook_refuses_what_only_a_script_writes(tmp_path):
+    # --json (or --output, checkpoints, PETSc options) in FENICS_NL_ARGS would be silently
+    # dropped in a kernel: it is an error instead, naming the flag
+    from nbclient.exceptions import CellExecutionError
+
+    with pytest.raises(CellExecutionError, match="--json: only when the demo runs as a"):
+        execute("newton_scalar.py", ["--json", "x.json"], tmp_path)

@@ -460,7 +460,8 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
     declared = isinstance(parser, type) and issubclass(parser, parameters.Parameters)
     cls, parser = (parser, parameters.parser_of(parser)) if declared else (None, parser)
     caller = sys._getframe(1).f_globals
-    if _current is None and caller.get("__name__") == "__main__" and "__file__" in caller:
+    if (_current is None and caller.get("__name__") == "__main__" and "__file__" in caller
+            and not _in_ipython()):  # IPython's %run sets __file__ too: a notebook's run
         _script_run(Path(caller["__file__"]))
     global _notebook_args
     run = _current
@@ -470,6 +471,14 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
         args = parameters.from_namespace(cls, parser, args)
     if run is None:
         _notebook_args = args
+        # in a notebook the pictures are drawn and shown; what a script writes is refused
+        # rather than silently dropped
+        given = [f"--{k.replace('_', '-')}" for k in ("json", "output", "checkpoint",
+                                                      "restart") if getattr(args, k, None)]
+        if given or petsc:
+            parser.error(f"{', '.join(given + petsc[:1])}: only when the demo runs as a "
+                         f"script (in a notebook, {NOTEBOOK_ARGS} takes its parameters, "
+                         "--png and --plot)")
     if run is not None:
         run.json_path = getattr(args, "json", None)
         run.output = getattr(args, "output", None)
@@ -583,8 +592,18 @@ _notebook_results: dict | None = None
 _notebook_args: argparse.Namespace | None = None  # a notebook's parameters
 
 
+def _in_ipython() -> bool:
+    """Whether this runs in an IPython shell or kernel (a notebook, or its %run)."""
+    ipython = sys.modules.get("IPython")
+    return ipython is not None and ipython.get_ipython() is not None
+
+
 def _show_in_notebook(writers: Sequence[Callable[[], None]]) -> None:
     """Run the writers, each on its own, and show the pictures they wrote (IPython)."""
+    targets = [Path(p) for p in (getattr(_notebook_args, f, None) for f in ("png", "plot"))
+               if p]
+    for path in targets:  # a picture left by an earlier run is never shown as this one's
+        path.unlink(missing_ok=True)
     for write in writers:
         try:
             write()
@@ -594,10 +613,9 @@ def _show_in_notebook(writers: Sequence[Callable[[], None]]) -> None:
         from IPython.display import Image, display
     except ImportError:
         return
-    for flag in ("png", "plot"):
-        path = getattr(_notebook_args, flag, None)
-        if path and Path(path).suffix.lower() == ".png" and Path(path).is_file():
-            display(Image(filename=path))
+    for path in targets:
+        if path.suffix.lower() == ".png" and path.is_file():
+            display(Image(filename=str(path)))
 
 
 def notebook_results() -> dict | None:
@@ -624,9 +642,12 @@ def _script_run(path: Path) -> None:
         _current = None
         sys.excepthook = sys.__excepthook__
         if not isinstance(err, (*EXPECTED_ERRORS, PETSc.Error)):
+            sys.__excepthook__(kind, err, tb)  # a bug: its traceback first
+            if MPI.COMM_WORLD.size > 1:  # the other ranks may not have failed: no
+                sys.stderr.flush()       # collective clean-up, end them all
+                MPI.COMM_WORLD.Abort(1)
             run.close_series()
             _forget(run.options)
-            sys.__excepthook__(kind, err, tb)
             return
         try:
             status = _failed(run, err, run.t0)

@@ -14,9 +14,10 @@ Each field says its default, its meaning, its unit and its range, once::
         def check(self):  # what involves several fields; a ValueError is one line, status 2
             if not self.inner_radius < self.outer_radius: raise ValueError("...")
 
-`cli.arguments(Vessel, prefixes)` parses the command line (or, in a notebook, takes the
-defaults) and returns a `Vessel`. `OUTPUTS` and `CHECKPOINTS` add the scene contract's
-output flags (--json always; --png, --plot, --output, --checkpoint where a demo has them).
+`cli.arguments(Vessel, prefixes)` parses the command line (in a notebook: the flags in the
+environment variable FENICS_NL_ARGS, else the defaults) and returns a `Vessel`. `OUTPUTS`
+and `CHECKPOINTS` add the scene contract's output flags (--json always; --png, --plot,
+--output, --checkpoint where a demo has them).
 """
 
 from __future__ import annotations

@@ -78,7 +78,7 @@ class BracketPart:
 
     Lagrange P`degree` tetrahedra. Everything a residual is written with is public: `u`,
     `V`, `dx` (degree 2 × degree by default: exact for the linear part of the power law,
-    README table), `traction` (set by `set_load`) and `ds_load`. With
+    docs/benchmarks.md's table), `traction` (set by `set_load`) and `ds_load`. With
     ``support="contact"`` the base is the candidate contact surface on a rigid floor.
     """
 
