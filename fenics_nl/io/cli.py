@@ -426,20 +426,19 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
 
     run = _current = _Run(sys.argv[1:] if argv is None else argv)
     run.path = Path(path)
-    t0 = run.t0
     try:
         runpy.run_path(str(path), run_name="__scene__")
     except SystemExit as stop:  # argparse: --help, or a bad flag (already said)
         _forget(run.options)
         return stop.code if isinstance(stop.code, int) else int(stop.code is not None)
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
-        return _failed(run, err, t0)
+        return _failed(run, err)
     finally:
         _current = None
         run.close_series()  # the fields of every converged step, also after a failure
     if run.out is None:
         raise RuntimeError(f"{path} ended without calling cli.results")
-    return _finish(run, t0)
+    return _finish(run)
 
 
 NOTEBOOK_ARGS = "FENICS_NL_ARGS"  # a demo's flags in a notebook (e.g. "--size 20")
@@ -583,7 +582,7 @@ def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
     _current = None
     sys.excepthook = sys.__excepthook__
     run.close_series()
-    status = _finish(run, run.t0)
+    status = _finish(run)
     if status:
         sys.exit(status)
 
@@ -604,11 +603,7 @@ def _show_in_notebook(writers: Sequence[Callable[[], None]]) -> None:
                if p]
     for path in targets:  # a picture left by an earlier run is never shown as this one's
         path.unlink(missing_ok=True)
-    for write in writers:
-        try:
-            write()
-        except Exception as err:  # a picture must not stop the notebook
-            error(f"writing an output failed: {_one_line(err)}")
+    _write_each(writers)  # a picture must not stop the notebook
     try:
         from IPython.display import Image, display
     except ImportError:
@@ -650,7 +645,7 @@ def _script_run(path: Path) -> None:
             _forget(run.options)
             return
         try:
-            status = _failed(run, err, run.t0)
+            status = _failed(run, err)
         finally:
             run.close_series()
         sys.stdout.flush()
@@ -673,18 +668,17 @@ def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
     from petsc4py import PETSc
 
     global _current
-    t0 = time.perf_counter()
     run = _current = _Run([])
     run.json_path, run.output = json_path, output
     try:
         run.options = PetscOptions(petsc_argv, prefixes or {})
         run.out, run.writers = solve()
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
-        return _failed(run, err, t0)
+        return _failed(run, err)
     finally:
         _current = None
         run.close_series()
-    return _finish(run, t0)
+    return _finish(run)
 
 
 def _forget(options: PetscOptions | None) -> None:
@@ -693,7 +687,7 @@ def _forget(options: PetscOptions | None) -> None:
         options.unused()
 
 
-def _failed(run: _Run, err: BaseException, t0: float) -> int:
+def _failed(run: _Run, err: BaseException) -> int:
     """One line, and the JSON of what converged if a solve failed or steps had converged.
 
     Bad input found before any step (a ValueError) writes nothing: nothing was solved.
@@ -704,7 +698,7 @@ def _failed(run: _Run, err: BaseException, t0: float) -> int:
     last = next((s["load_factor"] for s in reversed(run.steps) if "load_factor" in s), None)
     out = {**run.known, "status": "failed", "message": message,
            "converged_steps": len(run.steps), "load_factor": last, "steps": run.steps,
-           "ranks": MPI.COMM_WORLD.size, "wall_time_s": time.perf_counter() - t0,
+           "ranks": MPI.COMM_WORLD.size, "wall_time_s": time.perf_counter() - run.t0,
            "warnings": ["the run failed: the quantities are those of the last converged "
                         "step"] if run.steps else ["the run failed before any step "
                                                    "converged"], **_totals(run.steps)}
@@ -713,12 +707,25 @@ def _failed(run: _Run, err: BaseException, t0: float) -> int:
         if text is not None and _write_json(text, run.json_path):
             say(f"wrote {run.json_path} (status failed, {len(run.steps)} converged step(s))")
     if run.steps and run.failure_writers is not None:
-        for write in run.failure_writers(out):
-            try:  # each on its own, as after a run that succeeds
-                write()
-            except Exception as err:
-                error(f"writing an output failed: {_one_line(err)}")
+        _write_each(run.failure_writers(out))  # as after a run that succeeds
     return 2
+
+
+def _write_each(writers: Sequence[Callable[[], None]]) -> bool:
+    """Run every writer, each on its own: a failing output never takes the others down.
+
+    Each failure is one line (its traceback too with FENICS_NL_DEBUG); False if any failed.
+    """
+    ok = True
+    for write in writers:
+        try:
+            write()
+        except Exception as err:
+            error(f"writing an output failed: {_one_line(err)}")
+            if MPI.COMM_WORLD.rank == 0 and "FENICS_NL_DEBUG" in os.environ:
+                traceback.print_exc()
+            ok = False
+    return ok
 
 
 def _totals(steps: list[dict]) -> dict:
@@ -755,10 +762,10 @@ def _write_json(text: str, json_path: str | None) -> bool:
     return True
 
 
-def _finish(run: _Run, t0: float) -> int:
+def _finish(run: _Run) -> int:
     """Warnings, the JSON (first), every writer on its own, unread PETSc options."""
     out, writers, options = run.out, run.writers, run.options
-    out["wall_time_s"] = time.perf_counter() - t0
+    out["wall_time_s"] = time.perf_counter() - run.t0
     out.setdefault("warnings", [])
     out.setdefault("status", "ok")
     if run.steps:
@@ -776,14 +783,8 @@ def _finish(run: _Run, t0: float) -> int:
         status = 1
     elif run.json_path:
         say(f"wrote {run.json_path}")
-    for write in writers:
-        try:
-            write()
-        except Exception as err:  # an output must never take the others down
-            error(f"writing an output failed: {_one_line(err)}")
-            if MPI.COMM_WORLD.rank == 0 and "FENICS_NL_DEBUG" in os.environ:
-                traceback.print_exc()
-            status = 1
+    if not _write_each(writers):
+        status = 1
     left = options.unused() if options is not None else []
     if left:
         error(f"PETSc option -{left[0]} was read by no solver (misspelt?); this run's options "
