@@ -33,11 +33,15 @@ $(VENV)/.bench-installed: $(VENV)/.installed
 
 # the three scenes at small sizes, the snap-through and the scalar demo, pictures and JSON
 # in results/
-# (about 1 min on 2 cores; the bracket runs on 2 ranks)
+# (about 2 min on 2 cores; the bracket runs on 2 ranks)
 demo: $(VENV)/.installed
 	@mkdir -p results
 	$(PY) demos/punch.py --steps 4 --png results/punch.png --plot results/punch_curves.png \
 	  --json results/punch.json
+	$(PY) demos/punch_friction.py --png results/punch_friction.png \
+	  --plot results/punch_friction_curves.png --json results/punch_friction.json
+	$(PY) demos/indentation.py --png results/indentation_section.png \
+	  --plot results/indentation.png --json results/indentation.json
 	$(PY) demos/buckling_beam.py --load-ratio 2 --png results/beam.png \
 	  --plot results/beam_path.png --json results/beam.json
 	$(MPIEXEC) -n 2 $(PY) demos/bracket.py --support contact --size 8 --png results/bracket.png \

@@ -158,6 +158,12 @@ class Demos:
     def punch(self, *args, ranks=1) -> dict:
         return self.json("punch.py", *args, ranks=ranks)
 
+    def punch_friction(self, *args, ranks=1) -> dict:
+        return self.json("punch_friction.py", *args, ranks=ranks)
+
+    def indentation(self, *args, ranks=1) -> dict:
+        return self.json("indentation.py", *args, ranks=ranks)
+
     def beam(self, *args, ranks=1) -> dict:
         return self.json("buckling_beam.py", *args, ranks=ranks)
 

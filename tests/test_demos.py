@@ -50,13 +50,16 @@ def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
     assert abs(d["secant"]["order"] - (1 + 5**0.5) / 2) < 0.15
 
 
-@pytest.mark.parametrize("name", ["newton_scalar.py", "punch.py", "buckling_beam.py",
+@pytest.mark.parametrize("name", ["newton_scalar.py", "punch.py", "punch_friction.py",
+                                  "indentation.py", "buckling_beam.py",
                                   "pressure_vessel.py", "snap_through.py",
                                   "bracket.py"])
 def test_help_describes_the_demo_and_states_defaults_once(demo, name):
     text = demo.run([name, "--help"]).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
-    prefix = {"punch.py": "-punch_axisymmetric_elim_ksp_view", "buckling_beam.py":
+    prefix = {"punch.py": "-punch_axisymmetric_elim_ksp_view",
+              "punch_friction.py": "-punch_axisymmetric_elim_ksp_view",
+              "indentation.py": "-punch_axisymmetric_elim_ksp_view", "buckling_beam.py":
               "-beam_buckling_", "bracket.py": "-bracket_elim_",
               "snap_through.py": "-arch_continuation_"}.get(name)
     if prefix:  # the PETSc options prefixes are documented
@@ -124,7 +127,8 @@ def test_punch_every_output_is_written(tmp_path, demo):
 def test_output_is_a_time_series_of_every_converged_step(tmp_path, demo):
     from conftest import read_series
 
-    demo.punch("--refine", "0", "--steps", "3", "--material", "j2", "--output", tmp_path / "f")
+    demo.indentation("--refine", "0", "--steps", "3", "--loading-only", "--output",
+                     tmp_path / "f")
     times, u = read_series(tmp_path / "f" / "displacement.bp", "displacement")
     assert times == pytest.approx([1 / 3, 2 / 3, 1.0], rel=1e-12)
     assert np.abs(u[0]).max() < np.abs(u[1]).max() < np.abs(u[2]).max()
@@ -542,27 +546,27 @@ def test_a_bracket_on_the_floor_in_j2_restarts_on_the_same_path(tmp_path, demo):
     assert proc.returncode == 2 and "not --compare" in proc.stderr
 
 
-def restarted_one_step_short(demo, tmp_path, args, steps):
-    """The punch run with --checkpoint, and again restarted one saved step short of its
-    loading's end: both JSONs."""
+def restarted_one_step_short(run, tmp_path, args, steps):
+    """A punch demo's run (`run`: `demo.punch`, ...) with --checkpoint, and again restarted
+    one saved step short of its loading's end: both JSONs."""
     import json
 
-    whole = demo.punch(*args, "--steps", str(steps), "--checkpoint", tmp_path / "ck")
+    whole = run(*args, "--steps", str(steps), "--checkpoint", tmp_path / "ck")
     (tmp_path / "ck" / "latest.json").write_text(json.dumps({"step": f"step-{steps - 1:06d}"}))
-    return whole, demo.punch(*args, "--steps", str(steps), "--restart", tmp_path / "ck")
+    return whole, run(*args, "--steps", str(steps), "--restart", tmp_path / "ck")
 
 
-@pytest.mark.parametrize("args", [
+@pytest.mark.parametrize("story,args", [
     # the slip history, then the tangential load redone
-    ["--model", "plane_strain", "--block", "10", "--friction", "0.3", "--tangential-ratio",
-     "0.5"],
-    ["--force", "0.01", "--formulation", "multiplier"]])  # the secant on δ, its last state
-def test_a_punch_restarts_on_the_same_path(tmp_path, demo, args):
+    ("punch_friction", ["--nu", "0.3", "--block", "10", "--tangential-ratio", "0.5"]),
+    ("punch", ["--force", "0.01", "--formulation", "multiplier"])])  # the secant on δ
+def test_a_punch_restarts_on_the_same_path(tmp_path, demo, story, args):
     # the same JSON, key by key, to 1e-10 (the multiplier form's SNES starts from zero
     # multipliers: round-off apart)
     from test_vessel import same_run
 
-    same_run(*restarted_one_step_short(demo, tmp_path, [*args, "--refine", "0"], 2))
+    same_run(*restarted_one_step_short(getattr(demo, story), tmp_path,
+                                       [*args, "--refine", "0"], 2))
 
 
 def test_punch_j2_load_unload_leaves_an_imprint(tmp_path, demo):
@@ -570,8 +574,7 @@ def test_punch_j2_load_unload_leaves_an_imprint(tmp_path, demo):
     # unloaded surface keeps a dent, the punch leaves it with no force
     from test_vessel import same_run
 
-    d, resumed = restarted_one_step_short(demo, tmp_path, ["--material", "j2", "--refine", "0",
-                                                            "--unload"], 2)
+    d, resumed = restarted_one_step_short(demo.indentation, tmp_path, ["--refine", "0"], 2)
     same_run(d, resumed)  # the plastic state comes back with a restart; the unloading redone
     assert d["force"] < d["hertz_force"]
     assert 0 < d["residual_imprint_depth"] < d["indentation"]

@@ -11,12 +11,14 @@ from mpi4py import MPI
 
 from fenics_nl.contact.friction import FrictionalContact
 
-# the plane-strain cylinder of Cattaneo-Mindlin: a rigid punch (R = 1, δ = 0.01) on an
-# incompressible block (Taylor-Hood), h = a/24, 100 a wide
-INCOMPRESSIBLE_CYLINDER = ("--model", "plane_strain", "--mixed", "--nu", "0.5", "--refine", "0",
-                           "--block", "100", "--friction", "0.3")
+# the plane-strain cylinder of Cattaneo-Mindlin (`demos/punch_friction.py`'s defaults): a
+# rigid punch (R = 1, δ = 0.01) on an incompressible block (Taylor-Hood), f = 0.3; here
+# h = a/24, 100 a wide
+INCOMPRESSIBLE_CYLINDER = ("--refine", "0", "--block", "100")
 # the same on a compressible P1 block: cheap, but not Cattaneo-Mindlin's (Spence's coupling)
-COMPRESSIBLE_CYLINDER = ("--model", "plane_strain", "--refine", "0", "--block", "100")
+COMPRESSIBLE_CYLINDER = ("--nu", "0.3", "--refine", "0", "--block", "100")
+# the axisymmetric punch with friction: a normal load only
+AXISYMMETRIC = ("--model", "axisymmetric", "--nu", "0.3", "--refine", "0")
 
 
 def jenkins_element(k_n, k_t, delta, f):
@@ -90,7 +92,7 @@ def test_cattaneo_mindlin_partial_slip_of_a_cylinder(demo):
     # the stick half-width 0.08 h from a √(1 − Q/(fP)), and the tangential traction within
     # 2.0 % of f p0 of (f p0/a)(√(a² − x²) − √(c² − x²)) except within 2 h of the
     # stick-slip edges ±c, where its slope is infinite (3.4 % within 1 h of them)
-    d = demo.punch(*INCOMPRESSIBLE_CYLINDER, "--tangential-displacement", "0.0023")
+    d = demo.punch_friction(*INCOMPRESSIBLE_CYLINDER, "--tangential-displacement", "0.0023")
     assert d["friction"] == 0.3 and d["stick_nodes"] > 0 and d["slip_nodes"] > 0
     assert 0.4 < d["tangential_force"] / (0.3 * d["force"]) < 0.6
     assert abs(d["stick_radius"] - d["stick_radius_exact"]) < d["element_size"]
@@ -193,15 +195,16 @@ def test_coulombs_law_holds_node_by_node_in_3d():
 
 def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
     free = demo.punch("--refine", "0")
-    smooth = demo.punch("--refine", "0", "--friction", "0")
+    smooth = demo.punch_friction(*AXISYMMETRIC, "--friction", "0")
     assert smooth["force"] == pytest.approx(free["force"], rel=1e-9)
     # f = 0.3 at ν = 0.3: friction holds the surface back from its inward slip (Spence), so
     # the same δ needs more force (measured +1.7 %); the axis node's radial reaction is its
     # support's, not friction's, and takes no part in the statuses
-    sticky = demo.punch("--refine", "0", "--friction", "0.3")
+    sticky = demo.punch_friction(*AXISYMMETRIC, "--friction", "0.3")
     assert free["force"] < sticky["force"] < 1.05 * free["force"]
     # f = 10 and Q = 1e-4 f P: no node slips
-    rough = demo.punch(*COMPRESSIBLE_CYLINDER, "--friction", "10", "--tangential-ratio", "1e-4")
+    rough = demo.punch_friction(*COMPRESSIBLE_CYLINDER, "--friction", "10", "--tangential-ratio",
+                                "1e-4")
     assert rough["slip_nodes"] == 0 and rough["stick_nodes"] == rough["nodes_in_contact"]
 
 
@@ -209,9 +212,9 @@ def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
 def test_friction_two_ranks_give_the_serial_answer(demo):
     # a block 10 a wide: there the partition cuts the contact zone (both ranks own stick
     # and slip nodes: `test_friction_on_a_cut_contact_zone` checks it)
-    args = ("--model", "plane_strain", "--refine", "0", "--block", "10", "--friction", "0.3",
-            "--tangential-displacement", "0.002")
-    s, p = demo.punch(*args), demo.punch(*args, ranks=2)
+    args = ("--nu", "0.3", "--refine", "0", "--block", "10", "--tangential-displacement",
+            "0.002")
+    s, p = demo.punch_friction(*args), demo.punch_friction(*args, ranks=2)
     assert p["ranks"] == 2
     assert p["tangential_force"] == pytest.approx(s["tangential_force"], rel=1e-8)
     assert (p["stick_nodes"], p["slip_nodes"]) == (s["stick_nodes"], s["slip_nodes"])
@@ -219,17 +222,16 @@ def test_friction_two_ranks_give_the_serial_answer(demo):
 
 @pytest.mark.parametrize("args,words", [
     (["--friction", "-0.1"], "--friction: must be >= 0"),
-    (["--model", "plane_strain", "--tangential-ratio", "0.5"], "needs --friction"),
-    (["--friction", "0.3", "--tangential-ratio", "0.5"], "axial symmetry"),
-    (["--friction", "0.3", "--formulation", "multiplier"], "elimination"),
-    (["--model", "plane_strain", "--friction", "0.3", "--tangential-ratio", "1"], "slides"),
-    (["--model", "plane_strain", "--refine", "0", "--block", "100", "--friction", "0.3",
-      "--tangential-force", "1"], "slides"),
-    (["--model", "plane_strain", "--refine", "0", "--block", "100", "--indentation", "-0.01",
-      "--friction", "0.3", "--tangential-displacement", "0.001"], "does not touch"),
+    (["--friction", "0", "--tangential-ratio", "0.5"], "needs --friction"),
+    (["--model", "axisymmetric", "--tangential-ratio", "0.5"], "axial symmetry"),
+    (["--formulation", "multiplier"], "elimination"),
+    (["--tangential-ratio", "1"], "slides"),
+    ([*COMPRESSIBLE_CYLINDER, "--tangential-force", "1"], "slides"),
+    ([*COMPRESSIBLE_CYLINDER, "--indentation", "-0.01", "--tangential-displacement", "0.001"],
+     "does not touch"),
 ])
 def test_friction_bad_input_is_one_line(demo, args, words):
-    proc = demo.run(["punch.py", *args], check=False)
+    proc = demo.run(["punch_friction.py", *args], check=False)
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode != 0 and len(lines) == 1 and words in lines[0], proc.stderr
 

@@ -3,8 +3,10 @@
 The force–indentation curve, the deformed contact zone in section, and the contact
 pressure (or, with friction, the tangential traction) along the surface.
 
-`curves` and `section_picture` are collective (the surface profile and the section are
-gathered on rank 0, which draws); `PunchRun` is what they read of a run.
+`PunchRun.snapshot` gathers on rank 0 what they draw of the state at hand (collective);
+`curves` and `section_picture` then draw on rank 0, the whole load path on the curve
+(loading, and an unloading after it) and the snapshot's state on the rest: a run that is
+unloaded is drawn at its largest load.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ class PunchRun:
         traction_profile: its gathered profile (`Punch.traction_profile`, or in 3D the
             radii and the force inside each), computed on every rank.
         stick_radius_exact: Cattaneo–Mindlin's c for the computed load, if known.
+        loading_steps: the states that load the punch (those after it unload it).
     """
 
     punch: object
@@ -49,22 +52,41 @@ class PunchRun:
     traction: object = None
     traction_profile: tuple | None = None
     stick_radius_exact: float | None = None
+    loading_steps: int | None = None
     model: str = field(init=False)
+    state: object = field(init=False)  # the drawn state: the last one at `snapshot`
+    profile: tuple | None = field(init=False, default=None)
+    section: tuple | None = field(init=False, default=None)
 
     def __post_init__(self):
         self.model = self.punch.model
 
+    def snapshot(self, *, section: bool) -> None:
+        """Gather what is drawn of the current state on rank 0, to draw later (collective).
+
+        Its surface profile, and with `section` the deformed section coloured by σ_eq.
+        """
+        self.state = self.states[-1]
+        self.profile = self.punch.surface_profile()
+        if section:
+            block = self.punch.block
+            self.section = output.section(block.displacement(), self.punch.von_mises(),
+                                          normal_axis=1 if block.vertical == 2 else None)
+
 
 def curves(run: PunchRun, path: str) -> None:
     """P(δ) of every step against Hertz, beside the pressure (or traction) panel."""
-    profile = run.punch.surface_profile()  # collective
     if run.punch.mesh.comm.rank != 0:
         return
     plt = pictures.pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
+    n = len(run.states) if run.loading_steps is None else run.loading_steps
     d = np.array([0.0] + [s.indentation for s in run.states])
     P = np.array([0.0] + [s.force for s in run.states])
-    ax1.plot(d, P, "o", label="active set (FE)")
+    ax1.plot(d[: n + 1], P[: n + 1], "o-", label="active set (FE)" + (", loading" if
+                                                                      n < len(d) - 1 else ""))
+    if n < len(d) - 1:
+        ax1.plot(d[n:], P[n:], "s--", color="C2", label="unloading")
     if run.model != "plane_strain":
         dd = np.linspace(0, d.max(), 100)
         Es = hertz.effective_modulus(run.E, run.nu)
@@ -74,8 +96,8 @@ def curves(run: PunchRun, path: str) -> None:
                                         else ""))
     ax1.legend()
     ax1.grid(alpha=0.3)
-    _right_panel(ax2, run, profile, run.states[-1])
-    fig.suptitle(title(run, run.states[-1]))
+    _right_panel(ax2, run, run.profile, run.state)
+    fig.suptitle(title(run, run.state))
     pictures.save_figure(fig, path)
 
 
@@ -189,16 +211,13 @@ def pressure_panel(ax, profile, state, ref) -> None:
     ax.grid(alpha=0.3)
 
 
-def section_picture(run: PunchRun, von_mises, path: str) -> None:
-    """The deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
-    punch, block, state, ref = run.punch, run.punch.block, run.states[-1], run.ref
-    section = output.section(block.displacement(), von_mises,
-                             normal_axis=1 if block.vertical == 2 else None)  # collective
-    profile = punch.surface_profile()
+def section_picture(run: PunchRun, path: str) -> None:
+    """The snapshot's deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
+    punch, block, state, ref = run.punch, run.punch.block, run.state, run.ref
     if punch.mesh.comm.rank != 0:
         return
     plt = pictures.pyplot()
-    x, z, u_x, u_z, triangles, vm = section
+    x, z, u_x, u_z, triangles, vm = run.section
     a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * block.h)
     window = 2.5 * a
     # the rigid drop of the block is removed (the surface at the window's edge stays put),
@@ -234,6 +253,6 @@ def section_picture(run: PunchRun, von_mises, path: str) -> None:
     cb = fig.colorbar(tpc, ax=ax, shrink=0.8)
     cb.set_label("von Mises stress σ_eq / p0 (Hertz)")
     ax.legend(loc="lower right", fontsize=8)
-    _right_panel(ax2, run, profile, state)
+    _right_panel(ax2, run, run.profile, state)
     fig.suptitle(title(run, state), fontsize=10)
     pictures.save_figure(fig, path)

@@ -1,0 +1,306 @@
+"""What the three punch demos share: flags, step report, Hertz's check, JSON, pictures.
+
+`demos/punch.py` (Hertz), `demos/punch_friction.py` (Cattaneo–Mindlin) and
+`demos/indentation.py` (J2: load, unload, imprint) each tell their own story; the block,
+the load path and its report, the comparison with Hertz and the outputs are the same in
+all three, and live here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from fenics_nl.io import cli
+from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, choice, number, switch
+from fenics_nl.scenes import punch_pictures
+from fenics_nl.scenes.punch import Punch, PunchBlock
+from fenics_nl.theory import hertz, mindlin
+
+__all__ = ["PunchParameters", "StepReport", "block_for", "compare_with_hertz",
+           "compare_with_mindlin", "contact_radius_for", "pictures", "prefixes", "summary"]
+
+MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
+
+
+@dataclass
+class PunchParameters(Parameters):
+    """A rigid punch on a block, pressed by the course's active set.
+
+    The flags of every punch demo: the block, the punch and its normal load, the solver.
+    Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa).
+    """
+
+    EPILOG = ("PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
+              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
+              "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
+              "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
+    OUTPUTS: ClassVar = {
+        "output": "displacement, von Mises stress (j2: plastic strains), contact pressure and "
+                  "active set",
+        "png": "the deformed contact zone (von Mises stress) beside the contact pressure, "
+               "against Hertz",
+        "plot": "force-indentation and pressure against Hertz"}
+    CHECKPOINTS = True
+
+    model: str = choice("axisymmetric", ["axisymmetric", "3d", "plane_strain"],
+                        "axisymmetric (r,z), 3D quarter, plane strain", spelling=True)
+    E: float = number(1.0, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    radius: float = number(1.0, "punch radius R", unit="length", above=0)
+    indentation: float | None = number(None, "displacement control: indentation δ, non-zero "
+                                       "(default 0.01 R; negative: the punch stays clear)",
+                                       unit="length", group="load")
+    force: float | None = number(None, "force control: total force P (per unit length in "
+                                 "plane strain)", unit="force", above=0, group="load")
+    steps: int = number(1, "load steps from 0 to the load", at_least=1)
+    formulation: str = choice("elimination", ["elimination", "multiplier"], "active normal "
+                              "displacements as Dirichlet rows, or Lagrange multipliers")
+    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements: no locking as "
+                         "ν → 1/2, and ν = 0.5 exactly (with the elimination)")
+    gap: str = choice("parabola", ["parabola", "sphere"], "punch shape: Hertz's parabola or "
+                      "the exact sphere")
+    refine: int = number(1, "element size under the punch a/(20·2^refine) (3D: "
+                         "a/(6·2^refine))", at_least=0, at_most=MAX_REFINE)
+    block: float | None = number(None, "block size in contact radii, >= 10 (default 1000, 3D "
+                                 "100)", above=0)
+
+    def check(self):
+        """The combinations the solvers refuse, and the default indentation (0.01 R)."""
+        if self.mixed and self.formulation == "multiplier" and self.model == "3d":
+            raise ValueError("--mixed --formulation multiplier is 2D and axisymmetric only (no "
+                             "nodal rule with positive weights on P2 triangles): use "
+                             "--formulation elimination in 3d")
+        if self.indentation is not None and self.indentation == 0:
+            raise ValueError("--indentation must be non-zero (negative: the punch stays clear)")
+        if self.indentation is None and self.force is None:
+            self.indentation = 0.01 * self.radius
+
+
+def prefixes(args: PunchParameters) -> dict[str, str]:
+    """The PETSc prefix of the run's solver (`cli.arguments`)."""
+    form = args.formulation[:4]
+    return {f"punch_{args.model}_{form}_":
+            "KSP" if args.formulation == "elimination" else "SNES and KSP"}
+
+
+def contact_radius_for(args: PunchParameters) -> float:
+    """The contact radius the block's mesh is made for.
+
+    Hertz's a for a prescribed force (sphere, or the cylinder's half-width), else √(Rδ)
+    (for a cylinder, a safe overestimate of its half-width).
+    """
+    if args.force is None:
+        return math.sqrt(args.radius * abs(args.indentation))
+    law = hertz.cylinder_from_force if args.model == "plane_strain" else hertz.sphere_from_force
+    return law(args.E, args.nu, args.radius, args.force)["contact_radius"]
+
+
+def block_size(args: PunchParameters) -> float:
+    """The block's size in contact radii: the flag's, else 1000 (3D: 100)."""
+    return args.block or (100.0 if args.model == "3d" else 1000.0)
+
+
+@dataclass
+class StepReport:
+    """The `on_step` of `solve_incrementally`: each converged state said and kept in the JSON.
+
+    `loading_steps` steps load the punch; those after them (an unloading) count the load
+    factor down. `fields()` gives what --output writes at the step.
+    """
+
+    states: list
+    loading_steps: int
+    total_steps: int
+    fields: object
+
+    def __call__(self, t, result) -> None:
+        """Say and keep the state just converged at load factor `t`."""
+        s = self.states[-1]
+        cli.converged_step({"load_factor": t if len(self.states) <= self.loading_steps else 1 - t,
+                            "indentation": s.indentation, "force": s.force,
+                            "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
+                            "active_set_iterations": s.active_set_iterations},
+                           fields=self.fields)
+        say(f"step {len(self.states)}/{self.total_steps}: δ = {s.indentation:.5g}, P = "
+            f"{s.force:.6g}, a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
+            f"{s.active_set_iterations} active-set iterations")
+
+
+@dataclass
+class HertzCheck:
+    """The loaded state against Hertz.
+
+    `ref`: Hertz's values (None: no contact); `errors`: the relative ones; `exponent`: m of
+    P ∝ δ^m fitted over the loading steps (None with fewer than two).
+    """
+
+    ref: dict | None
+    errors: dict = field(default_factory=dict)
+    exponent: float | None = None
+
+
+def compare_with_hertz(punch: Punch, loading: list) -> HertzCheck:
+    """The last loading state's force, contact radius and largest pressure against Hertz.
+
+    The force is not checked for the cylinder; the radius is the outermost active node's.
+    Said in one line, and the fitted exponent in another.
+    """
+    last = loading[-1]
+    if not last.force > 0:
+        say("the punch does not touch the block: zero contact force")
+        return HertzCheck(None)
+    ref = punch.hertz(last)
+    errors = {k: getattr(last, k) / ref[k] - 1 for k in ("force", "contact_radius",
+                                                         "max_pressure") if k in ref}
+    checked = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
+               f"{100 * e:+.3f} %)" for k, e in errors.items()]
+    if punch.model == "plane_strain":  # a cylinder: Hertz's a and p0 for the computed P
+        checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
+    say("; ".join(checked) + f"; h = {punch.block.h:.2g}")
+    exponent = None
+    if len(loading) >= 2 and all(s.force > 0 for s in loading):
+        exponent = float(np.polyfit(np.log([s.indentation for s in loading]),
+                                    np.log([s.force for s in loading]), 1)[0])
+        say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if punch.model == "plane_strain"
+                                                       else " (Hertz: 1.5)"))
+    return HertzCheck(ref, errors, exponent)
+
+
+REACTIONS_OF = {"axisymmetric": ("the whole body (2πr in the residual)",) * 2,
+                "3d": ("the modelled quarter", "the modelled half"),
+                "plane_strain": ("the modelled half, per unit length",
+                                 "the whole block, per unit length")}
+
+
+def summary(args: PunchParameters, punch: Punch, states: list, loading: list, nodes: int,
+            check: HertzCheck, material: str, warnings: list[str]) -> dict:
+    """The JSON every punch run has: the loaded state, its check, the steps, the work."""
+    block, last = punch.block, loading[-1]
+    out = {"model": args.model, "formulation": args.formulation, "material": material,
+           "mixed": args.mixed, "elements": "P2-P1 (Taylor-Hood)" if args.mixed else "P1",
+           "force": last.force, "indentation": last.indentation,
+           "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
+           "element_size": block.h, "nodes_in_contact": nodes,
+           "active_set_iterations": sum(s.active_set_iterations for s in states),
+           "newton_iterations": sum(s.newton_iterations for s in states),
+           "factorizations": sum(s.factorizations for s in states),
+           "steps": [{"indentation": s.indentation, "force": s.force,
+                      "contact_radius": s.contact_radius,
+                      "active_set_iterations": s.active_set_iterations} for s in states],
+           "reactions": punch.reactions(),
+           "reactions_of": REACTIONS_OF[args.model][block.tangential],
+           "dofs": punch.dofs, "ranks": punch.mesh.comm.size, "warnings": warnings}
+    if check.exponent is not None:
+        out["fitted_exponent"] = check.exponent
+    for k, e in check.errors.items():
+        out[f"hertz_{k}"], out[f"{k}_rel_error"] = check.ref[k], e
+    if args.model == "plane_strain" and check.ref is not None:
+        warnings.append("plane strain: the force is not checked (a cylinder's indentation "
+                        "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
+                        "checked against Hertz for the computed P")
+    return out
+
+
+def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=None,
+             traction=None, stick_radius_exact=None) -> list:
+    """The writers of --plot and --png, drawing the state at hand (collective).
+
+    States added to `states` later (an unloading) join the curve only.
+    """
+    if not (args.png or args.plot):
+        return []
+    profile = None
+    if traction is not None:
+        if args.model == "3d":  # Q(r), the force inside r
+            rings = np.linspace(0.0, 1.5, 301) * states[-1].contact_radius
+            profile = (rings, punch.tangential_force_within(rings))
+        else:
+            profile = punch.traction_profile()
+    run = punch_pictures.PunchRun(
+        punch, states, check.ref, args.E, args.nu, args.radius, mixed=args.mixed,
+        force_controlled=args.force is not None, friction=friction, traction=traction,
+        traction_profile=profile, stick_radius_exact=stick_radius_exact,
+        loading_steps=len(states))
+    run.snapshot(section=bool(args.png))
+    writers = []
+    if args.plot:  # (--output: the fields of every step were written as they converged)
+        writers.append(lambda: punch_pictures.curves(run, args.plot))
+    if args.png:
+        writers.append(lambda: punch_pictures.section_picture(run, args.png))
+    return writers
+
+
+def block_for(args: PunchParameters, *, tangential: bool = False) -> PunchBlock:
+    """The graded block for the run's expected contact radius (said while it is made)."""
+    size = block_size(args)
+    say(f"meshing the {args.model} block ({size:g} contact radii) ...")
+    return PunchBlock(args.model, contact_radius_for(args), refine=args.refine, block=size,
+                      mixed=args.mixed, tangential=tangential)
+
+
+def compare_with_mindlin(punch: Punch, T, friction: float, bonded: float | None) -> dict:
+    """The partial slip of the tangential state `T` against Cattaneo–Mindlin, for its P.
+
+    The stick radius (half-width) c; in plane strain the tangential traction away from
+    the stick–slip edges (where the exact one has an infinite slope), in 3D the force
+    inside each radius r = k h, Q(r) (P2 nodal forces are no pointwise traction: a
+    vertex's is about 0), and δ_t with the far field's share taken out (`bonded`: the
+    computed compliance before any slip). Said in one line; returned for the JSON.
+    """
+    E, nu, R, h = punch.material.E, punch.material.nu, punch.R, punch.block.h
+    three_d = punch.model == "3d"
+    H = (hertz.sphere_from_force if three_d else hertz.cylinder_from_force)(
+        E, nu, R, T.normal_force)
+    a, p0, fP = H["contact_radius"], H["max_pressure"], friction * T.normal_force
+    if three_d:
+        c = mindlin.sphere_stick_radius(a, T.tangential_force, fP)
+        radii = np.arange(1, int(1.5 * a / h) + 1) * h
+        gap = (punch.tangential_force_within(radii)
+               - mindlin.sphere_tangential_force_within(radii, a, p0, friction, c))
+        out = {"tangential_force_profile_max_error": float(np.abs(gap).max()
+                                                           / T.tangential_force),
+               **_tangential_compliance(T, a, fP, bonded, E, nu)}
+        said = (f"tangential force inside r within "
+                f"{100 * out['tangential_force_profile_max_error']:.2f} % of Q")
+    else:
+        c = mindlin.cylinder_stick_half_width(a, T.tangential_force, fP)
+        x, _, q, _ = punch.traction_profile() or (None,) * 4  # gathered on rank 0
+        comm, out = punch.mesh.comm, {}
+        if comm.rank == 0:
+            away = (np.abs(np.abs(x) - c) > 2 * h) & (np.abs(x) < 1.5 * a)
+            q_exact = mindlin.traction(x, a, p0, friction, c)
+            out["tangential_traction_max_error"] = float(np.abs(q - q_exact)[away].max()
+                                                         / (friction * p0))
+        out = comm.bcast(out, root=0)
+        said = (f"tangential traction within {100 * out['tangential_traction_max_error']:.2f}"
+                f" % of f p0 (beyond 2 h of the stick-slip edges)")
+    out["stick_radius_exact"] = c
+    say(f"Cattaneo-Mindlin: stick {'radius' if three_d else 'half-width'} {c:.5g} (FE: "
+        f"(c - c_exact)/h = {(T.stick_radius - c) / h:+.2f}); " + said)
+    return out
+
+
+def _tangential_compliance(T, a, fP, bonded, E, nu) -> dict:
+    """δ_t against Mindlin's, with the far field's share taken out.
+
+    The finite block (clamped bottom, free sides) adds a far-field compliance C_far to the
+    half-space's; it does not depend on how the contact zone sticks or slips, so the
+    punch's displacement less C_far Q compares with Mindlin's δ_t. C_far is the computed
+    bonded compliance (a move before any slip) less the half-space's (2 − ν)/(8 G a).
+    """
+    G = E / (2 * (1 + nu))
+    exact_bonded = (2 - nu) / (8 * G * a)
+    delta = mindlin.sphere_tangential_displacement(a, T.tangential_force, fP, G, nu)
+    far = (bonded - exact_bonded) * T.tangential_force
+    local = T.tangential_displacement - far
+    say(f"Mindlin: δ_t = {delta:.5g}; FE {T.tangential_displacement:.5g}, less the far "
+        f"field's {far:.3g} (bonded compliance {bonded:.4g} against the half-space's "
+        f"{exact_bonded:.4g}): {100 * (local / delta - 1):+.2f} %")
+    return {"tangential_displacement_exact": delta, "bonded_compliance": bonded,
+            "bonded_compliance_exact": exact_bonded, "tangential_displacement_local": local,
+            "tangential_displacement_rel_error": local / delta - 1}
