@@ -18,7 +18,7 @@ INCOMPRESSIBLE_CYLINDER = ("--refine", "0", "--block", "100")
 # the same on a compressible P1 block: cheap, but not Cattaneo-Mindlin's (Spence's coupling)
 COMPRESSIBLE_CYLINDER = ("--nu", "0.3", "--refine", "0", "--block", "100")
 # the axisymmetric punch with friction: a normal load only
-AXISYMMETRIC = ("--model", "axisymmetric", "--nu", "0.3", "--refine", "0")
+AXISYMMETRIC = ("--model", "axisymmetric", "--nu", "0.3", "--refine", "0", "--block", "100")
 
 
 def jenkins_element(k_n, k_t, delta, f):
@@ -194,7 +194,7 @@ def test_coulombs_law_holds_node_by_node_in_3d():
 
 
 def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
-    free = demo.punch("--refine", "0")
+    free = demo.punch("--refine", "0", "--block", "100")
     smooth = demo.punch_friction(*AXISYMMETRIC, "--friction", "0")
     assert smooth["force"] == pytest.approx(free["force"], rel=1e-9)
     # f = 0.3 at ν = 0.3: friction holds the surface back from its inward slip (Spence), so
