@@ -28,8 +28,6 @@
 # ## Implementation
 
 # +
-import math
-import resource
 import time
 from dataclasses import dataclass
 from typing import ClassVar
@@ -41,20 +39,19 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import ufl
 from mpi4py import MPI
 
-from fenics_nl.io import cli, pictures
+from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch, text
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.parallel import global_max
+from fenics_nl.scenes import bracket_run
 from fenics_nl.scenes.bracket import THICKNESS_MM, Bracket, BracketPart
+from fenics_nl.scenes.bracket_run import DEFAULT_SIZE_MM, MM
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import stalled_at_round_off
 
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "bfgs", "snes")
-MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit
-DEFAULT_SIZE_MM = 6.0  # P2: |u_load| 3.7 % below the extrapolated value (benchmarks page)
 # -
 
 # ### Parameters
@@ -145,7 +142,6 @@ class BracketParameters(Parameters):
 
 args = cli.arguments(BracketParameters, prefixes={
     "bracket_": "Newton's KSP; bracket_snes_: SNES; bracket_elim_: contact"})
-mm = MM[args.units]
 
 
 # -
@@ -214,27 +210,10 @@ def solve(newton):
                 tolerance=args.tolerance, friction=args.friction,
                 linear_solver=args.solver)
     say(f"{b.dofs} unknowns (P{args.degree}), {newton} Newton, {args.steps} load steps")
-    steps = []
-
-    def record(t, r):
-        if len(steps) >= args.steps:  # unloading: the force goes back down
-            t = 1.0 - t
-        steps.append({"force": t * args.force,
-                      "load_point_displacement": b.load_point_displacement(),
-                      "newton_iterations": r.iterations,
-                      "active_set_iterations": r.active_set_iterations,
-                      "factorizations": r.work.factorizations,
-                      "tangent_assemblies": r.work.tangent_assemblies,
-                      "krylov_iterations": r.work.krylov_iterations,
-                      "residual_norms": list(r.residual_norms)})
-        cli.converged_step({"load_factor": t, **steps[-1]}, fields=lambda: fields(b))
-        sets = (f" in {r.active_set_iterations} active-set iterations"
-                if r.active_set_iterations else "")
-        say(f"  {newton}: step {len(steps)}/{total}, F = {t * args.force:.4g} N, "
-            f"{r.iterations} Newton iterations{sets}, |u_load| = "
-            f"{steps[-1]['load_point_displacement']:.6g} {args.units}")
-
     total = 2 * args.steps if args.unload else args.steps
+    record = bracket_run.StepRecord(b, newton, args.force, args.steps, total, args.units,
+                                    fields=lambda: fields(b))
+    steps = record.steps
     # --restart: the checkpoint's displacement, plastic state, floor contact and steps back;
     # --checkpoint: saved after each converged step of the loading
     contact = b.solver if args.support == "contact" else None
@@ -265,7 +244,6 @@ def solve(newton):
         k = len(steps) + 1
         raise LoadStepError(f"load step {k}/{args.steps} (F = {err.target * args.force:.4g} N), "
                             f"{newton} Newton: {err.__cause__}; {advice}", err.result) from err
-    # -
     wall = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
     return b, steps, wall
 
@@ -295,154 +273,12 @@ say(f"supports hold ({', '.join(f'{x:.6g}' for x in held)}) N against the load "
 #
 # The JSON (the load-point displacement, the largest σ_eq and the strain it means, the
 # work counts; with `--compare` one table of the variants) and, when asked, the fields for
-# ParaView, the load-displacement curve and the picture.
-
-
-def summary(b, steps, wall, args):
-    vm = b.von_mises()
-    vm_max = global_max(comm, vm.x.array)
-    mat = b.material
-    out = {
-        "support": args.support, "force": args.force, "length_unit": args.units,
-        "load_point_displacement": steps[args.steps - 1]["load_point_displacement"],
-        "max_von_mises": vm_max,
-        "newton_iterations": sum(s["newton_iterations"] for s in steps),
-        "factorizations": sum(s["factorizations"] for s in steps),
-        "tangent_assemblies": sum(s["tangent_assemblies"] for s in steps),
-        "krylov_iterations": sum(s["krylov_iterations"] for s in steps),
-        "residual_norms": steps[-1]["residual_norms"],
-        "steps": [{k: v for k, v in s.items() if k != "residual_norms"} for s in steps],
-        "reactions": b.reactions(),
-        "largest_cell": b.largest_cell,
-        "dofs": b.dofs, "ranks": comm.size, "solve_time_s": wall,
-        "peak_memory_mb": comm.allreduce(
-            resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, op=MPI.MAX),
-        "warnings": resolution_warnings(args),
-    }
-    if isinstance(mat, PowerLaw):
-        # σ_eq = σ0 x (1 + x²)^((n−1)/2), x = ε_eq/ε0: invert for the peak strain
-        out["max_eps_eq_over_eps0"] = _strain_ratio(vm_max / mat.sigma0, mat.n)
-    if isinstance(mat, J2Plasticity):
-        out.update(plastic_zone(mat))
-    if args.unload:  # what the load leaves behind
-        out["permanent_load_point_displacement"] = steps[-1]["load_point_displacement"]
-        out["warnings"].append("unloaded: max_von_mises and the reactions are those of the "
-                               "residual state")
-    if args.support == "contact":
-        out["lifted_off_area"] = b.lifted_off_area()
-        out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
-        c = b.solver
-        out["max_floor_pressure"] = global_max(comm, c.pressure()[c.active])
-    if args.friction is not None:  # Coulomb on the whole floor: |T_t| <= f T_n
-        fx, fy, fz = out["reactions"]["base"]
-        out.update(friction=args.friction, stick_nodes=c.surface.count(c.stick),
-                   slip_nodes=c.surface.count(c.slip),
-                   floor_friction_ratio=math.hypot(fx, fy) / (args.friction * fz)
-                   if args.friction > 0 and fz > 0 else 0.0)
-    return out, vm
-
-
-def resolution_warnings(args):
-    """What the mesh cannot promise (the convergence checks: the benchmarks page)."""
-    notes = ["no closed form for this part: |u_load| is checked by mesh convergence "
-             "(docs/benchmarks.md), σ_eq peaks at the singular clamped bolt-hole edges"]
-    if args.mesh:
-        notes.append(f"user mesh {args.mesh}: its resolution is not checked")
-    elif args.size is not None and args.size / MM[args.units] > DEFAULT_SIZE_MM:
-        notes.append(f"elements coarser than the default {DEFAULT_SIZE_MM:g} mm: |u_load| is "
-                     f"more than 4 % below its converged value (measured: -5 % at 10 mm, "
-                     f"-10 % at 20 mm)")
-    if args.degree == 1:
-        notes.append("P1 tetrahedra lock in this bending problem (about half the displacement)")
-    return notes
-
-
-def plastic_zone(mat):
-    """The largest cumulated plastic strain and the plastic fraction of the volume."""
-    from dolfinx import fem
-
-    pq = mat.cumulated_plastic_strain
-    n = pq.function_space.dofmap.index_map.size_local
-    volume, plastic_volume = (comm.allreduce(fem.assemble_scalar(fem.form(f * part.dx)))
-                              for f in (1.0, ufl.conditional(ufl.gt(pq, 0), 1.0, 0.0)))
-    return {"max_cumulated_plastic_strain": global_max(comm, pq.x.array[:n]),
-            "plastic_volume_fraction": plastic_volume / volume}
-
-
-def _strain_ratio(s, n):
-    from scipy.optimize import brentq
-
-    return brentq(lambda x: x * (1 + x * x) ** ((n - 1) / 2) - s, 0.0, 1e9) if s > 0 else 0.0
-
-
-
-def compare():
-    """Every variant's summary and one table of them."""
-    rows = {n: summary(*r, args)[0] for n, r in runs.items()}
-    ref = rows["full"]["load_point_displacement"]
-    say(f"\n| Newton | iterations per step | factorizations | tangent assemblies | "
-        f"time (s) | |u_load| ({args.units}) | rel. diff. to full |\n|---|---|---|---|---|---|---|")
-    for name, r in rows.items():
-        its = ", ".join(str(s["newton_iterations"]) for s in r["steps"])
-        diff = abs(r["load_point_displacement"] / ref - 1)
-        say(f"| {name} | {its} | {r['factorizations']} | {r['tangent_assemblies']} | "
-            f"{r['solve_time_s']:.2f} | {r['load_point_displacement']:.9g} | {diff:.1e} |")
-    out = dict(rows["full"])
-    out["variants"] = rows
-    return out
-
-
-def writers(b, vm, steps, args):
-    """The outputs asked for, each run on its own after the JSON (--output's fields were
-    written at every converged step)."""
-    todo = []
-    if args.plot:
-        todo.append(lambda: plot(steps, args))
-    if args.png:
-        todo.append(lambda: picture(b, vm, args))
-    return todo
-
-
-def plot(steps, args):
-    if comm.rank != 0:
-        return
-    plt = pictures.pyplot()
-
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot([0] + [s["load_point_displacement"] for s in steps],
-            [0] + [s["force"] / 1e3 for s in steps], "o-")
-    ax.set_xlabel(f"load-point displacement |u| [{args.units}]")
-    ax.set_ylabel("force [kN]")
-    ax.grid(alpha=0.3)
-    ax.set_title(f"bracket, {args.support} support, {args.material}"
-                 + (f" n = {args.n}" if args.material == "power-law" else ""))
-    pictures.save_figure(fig, args.plot)
-
-
-def picture(b, vm, args):
-    """Two views of the deformed bracket (σ_eq; in J2 the cumulated plastic strain), the
-    load arrow, the bolts, the floor."""
-    if isinstance(b.material, J2Plasticity):  # where it yielded, and how much
-        pictures.bracket_picture(b, b.material.cumulated_plastic_strain_per_cell(), args.png,
-                                 units=args.units, force=args.force,
-                                 label="cumulated plastic strain p (largest of each cell)",
-                                 unloaded=args.unload)
-    else:
-        pictures.bracket_picture(b, vm, args.png, units=args.units, force=args.force,
-                                 unloaded=args.unload)
-    say(f"wrote {args.png}")
-
-
+# ParaView (written at every step as it converged), the load–displacement curve and the
+# deformed part (`fenics_nl.scenes.bracket_run`).
 
 if args.compare:
-    cli.results(compare())
+    cli.results(bracket_run.comparison(runs, args))
 else:
-    out, vm = summary(b, steps, wall, args)
-    strain = (f" (ε_eq ≈ {out['max_eps_eq_over_eps0']:.3g} ε0)"
-              if "max_eps_eq_over_eps0" in out else "")
-    lifted = (f", lifted-off area {out['lifted_off_area']:.4g} {args.units}²"
-              if "lifted_off_area" in out else "")
-    say(f"|u_load| = {out['load_point_displacement']:.6g} {args.units}, max σ_eq = "
-        f"{out['max_von_mises']:.4g} N/{args.units}²{strain}, {out['newton_iterations']} Newton "
-        f"iterations, {out['factorizations']} factorizations, {b.dofs} unknowns{lifted}")
-    cli.results(out, writers(b, vm, steps, args))
+    out, vm = bracket_run.summary(b, steps, wall, args)
+    bracket_run.say_result(out, b, args.units)
+    cli.results(out, bracket_run.writers(b, vm, steps, args))
