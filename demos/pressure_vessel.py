@@ -176,16 +176,7 @@ solver = make_solver(bcs)
 # proportion) gives σ_eq at the inner surface per unit pressure, hence $p_e$.
 
 # +
-p1 = 0.5 * p_e_exact
-body.pressure.value = p1
-NewtonSolver(residual, u, body.supports, rtol=1e-10, atol=1e-10, force_scale=force,
-             prefix="vessel_onset_").solve()
-vm_a, _ = body.stresses_at_inner(material)
-if vm_a >= s0:
-    raise SolveError(f"the onset step yielded (σ_eq(a) = {vm_a:.4g} >= σ0): it must be elastic")
-p_e = p1 * s0 / vm_a
-u.x.array[:] = 0.0
-body.pressure.value = 0.0
+p_e = body.yield_onset(residual, material, 0.5 * p_e_exact, force)
 say(f"{shape}, a = {a:g}, b = {b:g}, {body.dofs} unknowns; yield onset p_e = {p_e:.6g} "
     f"(closed form {p_e_exact:.6g}), limit {p_lim:.6g}")
 # -
@@ -354,14 +345,4 @@ def summary():
 outcome = vessel_pictures.VesselRun(
     shape, a, b, args.E, args.nu, s0, path, loaded, args.unload, p_lim, p_e_exact, c_fe,
     c_exact, compliance, exact_curve, inner, inner_exact)
-writers = []
-if args.plot:
-    writers.append(lambda: vessel_pictures.pressure_curve(outcome, args.plot))
-if args.png:
-    def picture():
-        vessel_pictures.plastic_zone(outcome, body.displacement(),
-                                     material.cumulated_plastic_strain_per_cell(), args.png)
-        say(f"wrote {args.png}")
-
-    writers.append(picture)
-cli.results(summary(), writers)
+cli.results(summary(), vessel_pictures.writers(outcome, body, material, args))

@@ -118,6 +118,28 @@ class VesselBody:
         hoop = self.probes.discontinuous("hoop", sigma[1, 1], self.degree)
         return vm[0], hoop[0]
 
+    def yield_onset(self, residual, material, trial: float, force: float) -> float:
+        """The pressure at which the inner surface yields, from one elastic solve.
+
+        σ_eq grows in proportion to an elastic load: solved at the pressure `trial` (which
+        must leave the body elastic, else a SolveError), σ_eq(a) per unit pressure gives
+        the onset σ0 / (σ_eq(a)/trial). The body is left unloaded. `force`: the force scale
+        of Newton's absolute tolerance.
+        """
+        from fenics_nl.errors import SolveError
+        from fenics_nl.solvers.newton import NewtonSolver
+
+        self.pressure.value = trial
+        NewtonSolver(residual, self.unknown, self.supports, rtol=1e-10, atol=1e-10,
+                     force_scale=force, prefix="vessel_onset_").solve()
+        vm_a, _ = self.stresses_at_inner(material)
+        if vm_a >= material.sigma0:
+            raise SolveError(f"the onset step yielded (σ_eq(a) = {vm_a:.4g} >= σ0): it must "
+                             "be elastic")
+        self.unknown.x.array[:] = 0.0
+        self.pressure.value = 0.0
+        return trial * material.sigma0 / vm_a
+
     def plastic_radius(self, material) -> float:
         """Largest |x| of a quadrature point where p > 0 (the plastic zone's edge), or a."""
         p = material.cumulated_plastic_strain
