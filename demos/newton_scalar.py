@@ -13,6 +13,29 @@
 # $C = |1 - r'(u)/K|$ (modified), $q = (1+\sqrt5)/2 \approx 1.618$ (secant).
 # The observed order is $q_k = \ln(e_{k+1}/e_k) / \ln(e_k/e_{k-1})$.
 #
+# ### Where the orders come from
+#
+# Expand the residual about the root $u$: $r(u_k) = r'(u)\, e_k + \tfrac12 r''(u)\, e_k^2 +
+# O(e_k^3)$.
+#
+# * **Newton** divides by the slope at $u_k$, $r'(u_k) = r'(u) + r''(u)\, e_k + \dots$, and
+#   the first-order terms cancel: $e_{k+1} = \frac{r''(u)}{2 r'(u)}\, e_k^2 + O(e_k^3)$.
+#   The number of correct digits doubles at each iteration.
+# * **Modified Newton** divides by a fixed $K$: $e_{k+1} = (1 - r'(u)/K)\, e_k + O(e_k^2)$.
+#   Each iteration gains the same number of digits, $-\log_{10}|1 - r'(u)/K|$; it converges
+#   only if $0 < r'(u)/K < 2$. A $K$ stiffer than the root's slope (a softening law started
+#   from its initial stiffness) converges slowly but surely; one less than half of it (a
+#   hardening law started from its initial stiffness) diverges.
+# * **Secant** divides by the chord through the last two iterates, and
+#   $e_{k+1} \approx \frac{r''(u)}{2 r'(u)}\, e_k\, e_{k-1}$: with $|e_{k+1}| \sim |e_k|^q$
+#   this needs $q^2 = q + 1$, whose root is the golden ratio.
+#
+# In a structure the same three choices are the full tangent (assembled and factorized at
+# every iteration), the constant tangent (factorized once, then back-substitutions only)
+# and the secant-type updates (quasi-Newton: BFGS on a frozen factorization). Which is
+# fastest is a matter of cost per iteration against the number of iterations: the bracket
+# and the vessel demos measure it.
+#
 # In double precision round-off arrives after three or four useful iterates, too few to
 # watch an order settle, so by default the iterations run in 60-digit arithmetic (mpmath);
 # `--digits 16` uses plain floats.
@@ -44,8 +67,6 @@ FUNCTIONS = {
 }
 EXPECTED = {"newton": 2.0, "modified": 1.0, "secant": (1 + 5**0.5) / 2}
 # -
-
-
 
 # ### Parameters
 #

@@ -1,4 +1,5 @@
 import argparse
+import sys
 
 import pytest
 
@@ -56,3 +57,79 @@ def test_an_old_spelling_is_read_said_once_and_never_written(tmp_path, demo):
     assert {canonical(old, "x") for old in OLD_SPELLINGS} == {"bfgs", "plane_strain",
                                                               "plane_stress", "lu", "gamg"}
     assert canonical("full", "x") == "full"
+
+
+FORGETFUL = '''from dataclasses import dataclass
+
+import fenics_nl  # noqa: F401
+from fenics_nl.io import cli
+from fenics_nl.io.parameters import Parameters, number
+
+
+@dataclass
+class P(Parameters):
+    """A script that solves and never reports."""
+
+    x: float = number(1.0, "x")
+
+
+args = cli.arguments(P, prefixes={})
+print("solved", args.x)
+'''
+
+
+def test_a_script_that_never_reports_its_results_fails(tmp_path):
+    # nothing written, nothing said: a status 0 would be a lie
+    import subprocess
+
+    script = tmp_path / "forgetful.py"
+    script.write_text(FORGETFUL)
+    proc = subprocess.run([sys.executable, script], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 1 and "solved 1.0" in proc.stdout
+    assert "ended without reporting its results" in proc.stderr, proc.stderr
+    helped = subprocess.run([sys.executable, script, "--help"], capture_output=True,
+                            text=True, timeout=300)
+    assert helped.returncode == 0 and "never reports" in helped.stdout, helped.stderr
+
+
+LONELY = '''from dataclasses import dataclass
+
+import fenics_nl  # noqa: F401
+from mpi4py import MPI
+
+from fenics_nl.io import cli
+from fenics_nl.io.parameters import Parameters
+
+@dataclass
+class P(Parameters):
+    """A run whose rank 1 fails alone while rank 0 waits in a collective."""
+
+
+args = cli.arguments(P, prefixes={})
+if MPI.COMM_WORLD.rank == 1:
+    raise ValueError("rank 1 alone")
+MPI.COMM_WORLD.barrier()
+cli.results({})
+'''
+
+
+@pytest.mark.spawns_mpi
+def test_an_error_on_one_rank_stops_the_run_instead_of_hanging(tmp_path):
+    # the failing rank waits 5 s for the others (FAILURE_WAIT_S), then ends them all
+    import subprocess
+
+    from conftest import MPIEXEC
+
+    script = tmp_path / "lonely.py"
+    script.write_text(LONELY)
+    proc = subprocess.run([str(MPIEXEC), "-n", "2", sys.executable, script],
+                          capture_output=True, text=True, timeout=240)
+    assert proc.returncode != 0
+    assert "rank 1 alone (on rank 1 only: the run is stopped)" in proc.stderr, proc.stderr
+
+
+@pytest.mark.spawns_mpi
+def test_help_is_printed_once_on_two_ranks(demo):
+    proc = demo.run(["newton_scalar.py", "--help"], ranks=2)
+    assert proc.stdout.count("usage:") == 1, proc.stdout

@@ -19,6 +19,7 @@ step and the last converged load factor.
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import math
 import os
@@ -87,6 +88,11 @@ class ArgumentParser(argparse.ArgumentParser):
         """Print `prog: error: message` alone (rank 0) and exit with status 2."""
         text = f"{self.prog}: error: {message} (see --help)\n"
         self.exit(2, text if MPI.COMM_WORLD.rank == 0 else None)
+
+    def print_help(self, file=None):
+        """The help, once: on rank 0 (under mpiexec every rank parses --help)."""
+        if MPI.COMM_WORLD.rank == 0:
+            super().print_help(file)
 
 
 def parser(description: str, epilog: str | None = None) -> ArgumentParser:
@@ -277,6 +283,8 @@ class _Run:
         self.failure_writers = None  # out -> writers of a failed run (its pictures)
         self.path: Path | None = None  # the demo file (a checkpoint's identity)
         self.args: argparse.Namespace | None = None  # its parameters
+        # a script's own communicator, to tell whether a failure is every rank's
+        self.failure_comm: MPI.Comm | None = None
 
     def close_series(self) -> None:
         """Close the fields' time series, saying what it holds (collective)."""
@@ -629,6 +637,8 @@ def _script_run(path: Path) -> None:
     global _current
     run = _current = _Run(sys.argv[1:])
     run.path, run.script = path, True
+    run.failure_comm = MPI.COMM_WORLD.Dup()  # every rank starts the script here
+    atexit.register(_ended_without_results, run)
 
     def one_line_exit(kind, err, tb):
         global _current
@@ -644,6 +654,11 @@ def _script_run(path: Path) -> None:
             run.close_series()
             _forget(run.options)
             return
+        if not _every_rank_failed(run):  # the others go on: no collective way out
+            print(f"error: {_one_line(err)} (on rank {MPI.COMM_WORLD.rank} only: the run "
+                  "is stopped)", file=sys.stderr, flush=True)
+            sys.stdout.flush()
+            MPI.COMM_WORLD.Abort(2)
         try:
             status = _failed(run, err)
         finally:
@@ -655,6 +670,46 @@ def _script_run(path: Path) -> None:
         os._exit(status)
 
     sys.excepthook = one_line_exit
+
+
+FAILURE_WAIT_S = 5.0  # how long a failing rank waits for the others (a collective error
+# is raised after a collective decision: its ranks arrive within milliseconds)
+
+
+def _every_rank_failed(run: _Run, seconds: float = FAILURE_WAIT_S) -> bool:
+    """Whether every rank reached this failure (an error raised collectively).
+
+    A non-blocking barrier on the run's own communicator, waited for `seconds`: the ranks
+    of a collective error arrive together; a rank alone in its error would wait for ever
+    in the collective clean-up of `_failed`.
+    """
+    comm = run.failure_comm
+    if comm is None or comm.size == 1:
+        return True
+    request = comm.Ibarrier()
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if request.Test():
+            return True
+        time.sleep(0.005)
+    return False
+
+
+def _ended_without_results(run: _Run) -> None:
+    """At the interpreter's exit: a script that never called `results` fails (status 1).
+
+    Nothing was reported, so a status 0 would be a lie. (`--help` and a bad flag end in
+    the parser, before the run has its parameters: they are left alone.)
+    """
+    if _current is not run or run.args is None:
+        return
+    error(f"{run.path.name} ended without reporting its results (cli.results was never "
+          "called): nothing was written")
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if MPI.Is_initialized() and not MPI.Is_finalized():
+        MPI.Finalize()
+    os._exit(1)
 
 
 def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
