@@ -73,12 +73,12 @@ BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed f
 	continuation
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
-	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-readme) || exit 1; done
-	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-readme)
+	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done
+	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-docs)
 
 bench-large: $(VENV)/.installed
-	$(PY) benchmarks/bracket.py --large --update-readme
-	$(PY) benchmarks/reading.py --update-readme
+	$(PY) benchmarks/bracket.py --large --update-docs
+	$(PY) benchmarks/reading.py --update-docs
 
 # the site in docs/_build/html (open index.html): every demo executed as a notebook first
 # (docs/notebooks.py, ~20 s), then Sphinx, warnings as errors; no network needed

@@ -16,7 +16,7 @@ Two profiles. The default one fits `make bench` (about 12 min on 2 cores: meshes
 `--large` (`make bench-large`, about 75 min) measures 31k, 81k and 234k, 1 vs 2 ranks at
 300k and the ~1M iterative part, into results/bracket_large.json.
 
-    python benchmarks/bracket.py [--large] [--quick] [--update-readme] [--resume]
+    python benchmarks/bracket.py [--large] [--quick] [--update-docs] [--resume]
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from common import elapsed, machine, pyplot, save_figure, update_readme
+from common import elapsed, machine, pyplot, save_figure, update_docs
 
 HERE = Path(__file__).resolve().parent
 DEMO = HERE.parent / "demos" / "bracket.py"
@@ -65,7 +65,8 @@ def parse_args():
                    help="element size of the Newton variants with CG + GAMG; 0 skips them")
     p.add_argument("--quick", action="store_true",
                    help="one small mesh (17k unknowns), nothing written")
-    p.add_argument("--update-readme", action="store_true", help="rewrite the README table")
+    p.add_argument("--update-docs", action="store_true",
+                   help="rewrite its table in docs/benchmarks.md")
     p.add_argument("--resume", action="store_true",
                    help="keep the parts already in the results file, measure the rest")
     args = p.parse_args()
@@ -205,8 +206,8 @@ def main():
         plot(out, HERE / "results" / f"{name}.png")
     text = table(out)
     say(text)
-    if args.update_readme and not args.quick:
-        update_readme(name.replace("_", "-"), text)
+    if args.update_docs and not args.quick:
+        update_docs(name.replace("_", "-"), text)
 
 
 def table(s) -> str:

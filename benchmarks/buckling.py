@@ -7,7 +7,7 @@ B. Newton variants along the path to 2 P_cr (40 fixed steps): iterations per ste
 C. Step control: fixed steps against growing steps (with the end-state stability check).
 
 Writes benchmarks/results/buckling.json, buckling.png (error against wall time for each
-element; Newton iterations per load step for each variant) and, with --update-readme, the
+element; Newton iterations per load step for each variant) and, with --update-docs, the
 tables of docs/benchmarks.md.
 """
 
@@ -21,7 +21,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
-from common import elapsed, machine, pyplot, save_figure, update_readme
+from common import elapsed, machine, pyplot, save_figure, update_docs
 from mpi4py import MPI
 
 from fenics_nl.scenes.beam import build_beam
@@ -173,7 +173,7 @@ def plot(r, path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     args = ap.parse_args()
     build_beam(L, H, E, NU).solve_path(1.5, 10)  # warm-up: JIT
     build_beam(L, H, E, NU, degree=1).critical_loads(1)
@@ -191,8 +191,8 @@ def main():
         if not args.quick:
             (HERE / "results" / "buckling.json").write_text(json.dumps(result, indent=1))
             plot(result, HERE / "results" / "buckling.png")
-            if args.update_readme:
-                update_readme("buckling", text)
+            if args.update_docs:
+                update_docs("buckling", text)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from pathlib import Path
 _START = time.perf_counter()
 
 ROOT = Path(__file__).resolve().parents[1]
-TABLES = ROOT / "docs" / "benchmarks.md"  # where --update-readme writes the tables
+TABLES = ROOT / "docs" / "benchmarks.md"  # where --update-docs writes the tables
 
 
 def machine(ranks: int = 1) -> dict:
@@ -41,18 +41,18 @@ def outside_kernels(r: dict) -> float:
 
 def options(doc: str, quick: str):
     """The flags every benchmark takes: --quick (`quick` says what it runs) and
-    --update-readme; `doc` is the benchmark's docstring."""
+    --update-docs; `doc` is the benchmark's docstring."""
     import argparse
 
     ap = argparse.ArgumentParser(description=doc.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help=quick)
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     return ap.parse_args()
 
 
 def publish(name: str, out: dict, table, args, say=print) -> None:
     """The end of a benchmark: its run time into `out`, `table(out)` shown, and unless
-    --quick the results file benchmarks/results/`name`.json and, with --update-readme,
+    --quick the results file benchmarks/results/`name`.json and, with --update-docs,
     the section `name` of docs/benchmarks.md."""
     import json
 
@@ -62,15 +62,12 @@ def publish(name: str, out: dict, table, args, say=print) -> None:
     if not args.quick:
         (ROOT / "benchmarks" / "results" / f"{name}.json").write_text(
             json.dumps(out, indent=2))
-        if args.update_readme:
-            update_readme(name, text)
+        if args.update_docs:
+            update_docs(name, text)
 
 
-def update_readme(name: str, text: str) -> None:
-    """Replace the generated section `name` of docs/benchmarks.md with `text`.
-
-    (The flag keeps its name, --update-readme: the tables were the README's.)
-    """
+def update_docs(name: str, text: str) -> None:
+    """Replace the generated section `name` of docs/benchmarks.md with `text`."""
     src = TABLES.read_text()
     start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
     i, j = src.index(start) + len(start), src.index(end)

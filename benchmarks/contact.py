@@ -7,7 +7,7 @@ B. Same mesh (axisymmetric, default size): active set (elimination with and with
 C. Contact-solve time over one linear elastic solve of the same mesh.
 
 Writes benchmarks/results/contact.json, benchmarks/results/contact.png and, with
---update-readme, the README table.
+--update-docs, the README table.
 """
 
 import argparse
@@ -20,7 +20,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import ufl
-from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, update_readme
+from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, update_docs
 from dolfinx import fem
 from mpi4py import MPI
 from peers import solve_penalty, solve_snes_vi
@@ -113,7 +113,7 @@ def say(msg):
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="coarse meshes only")
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     args = ap.parse_args()
     # warm-up: compile every form once
     punch("axisymmetric", 0).indent(DELTA)
@@ -135,8 +135,8 @@ def main():
         plot(result, HERE / "results" / "contact.png")
         text = table(result)
         print(text)
-        if args.update_readme:
-            update_readme("contact", text)
+        if args.update_docs:
+            update_docs("contact", text)
 
 
 def table(r):

@@ -11,7 +11,7 @@ B. The buckling beam (`scenes.beam`), perfect (no imperfection): to 1.5 P_cr. Ar
 
 Per run: steps, iterations, factorizations (and the stability checks' own), wall time and
 the error against the reference. Writes benchmarks/results/continuation.json and, with
---update-readme, the README table.
+--update-docs, the README table.
 """
 
 import math

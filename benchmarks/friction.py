@@ -14,7 +14,7 @@ And in 3D, the P1 sphere at ν = 0.3 (h = a/6, a block 10 a wide, f = 0.3) press
 moved by 0.002: the active set (slip directions by Newton, a spring across each slip)
 against the vector penalty peer at k = 10, 100, 1000 E/h.
 
-    python benchmarks/friction.py [--quick] [--update-readme]
+    python benchmarks/friction.py [--quick] [--update-docs]
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ Three problems, each at ν = 0.3, 0.49, 0.499 and 0.5 (0.5: the mixed formulatio
 
 Time is the solve's (the forms compiled by a first run of each configuration).
 
-    python benchmarks/mixed.py [--quick] [--update-readme]
+    python benchmarks/mixed.py [--quick] [--update-docs]
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 One run, one mesh, one linear solver (MUMPS): every variant starts from u = 0 at the same
 load and reaches the same tolerance. Writes benchmarks/results/newton.json, the plot
 newton.png (relative residual against wall time, one curve per variant) and, with
---update-readme, the table in README.md (between the `bench:newton` markers).
+--update-docs, the table in README.md (between the `bench:newton` markers).
 """
 
 import argparse
@@ -24,7 +24,7 @@ from common import (
     pyplot,
     save_figure,
     timed_linear_solve,
-    update_readme,
+    update_docs,
 )
 from dolfinx import fem
 from mpi4py import MPI
@@ -55,7 +55,7 @@ def parse_args():
                    help="end traction (E = 1000, σ0 = 1): strongly non-linear at the clamp")
     p.add_argument("--linear-solver", choices=["lu", "cholesky"], default="lu")
     p.add_argument("--repeat", type=int, default=1, help="runs per variant, the fastest kept")
-    p.add_argument("--update-readme", action="store_true")
+    p.add_argument("--update-docs", action="store_true")
     p.add_argument("--quick", action="store_true", help="small mesh, for a smoke run")
     return p.parse_args()
 
@@ -136,8 +136,8 @@ def main():
             out.write_text(json.dumps(summary, indent=1))
             print(f"wrote {out}")
             plot(summary, HERE / "results" / "newton.png")
-            if args.update_readme:
-                update_readme("newton", table(summary))
+            if args.update_docs:
+                update_docs("newton", table(summary))
 
 
 def table(s):

@@ -19,7 +19,7 @@ Variants: full (consistent tangent, from UFL), modified (the course's choice: th
 tangent factorized once for the run), BFGS (on that same factorization), SNES newtonls on
 the same residual and consistent tangent.
 
-    python benchmarks/plasticity.py [--quick] [--update-readme]
+    python benchmarks/plasticity.py [--quick] [--update-docs]
 """
 
 from __future__ import annotations

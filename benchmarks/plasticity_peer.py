@@ -29,7 +29,7 @@ Needs the optional benchmark dependencies (`make bench` installs them):
 (its declared dependency `fenics-dolfinx` is the same DOLFINx as our wheel under another
 name).
 
-    python benchmarks/plasticity_peer.py [--quick] [--update-readme]
+    python benchmarks/plasticity_peer.py [--quick] [--update-docs]
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ except ImportError as err:
 import numpy as np
 import plasticity
 import ufl
-from common import elapsed, machine, update_readme
+from common import elapsed, machine, update_docs
 from mpi4py import MPI
 
 from fenics_nl.materials import kinematics
@@ -292,7 +292,7 @@ def table(rows: list[dict], reference: dict) -> str:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="two coarse meshes, nothing written")
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     args = ap.parse_args()
     sizes = [0.04, 0.02] if args.quick else [0.02, 0.01, 0.007]
     compare(0.05)  # warm-up: forms and the Numba kernel compiled
@@ -312,8 +312,8 @@ def main():
              "reference": {k: reference[k] for k in ("h", "dofs", "inner_displacement",
                                                      "time_s")},
              "benchmark_time_s": elapsed()}, indent=2))
-        if args.update_readme:
-            update_readme("plasticity_peer", text)
+        if args.update_docs:
+            update_docs("plasticity_peer", text)
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ Every figure and every choice ("fastest", "gave up at") is computed from the JSO
 benchmarks/results/, so the text stays true when `make bench` is run again. A benchmark
 whose result file is missing is left out.
 
-    python benchmarks/reading.py [--update-readme]
+    python benchmarks/reading.py [--update-docs]
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import json
 from itertools import pairwise
 from pathlib import Path
 
-from common import outside_kernels, update_readme
+from common import outside_kernels, update_docs
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -392,12 +392,12 @@ def reading() -> str:
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--update-readme", action="store_true")
+    ap.add_argument("--update-docs", action="store_true")
     args = ap.parse_args()
     text = reading()
     print(text)
-    if args.update_readme:
-        update_readme("reading", text)
+    if args.update_docs:
+        update_docs("reading", text)
 
 
 if __name__ == "__main__":

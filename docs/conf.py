@@ -2,7 +2,7 @@
 
 The demos' pages are notebooks executed beforehand by docs/notebooks.py (Sphinx executes
 nothing); the benchmark tables in benchmarks.md are written by the benchmark scripts
-(`--update-readme`) from benchmarks/results/*.json.
+(`--update-docs`) from benchmarks/results/*.json.
 """
 
 import sysconfig
