@@ -161,8 +161,20 @@ part = BracketPart(size=size_mm, mesh_file=args.mesh, support=args.support,
 
 # ### The material
 #
-# The power law's energy $\varphi(\varepsilon)$ (or Hooke's); $\sigma$ and the tangent are
-# its derivatives, taken by UFL.
+# The power law is a free energy of the strain alone (deformation theory: non-linear
+# elasticity, no history),
+#
+# $$ \varphi(\varepsilon) = \frac{\kappa}{2} (\mathrm{tr}\,\varepsilon)^2 +
+#    \frac{\sigma_0 \varepsilon_0}{n+1}\Big[\big(1 + \varepsilon_{eq}^2/\varepsilon_0^2
+#    \big)^{(n+1)/2} - 1\Big], \qquad
+#    \varepsilon_{eq}^2 = \tfrac23\, \mathrm{dev}\,\varepsilon : \mathrm{dev}\,\varepsilon, $$
+#
+# smooth at zero strain (there its tangent is Hooke's) and convex for every $n > 0$, so the
+# equilibrium is the unique minimiser of the potential energy and every Newton variant has a
+# well-posed target. $\sigma = \partial\varphi/\partial\varepsilon$ and the tangent
+# $\partial^2\varphi/\partial\varepsilon^2$ are UFL's derivatives of this one expression.
+# `--material j2` is von Mises plasticity instead (a history: the state committed per step),
+# `--material linear` Hooke's law.
 
 if args.material == "j2":  # its state lives at the quadrature points of the residual's rule
     material = J2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
@@ -192,6 +204,16 @@ residual = internal * part.dx - ufl.dot(part.traction, v) * part.ds_load
 # loop when the base rests on the floor; its absolute tolerance is `--tolerance` times the
 # load. Equal load steps, each from the last converged state. With `--compare`, every
 # variant runs on the same mesh from u = 0.
+#
+# What each variant costs per iteration is what decides between them: full Newton
+# assembles and factorizes the tangent at every iteration (few iterations, quadratic);
+# modified Newton factorizes once per step and then only back-substitutes (many cheap
+# iterations, a linear rate); periodic refreshes every third iteration; quasi-Newton (BFGS)
+# keeps the step's first factorization and corrects it by the last iterates' secant
+# information (superlinear). With MUMPS a full iteration of this P2 mesh (assembly and
+# factorization) costs about 14 modified ones (0.52 s against 0.037 s at 22k unknowns), so
+# the frozen tangents win here, BFGS by 2.6x; with CG + GAMG (`--solver gamg`) nothing is
+# factorized and the ranking turns over (the benchmarks page has both).
 
 # +
 def fields(b):

@@ -121,9 +121,20 @@ body = VesselBody(shape, a, b, size=args.size, mixed=args.mixed)
 
 # ### The material
 #
-# J2 plasticity: the step's condensed energy around the closed-form radial return, in UFL
-# (`fenics_nl.materials.plasticity`); its state lives at the quadrature points of the
-# residual's rule.
+# J2 plasticity with linear isotropic hardening $H$ (perfect at $H = 0$). Over a load step
+# from the committed state $(\varepsilon^p_n, p_n)$, the trial stress
+# $\sigma^{tr} = \mathbb{C} : (\varepsilon - \varepsilon^p_n)$ is returned radially onto the
+# yield surface when it lies outside it:
+#
+# $$ \Delta p = \frac{\langle \sigma^{tr}_{eq} - \sigma_0 - H p_n \rangle}{3\mu + H},
+#    \qquad \sigma = \sigma^{tr} - 3\mu\,\Delta p\, \frac{s^{tr}}{\sigma^{tr}_{eq}}, $$
+#
+# ($\langle x \rangle = \max(x, 0)$, $\mu$ the shear modulus). This is the minimiser of
+# the step's condensed energy, so $\sigma$ is its derivative with respect to $\varepsilon$
+# and the consistent tangent its second derivative: UFL takes both
+# (`fenics_nl.materials.plasticity`), and full Newton converges quadratically even in the
+# plastic zone. The state lives at the quadrature points of the residual's rule and is
+# committed only when a step has converged: a failed step leaves no trace.
 
 material = J2Plasticity(args.E, args.nu, sigma0=s0, H=args.hardening)
 material.bind(body.mesh, body.quadrature_degree)
@@ -149,6 +160,15 @@ residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * bo
 # for the whole run; `--newton snes` is PETSc's newtonls on the same residual and consistent
 # tangent, a cross-check. The absolute tolerance is relative to the limit load's force on
 # the inner surface.
+#
+# The elastic tangent $K$ is stiffer than the material everywhere (plastic flow only
+# softens: the Hessian of the step's convex energy $\Pi$ lies below $K$), so a step
+# $\Delta u = -K^{-1} R$ lowers $\Pi$ by at least $\tfrac12 R^T K^{-1} R$: modified Newton
+# converges at every load below the limit, at a rate that worsens as the plastic zone
+# spreads (near the limit load the structure's stiffness tends to zero while $K$ stays).
+# Full Newton needs a few iterations per step, each a new factorization; modified Newton
+# many more, each only a back-substitution. `--newton modified` shows the iteration counts
+# growing step after step.
 
 # +
 control = "pressure" if args.inner_displacement is None else "displacement"

@@ -129,6 +129,22 @@ say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {arch.dofs} unknowns
 #
 # Arc-length continuation until $q_0$ reaches the target, with a stability check at each
 # state (the tangent's inertia) that tells limit points from bifurcations.
+#
+# Why load control cannot pass a limit point: there $dq_0/da = 0$, the tangent stiffness
+# $K_t$ is singular along the path's direction, and for a slightly larger load no nearby
+# equilibrium exists; Newton at fixed load diverges or jumps to the far, inverted branch.
+# Arc-length makes the load factor $\lambda$ an unknown and prescribes the step's length
+# in $(u, \lambda)$ instead: each step predicts along the path's tangent $(\dot u, \dot
+# \lambda)$, $K_t \dot u = \dot\lambda f$ with $\|\dot u\|^2/u_{ref}^2 + \psi^2 \dot\lambda^2 =
+# \Delta s^2$, and corrects on the constraint. The bordered system stays regular at a limit
+# point (the constraint row fills the missing direction), so the path goes round it and
+# $\lambda$ falls on the unstable branch. Each corrector iteration needs two back-solves
+# with the Newton variant's matrix: for the residual and for the load vector.
+#
+# The stability check counts the negative eigenvalues of $K_t$ (its inertia, from an
+# $LDL^T$ factorization). It changes by one at a critical point; if $\dot\lambda$ changes
+# sign there too it is a limit point, else a bifurcation. Between the two limit points the
+# arch is unstable: one negative eigenvalue.
 
 # +
 # atol 1e-8: the arch's membrane forces are ~1e5 times its load, and their round-off is
