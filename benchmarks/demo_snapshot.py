@@ -34,6 +34,7 @@ RUNS = {  # name: the demo and its arguments (small meshes, every path the demo 
     "vessel": ["pressure_vessel.py", "--steps", "6", "--unload"],
     "vessel_modified": ["pressure_vessel.py", "--newton", "modified", "--steps", "4"],
     "snap_through": ["snap_through.py"],
+    "damage_bar": ["damage_bar.py"],
     "case_cylinder": ["-m", "fenics_nl", "run", str(ROOT / "cases" / "thick_cylinder.toml")],
     "case_arch": ["-m", "fenics_nl", "run", str(ROOT / "cases" / "shallow_arch.toml")],
 }

@@ -33,9 +33,10 @@ SMALL = {
     "buckling_beam.py": ["--load-ratio", "1.2", "--steps", "10"],
     "pressure_vessel.py": [],
     "snap_through.py": [],
+    "damage_bar.py": [],
 }
 # the pictures each page shows (the demo's own --png and --plot)
-PICTURES = {"newton_scalar.py": ["--plot"]}
+PICTURES = {"newton_scalar.py": ["--plot"], "damage_bar.py": ["--plot"]}
 
 _RESULTS_CELL = ("import json\nfrom fenics_nl.io import cli\n"
                  "print(json.dumps(cli.notebook_results()))")

@@ -332,6 +332,7 @@ class ArcLength:
         self._q = None  # the load vector q = −∂R/∂λ of the current step
         self._largest = 0.0  # the largest first residual of a step: round-off's scale
         self._sense0 = 1.0  # the first step's sense of λ (towards the target)
+        self._descending = False  # the target counts only when λ falls through it
 
     # -- the metric --------------------------------------------------------------------
 
@@ -405,7 +406,8 @@ class ArcLength:
                 sense = math.copysign(1.0, self._dot(previous[0], dq)
                                       + self.psi**2 * previous[1])
             dlam = sense * ds / math.sqrt(self._dot(dq, dq) + self.psi**2)
-            if target is not None and (target - lam0) * (target - lam0 - dlam) < 0:
+            if (target is not None and (target - lam0) * (target - lam0 - dlam) < 0
+                    and not (self._descending and dlam > 0)):
                 # the predictor passes the target: aim at it, so that the landing is short
                 ds *= (target - lam0) / dlam
                 dlam, aimed = target - lam0, True
@@ -523,8 +525,12 @@ class ArcLength:
             progress: Callable[[str], None] | None = None,
             progress_every: int = 1,
             resume: ArcState | None = None,
-            on_state: Callable[[ArcState], None] | None = None) -> ContinuationPath:
+            on_state: Callable[[ArcState], None] | None = None,
+            descending: bool = False) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
+
+        `descending`: only where λ falls through `target` (a softening branch past its limit
+        point: the way up through the same λ goes on).
 
         The step that crosses it is then solved at λ = target exactly (Newton at fixed λ,
         from the nearer of its two ends). ContinuationError if the target is not crossed
@@ -542,6 +548,7 @@ class ArcLength:
         if max_steps < 1:
             raise ValueError(f"max_steps must be >= 1, got {max_steps}")
         say = progress or (lambda message: None)
+        self._descending = descending
         if self.metric_dofs is not None:
             x = self.solver.u.x.petsc_vec
             self._weights = x.duplicate()
@@ -643,8 +650,9 @@ class ArcLength:
             return None
         step = _Step(du, dlam, walk.lam + dlam, its, work, norms, t0, count, sense, turned,
                      bifurcation, leave, tangent)
-        if walk.kick is None and not leave and (
-                aimed or (walk.lam - target) * (step.lam - target) <= 0):
+        crosses = (walk.lam - target) * (step.lam - target) <= 0 and not (
+            self._descending and step.lam >= walk.lam)
+        if walk.kick is None and not leave and (aimed or crosses):
             # the step passes the target, or was aimed at it (the arc's corrector may stop
             # just short of it, and aiming again would shrink the arc without end): solve
             # there (or cut the arc if that fails)

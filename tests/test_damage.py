@@ -1,0 +1,61 @@
+"""The course's local brittle damage law (`materials.damage`) on the bar (`demos/damage_bar.py`)."""
+
+import math
+from itertools import pairwise
+
+import pytest
+
+
+def test_the_uniform_bar_follows_the_closed_form_and_the_weak_spot_localizes(demo):
+    d = demo.json("damage_bar.py")
+    # σ = Eε, then w_c/ε: measured 2.8e-13 over 12 steps to 4 ε_c (a uniform state has no
+    # discretization error; the homogeneous branch is kept because every point of the
+    # threshold starts its step with the damaged secant)
+    assert d["uniform_max_rel_error"] < 1e-10
+    assert d["critical_stress"] == pytest.approx(math.sqrt(1e-4), rel=1e-12)
+    assert max(d["stress_history"]) == pytest.approx(d["critical_stress"], rel=1e-10)
+    # the weak first cell takes all the damage, and dissipates one cell's A h w_c ln(1/ρ):
+    # measured -0.009 % on every mesh (the external work's trapezoid rule over the steps)
+    table = d["mesh_table"]
+    assert d["localized"] and [t["damaged_cells"] for t in table] == [1, 1, 1]
+    for t in table:
+        assert abs(t["dissipated_energy_rel_error"]) < 1e-3
+        assert t["peak_stress"] <= d["weak_critical_stress"] * (1 + 1e-9)
+    # halving h halves the energy it takes to break the bar: no length scale
+    for coarse, fine in pairwise(table):
+        assert fine["dissipated_energy"] / coarse["dissipated_energy"] == pytest.approx(
+            0.5, rel=1e-3)
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--weak", "1.5"], "--weak: must be <= 0.999"),
+    (["--cells", "2"], "--cells: must be >= 3"),
+    (["--stress-ratio", "0"], "--stress-ratio: must be > 0"),
+    (["--wc", "-1"], "--wc: must be > 0"),
+])
+def test_damage_bar_bad_input_is_one_line(demo, args, words):
+    proc = demo.run(["damage_bar.py", *args], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and words in lines[0], proc.stderr
+
+
+def test_the_course_damage_law_refuses_what_it_cannot_be():
+    from fenics_nl.materials.damage import CourseDamage
+
+    with pytest.raises(ValueError, match="w_c"):
+        CourseDamage(1.0, 0.0, w_c=0.0)
+    law = CourseDamage(1.0, 0.0, w_c=1e-4)
+    with pytest.raises(ValueError, match="bind"):
+        law.energy(None)
+    assert law.critical_strain == pytest.approx(1e-2) and law.critical_stress == pytest.approx(
+        1e-2)
+
+
+@pytest.mark.spawns_mpi
+def test_damage_bar_two_ranks_give_the_serial_answer(demo):
+    s, p = demo.json("damage_bar.py"), demo.json("damage_bar.py", ranks=2)
+    assert p["ranks"] == 2 and p["localized"]
+    for a, b in zip(s["mesh_table"], p["mesh_table"], strict=True):
+        assert b["dissipated_energy"] == pytest.approx(a["dissipated_energy"], rel=1e-8)
+        assert b["steps"] == a["steps"]
+    assert p["stress_history"] == pytest.approx(s["stress_history"], rel=1e-10)
