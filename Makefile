@@ -20,8 +20,10 @@ $(VENV)/.installed: pyproject.toml
 	@touch $@
 
 # the documentation's extra: Sphinx, MyST-NB, the theme, MathJax's files, Playwright
+# (the extra's requirements only: the package itself is installed already)
 $(VENV)/.docs-installed: $(VENV)/.installed
-	$(PY) -m pip install --quiet -e ".[test,docs]"
+	$(PY) -m pip install --quiet $$($(PY) -c "import tomllib; print(' '.join(tomllib.load(open( \
+	  'pyproject.toml', 'rb'))['project']['optional-dependencies']['docs']))")
 	@touch $@
 
 # the benchmarks' extra: numba and the J2 peer (see pyproject.toml's bench extra)
@@ -84,7 +86,7 @@ bench-large: $(VENV)/.installed
 # (docs/notebooks.py, ~20 s), then Sphinx, warnings as errors; no network needed
 docs: $(VENV)/.docs-installed
 	$(PY) docs/notebooks.py
-	$(PY) -m sphinx -b html -q -W --keep-going docs docs/_build/html
+	$(PY) -m sphinx -b html -q -W --keep-going -j 2 docs docs/_build/html
 	@echo "make docs: open $(CURDIR)/docs/_build/html/index.html"
 
 # every page of the built site in headless Chromium (Debian's package chromium): failed

@@ -29,7 +29,7 @@ SMALL = {
     "punch.py": ["--refine", "0"],
     # its defaults but the tangential load by the punch's position (16 s, not 28 s)
     "punch_friction.py": ["--tangential-displacement", "0.0023"],
-    "indentation.py": ["--refine", "0"],
+    "indentation.py": ["--refine", "0", "--steps", "2"],
     "bracket.py": ["--size", "20", "--steps", "1"],
     "buckling_beam.py": ["--load-ratio", "1.2", "--steps", "10"],
     "pressure_vessel.py": [],

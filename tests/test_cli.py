@@ -116,7 +116,8 @@ cli.results({})
 
 @pytest.mark.spawns_mpi
 def test_an_error_on_one_rank_stops_the_run_instead_of_hanging(tmp_path):
-    # the failing rank waits 5 s for the others (FAILURE_WAIT_S), then ends them all
+    # the failing rank waits for the others (FAILURE_WAIT_S: 1 s here), then ends them all
+    import os
     import subprocess
 
     from conftest import MPIEXEC
@@ -124,7 +125,8 @@ def test_an_error_on_one_rank_stops_the_run_instead_of_hanging(tmp_path):
     script = tmp_path / "lonely.py"
     script.write_text(LONELY)
     proc = subprocess.run([str(MPIEXEC), "-n", "2", sys.executable, script],
-                          capture_output=True, text=True, timeout=240)
+                          capture_output=True, text=True, timeout=240,
+                          env={**os.environ, "FENICS_NL_FAILURE_WAIT_S": "1"})
     assert proc.returncode != 0
     assert "rank 1 alone (on rank 1 only: the run is stopped)" in proc.stderr, proc.stderr
 

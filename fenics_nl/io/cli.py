@@ -672,8 +672,9 @@ def _script_run(path: Path) -> None:
     sys.excepthook = one_line_exit
 
 
-FAILURE_WAIT_S = 5.0  # how long a failing rank waits for the others (a collective error
-# is raised after a collective decision: its ranks arrive within milliseconds)
+# how long a failing rank waits for the others (a collective error is raised after a
+# collective decision: its ranks arrive within milliseconds); FENICS_NL_FAILURE_WAIT_S sets it
+FAILURE_WAIT_S = float(os.environ.get("FENICS_NL_FAILURE_WAIT_S", 5.0))
 
 
 def _every_rank_failed(run: _Run, seconds: float = FAILURE_WAIT_S) -> bool:
