@@ -59,3 +59,49 @@ def test_damage_bar_two_ranks_give_the_serial_answer(demo):
         assert b["dissipated_energy"] == pytest.approx(a["dissipated_energy"], rel=1e-8)
         assert b["steps"] == a["steps"]
     assert p["stress_history"] == pytest.approx(s["stress_history"], rel=1e-10)
+
+
+@pytest.mark.parametrize("model", ["at1", "at2"])
+def test_gradient_damage_homogeneous_bar_is_its_closed_form(model):
+    homogeneous_gradient_damage_bar(model)
+
+
+@pytest.mark.mpi
+def test_gradient_damage_homogeneous_bar_on_two_ranks():
+    homogeneous_gradient_damage_bar("at1")  # the same closed form, the bar cut in two
+
+
+def homogeneous_gradient_damage_bar(model):
+    # the uniform bar (plane strain at ν = 0, one cell high: uniaxial stress, ∇α = 0) pulled
+    # in 10 steps to 2 ε_c (AT2: to 2 × the peak's strain) by alternate minimization with
+    # the bound αⁿ ≤ α ≤ 1: σ and α against the closed form of the same energy, to 1e-9
+    # (measured 2e-12 for AT1); AT1 elastic up to σ_c = √(3 Gc E / (8 ell)) (1 + k) exactly
+    import numpy as np
+    import ufl
+    from dolfinx import fem
+
+    from fenics_nl.domain import boundary
+    from fenics_nl.materials.damage import CourseDamage
+    from fenics_nl.materials.gradient_damage import GradientDamage
+    from fenics_nl.scenes.damage_bar import DamageBar
+    from fenics_nl.solvers.alternate import AlternateMinimization
+
+    law = GradientDamage(1.0, 0.0, Gc=1.0, ell=0.1, model=model, residual_stiffness=1e-6)
+    bar = DamageBar(CourseDamage(1.0, 0.0, w_c=1.0), 1.0, 10)  # its mesh and supports
+    alpha = fem.Function(fem.functionspace(bar.mesh, ("Lagrange", 1)))
+    energy = law.energy(bar.u, alpha, bar.MODEL) * ufl.dx
+    solver = AlternateMinimization(energy, bar.u, alpha, force_scale=law.critical_stress * 0.1)
+    peak = law.critical_strain if model == "at1" else math.sqrt(law.Gc / law.ell / 3)
+    assert law.critical_stress == pytest.approx(
+        law.homogeneous_stress(peak), rel=1e-14)
+    if model == "at1":
+        assert law.critical_stress == pytest.approx(
+            (1 + 1e-6) * math.sqrt(3 * 1.0 * 1.0 / (8 * 0.1)), rel=1e-14)
+    for strain in np.linspace(0, 2 * peak, 11)[1:]:
+        solver.solve(bar.stretch_supports(strain))
+        solver.commit()
+        held = boundary.reactions(solver.residual_u, bar.u, {"right": bar.right},
+                                  {"right": [0]}, space=bar.V)["right"][0]
+        sigma = held / bar.cross_section
+        assert sigma == pytest.approx(law.homogeneous_stress(strain), rel=1e-9)
+        assert alpha.x.array == pytest.approx(law.homogeneous_damage(strain), abs=1e-9)

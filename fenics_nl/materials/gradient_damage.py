@@ -1,0 +1,103 @@
+"""Gradient damage (the variational models AT1 and AT2): an energy of (u, α) with a length ell.
+
+    E(u, α) = ∫ a(α) ψ0(ε(u)) + (Gc / c_w) (w(α)/ell + ell |∇α|²) dx,    a(α) = (1 − α)² + k,
+
+AT1: w(α) = α, c_w = 8/3 (an elastic phase up to σ_c = √(3 Gc E / (8 ell)));
+AT2: w(α) = α², c_w = 2 (damage from the first strain). ψ0 is Hooke's energy (E, ν) and k a
+residual stiffness. Irreversibility is a bound, αⁿ ≤ α ≤ 1, on the damage problem
+(`solvers.alternate`); the energy's derivatives in u and α, and their tangents, are UFL's.
+
+The uniaxial homogeneous state (ν = 0, ∇α = 0) has a closed form from the same energy:
+stationarity in α gives (1 − α) E ε² = (Gc/c_w) w'(α)/ell, so
+
+    AT1: 1 − α = ε_c²/ε² past ε_c = √(3 Gc/(8 ell E)),    AT2: α = E ε² / (E ε² + Gc/ell),
+
+and σ = a(α) E ε (`homogeneous_stress`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import ufl
+
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import Isotropic, LinearElastic, check_range
+
+__all__ = ["GradientDamage"]
+
+MODELS = {"at1": 8.0 / 3.0, "at2": 2.0}  # c_w
+
+
+@dataclass(frozen=True)
+class GradientDamage(Isotropic):
+    """AT1 or AT2 gradient damage on Hooke's law (E, ν): toughness Gc, length ell."""
+
+    Gc: float = 1.0
+    ell: float = 1.0
+    model: str = "at1"
+    residual_stiffness: float = 0.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        check_range("Gc", self.Gc, 0.0, math.inf)
+        check_range("ell", self.ell, 0.0, math.inf)
+        if self.model not in MODELS:
+            raise ValueError(f"model must be at1 or at2, got {self.model!r}")
+        if not 0 <= self.residual_stiffness < 1:
+            raise ValueError(f"residual stiffness must be in [0, 1), got "
+                             f"{self.residual_stiffness!r}")
+
+    @property
+    def c_w(self) -> float:
+        """The normalisation of w: ∫ √w over the optimal profile, times 4."""
+        return MODELS[self.model]
+
+    def w(self, alpha):
+        """The local dissipation: α (AT1) or α² (AT2)."""
+        return alpha if self.model == "at1" else alpha**2
+
+    def stiffness(self, alpha):
+        """a(α) = (1 − α)² + k."""
+        return (1 - alpha) ** 2 + self.residual_stiffness
+
+    def energy(self, u, alpha, model: str = "3d"):
+        """The energy density of (u, α) (times 2πr in the axisymmetric model)."""
+        eps = kinematics.small_strain(u, model)
+        psi0 = LinearElastic(self.E, self.nu).energy(eps)
+        fracture = self.Gc / self.c_w * (self.w(alpha) / self.ell
+                                         + self.ell * ufl.inner(ufl.grad(alpha),
+                                                                ufl.grad(alpha)))
+        weight = kinematics.measure_weight(kinematics.domain(u), model)
+        return (self.stiffness(alpha) * psi0 + fracture) * weight
+
+    @property
+    def critical_strain(self) -> float:
+        """AT1: ε_c = √(3 Gc / (8 ell E)), the end of the elastic phase (AT2 has none: 0)."""
+        if self.model == "at2":
+            return 0.0
+        return math.sqrt(self.Gc / (self.c_w * self.ell * self.E))
+
+    @property
+    def critical_stress(self) -> float:
+        """The peak of the homogeneous uniaxial response (AT1: a(0) E ε_c; AT2: its maximum)."""
+        if self.model == "at1":
+            return self.homogeneous_stress(self.critical_strain)
+        # AT2: σ(ε) = E ε (g/(E ε² + g))², g = Gc/ell, is largest at E ε² = g/3
+        g = self.Gc / self.ell
+        eps = math.sqrt(g / (3 * self.E))
+        return self.homogeneous_stress(eps)
+
+    def homogeneous_damage(self, strain: float) -> float:
+        """α of the homogeneous uniaxial state at `strain` (ν = 0), loading monotonically."""
+        E, g = self.E, self.Gc / self.ell
+        if self.model == "at1":
+            ec = self.critical_strain
+            return 0.0 if abs(strain) <= ec else 1.0 - ec**2 / strain**2
+        return E * strain**2 / (E * strain**2 + g)
+
+    def homogeneous_stress(self, strain: float) -> float:
+        """σ = a(α) E ε of the homogeneous uniaxial state (ν = 0)."""
+        a = self.stiffness(self.homogeneous_damage(strain))
+        return a * self.E * strain
