@@ -102,9 +102,7 @@ cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {bl
 load = PunchLoad(punch, indentation=args.indentation, force=args.force,
                  first_guess=a * a / args.radius)
 report = punch_run.StepReport(load.states, args.steps, args.steps * (2 if unload else 1),
-                              fields=lambda: [
-    block.displacement(), *([block.fields.pressure()] if args.mixed else []),
-    *punch.contact_fields(), punch.von_mises(), *material.output_fields()])
+                              punch.output_fields)
 
 
 def commit():
@@ -113,11 +111,7 @@ def commit():
 
 # --restart: the displacement, the plastic state, the statuses and the states back;
 # --checkpoint: saved after each converged step of the loading
-checkpoints = cli.checkpointing({"unknown": block.unknown, **material.state_functions()},
-                                newton=punch.contact.newton, contact=punch.contact,
-                                kept=load.record)
-if checkpoints.kept is not None:
-    load.take_back(checkpoints.kept)
+checkpoints = punch_run.checkpointing(punch, load, material.state_functions())
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
                     on_step=report, commit=commit, **checkpoints.options)
 # -

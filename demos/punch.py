@@ -114,16 +114,10 @@ punch = Punch(block, material, residual, args.radius, formulation=args.formulati
 cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
 load = PunchLoad(punch, indentation=args.indentation, force=args.force,
                  first_guess=a * a / args.radius)
-report = punch_run.StepReport(load.states, args.steps, args.steps, fields=lambda: [
-    block.displacement(), *([block.fields.pressure()] if args.mixed else []),
-    *punch.contact_fields(), punch.von_mises()])
-
+report = punch_run.StepReport(load.states, args.steps, args.steps, punch.output_fields)
 # --restart: the displacement, the contact statuses and the states back; --checkpoint:
 # saved after each converged step
-checkpoints = cli.checkpointing({"unknown": block.unknown}, newton=punch.contact.newton,
-                                contact=punch.contact, kept=load.record)
-if checkpoints.kept is not None:
-    load.take_back(checkpoints.kept)
+checkpoints = punch_run.checkpointing(punch, load)
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
                     on_step=report, **checkpoints.options)
 # -

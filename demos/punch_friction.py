@@ -133,15 +133,10 @@ cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {bl
 # +
 load = PunchLoad(punch, indentation=args.indentation, force=args.force,
                  first_guess=a * a / args.radius)
-report = punch_run.StepReport(load.states, args.steps, args.steps, fields=lambda: [
-    block.displacement(), *([block.fields.pressure()] if args.mixed else []),
-    *punch.contact_fields(), punch.von_mises()])
+report = punch_run.StepReport(load.states, args.steps, args.steps, punch.output_fields)
 # --restart: the displacement, the statuses and the slip history, the states back;
 # --checkpoint: saved after each converged step of the normal load
-checkpoints = cli.checkpointing({"unknown": block.unknown}, newton=punch.contact.newton,
-                                contact=punch.contact, kept=load.record)
-if checkpoints.kept is not None:
-    load.take_back(checkpoints.kept)
+checkpoints = punch_run.checkpointing(punch, load)
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
                     on_step=report, **checkpoints.options)
 pressed = load.states[-1]

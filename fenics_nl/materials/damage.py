@@ -150,13 +150,12 @@ class CourseDamage(Isotropic, SmallStrain):
         """The largest committed α of each cell's quadrature points (DG0 Function)."""
         from dolfinx import fem
 
+        from fenics_nl.materials.plasticity import per_cell
+
         a = self.alpha
-        msh = a.function_space.mesh
-        cells = fem.Function(fem.functionspace(msh, ("DG", 0)), name="damage")
-        n = msh.topology.index_map(msh.topology.dim).size_local
-        values = a.x.array[a.function_space.dofmap.list[:n]]
-        cells.x.array[:n] = np.max(values, axis=1)
-        cells.x.scatter_forward()
+        cells = fem.Function(fem.functionspace(a.function_space.mesh, ("DG", 0)),
+                             name="damage")
+        per_cell(a, cells, np.max)
         return cells
 
     def state_functions(self) -> dict:

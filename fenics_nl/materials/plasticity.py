@@ -29,7 +29,7 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["J2Plasticity", "PlasticState"]
+__all__ = ["J2Plasticity", "PlasticState", "per_cell"]
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
 
@@ -123,7 +123,7 @@ class J2Plasticity(Isotropic, SmallStrain):
         p = self.cumulated_plastic_strain
         cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
                              name="cumulated_plastic_strain")
-        _per_cell(p, cells, np.max)
+        per_cell(p, cells, np.max)
         return cells
 
     def state_functions(self) -> dict:
@@ -211,7 +211,7 @@ class J2Plasticity(Isotropic, SmallStrain):
         at_points = fem.Function(Q)
         at_points.interpolate(fem.Expression(expression, st.points))
         f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
-        _per_cell(at_points, f, np.mean)
+        per_cell(at_points, f, np.mean)
         return f
 
     def commit(self, u, model: str = "3d") -> None:
@@ -239,7 +239,7 @@ class J2Plasticity(Isotropic, SmallStrain):
         st.p.x.array[:] = b.x.array
 
 
-def _per_cell(at_points, cells, reduce) -> None:
+def per_cell(at_points, cells, reduce) -> None:
     """DG0 `cells` = `reduce` of each owned cell's quadrature values of `at_points`.
 
     Read and written through both dofmaps (no assumption on dof numbering); ghosts updated.

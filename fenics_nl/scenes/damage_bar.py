@@ -80,6 +80,10 @@ class DamageBar:
         Vx, _ = V.sub(0).collapse()
         self.opening_dofs = fem.locate_dofs_geometrical(
             (V.sub(0), Vx), lambda x: np.isclose(x[0], h))[0]
+        # u_x at the right end: this rank's owned dofs there (read at every step)
+        n = V.dofmap.index_map.size_local
+        self._end_dofs = 2 * np.flatnonzero(np.isclose(V.tabulate_dof_coordinates()[:n, 0],
+                                                       length))
 
     @property
     def dofs(self) -> int:
@@ -101,11 +105,7 @@ class DamageBar:
 
     def end_displacement(self) -> float:
         """u_x at the right end."""
-        x = self.V.tabulate_dof_coordinates()
-        n = self.V.dofmap.index_map.size_local
-        ux = self.u.x.array.reshape(-1, 2)[:n, 0]
-        at_end = np.isclose(x[:n, 0], self.L)
-        return global_max(self.mesh.comm, ux[at_end])
+        return global_max(self.mesh.comm, self.u.x.array[self._end_dofs])
 
     def reaction_stress(self) -> float:
         """σ from the right end's reaction under displacement control."""

@@ -436,6 +436,17 @@ class Punch:
         """Nodal contact pressure and active set (1/0) on S_C, to write out."""
         return self.contact.fields(self.block.weight)
 
+    def output_fields(self) -> list[fem.Function]:
+        """What --output writes of a state.
+
+        The displacement (and the pressure if mixed), the contact pressure and active set,
+        σ_eq, and a path-dependent law's state.
+        """
+        b = self.block
+        return [b.displacement(), *([b.fields.pressure()] if b.mixed else []),
+                *self.contact_fields(), self.von_mises(),
+                *(self.material.output_fields() if self.material.path_dependent else [])]
+
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on each constrained group of the modelled part (`boundary`).
 

@@ -21,7 +21,7 @@ from fenics_nl.scenes import punch_pictures
 from fenics_nl.scenes.punch import Punch, PunchBlock
 from fenics_nl.theory import hertz, mindlin
 
-__all__ = ["PunchParameters", "StepReport", "block_for", "compare_with_hertz",
+__all__ = ["PunchParameters", "StepReport", "block_for", "checkpointing", "compare_with_hertz",
            "compare_with_mindlin", "contact_radius_for", "pictures", "prefixes", "summary"]
 
 MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
@@ -233,6 +233,21 @@ def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=No
     if args.png:
         writers.append(lambda: punch_pictures.section_picture(run, args.png))
     return writers
+
+
+def checkpointing(punch: Punch, load, state: dict | None = None) -> cli.Checkpointing:
+    """--checkpoint / --restart of a punch's loading (`cli.checkpointing`).
+
+    Saved after each converged step: the unknown, the law's `state` functions, the contact
+    statuses (with friction its slip history) and the load's states; with --restart they
+    are put back now, the states into `load`.
+    """
+    checkpoints = cli.checkpointing({"unknown": punch.block.unknown, **(state or {})},
+                                    newton=punch.contact.newton, contact=punch.contact,
+                                    kept=load.record)
+    if checkpoints.kept is not None:
+        load.take_back(checkpoints.kept)
+    return checkpoints
 
 
 def block_for(args: PunchParameters, *, tangential: bool = False) -> PunchBlock:

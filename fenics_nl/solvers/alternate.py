@@ -73,10 +73,11 @@ class AlternateMinimization:
         """One load step from the current (u, α), with the Dirichlet conditions `bcs`."""
         bcs = self.bcs if bcs is None else list(bcs)
         snes = self.damage_problem.solver
+        displacement = NewtonSolver(self.residual_u, self.u, bcs, rtol=1e-12, atol=1e-14,
+                                    force_scale=self.force_scale)
         newton_its = damage_its = 0
         for k in range(1, self.max_it + 1):
-            newton_its += NewtonSolver(self.residual_u, self.u, bcs, rtol=1e-12, atol=1e-14,
-                                       force_scale=self.force_scale).solve().iterations
+            newton_its += displacement.solve().iterations
             before = self.alpha.x.array.copy()
             snes.setVariableBounds(self.lower.x.petsc_vec, self._upper)
             self.damage_problem.solve()
