@@ -105,3 +105,99 @@ def homogeneous_gradient_damage_bar(model):
         sigma = held / bar.cross_section
         assert sigma == pytest.approx(law.homogeneous_stress(strain), rel=1e-9)
         assert alpha.x.array == pytest.approx(law.homogeneous_damage(strain), abs=1e-9)
+
+
+def _gradient_law(model, ell):
+    from fenics_nl.materials.gradient_damage import GradientDamage
+
+    return GradientDamage(1.0, 0.0, Gc=1.0, ell=ell, model=model, residual_stiffness=1e-6)
+
+
+def _peak_strain(law):
+    return law.critical_strain or math.sqrt(law.Gc / law.ell / (3 * law.E))
+
+
+def crack_in_a_held_bar(comm):
+    # AT1, ell = L/10, h = ell/5 and ell/10 (odd cells: a band of one cell at α = 1 in the
+    # middle), pulled to twice the peak's strain
+    import numpy as np
+
+    from fenics_nl.scenes.gradient_damage_bar import crack
+
+    law = _gradient_law("at1", 0.1)
+    strains = _peak_strain(law) * np.array([0.99, 1.1, 1.25, 1.5, 2.0])
+    return [crack(law, 1.0, cells, strains, comm=comm) for cells in (49, 101)]
+
+
+def test_a_crack_in_a_bar_dissipates_gc_and_one_band():
+    # Gc (1 + h/(c_w ell)) per unit section: measured -0.19 % and -0.12 % (the band's nodes
+    # at α = 0.998, 0.999: the last load's residual stress); the issue asks 1 % at h <= ell/5.
+    # The profile on each side is (1 - d/(2 ell))²: measured within 2.2e-3 and 1.0e-3, the
+    # band's shortfall from 1 (0.01 allows twice the P1 interpolation error at h = ell/5)
+    from mpi4py import MPI
+
+    for c in crack_in_a_held_bar(MPI.COMM_WORLD):
+        assert abs(c["dissipated_energy_rel_error"]) < 0.01, c["h_over_ell"]
+        assert c["band_width"] == pytest.approx(c["h"], rel=1e-9)
+        assert c["profile_max_error"] < 0.01
+        assert c["largest_damage"] > 0.99
+
+
+@pytest.mark.parametrize("model", ["at1", "at2"])
+def test_the_homogeneous_bar_bifurcates_where_its_second_variation_says(model):
+    # L = 2 ell: the homogeneous bar is stable past its peak; its second variation on the
+    # damage's inactive set turns negative at 3 E ε_b² = (Gc/c_w)(w''/ell + 2 ell π²/L²)
+    # (AT1: 1.2825 ε_c; AT2: 1.8621 × its peak strain). Measured on 40 cells: +0.06 %, +0.05 %
+    # (the P1 cosine mode's gradient energy); the bar then leaves its branch along the
+    # critical mode and breaks at an end
+    bar, record = _pulled_short_bar(model, "none")
+    law = bar.law
+    assert record.bifurcation_strain == pytest.approx(law.bifurcation_strain(1.0), rel=5e-3)
+    stable = record.bifurcation_step
+    for strain, stress in zip(record.strain[:stable], record.stress[:stable], strict=True):
+        assert stress == pytest.approx(law.homogeneous_stress(strain), rel=1e-6)
+    assert record.largest_damage[-1] > 0.99
+    assert record.stress[-1] < 0.1 * law.homogeneous_stress(record.strain[-1])
+
+
+def _pulled_short_bar(model, acceleration, comm=None):
+    import numpy as np
+    from mpi4py import MPI
+
+    from fenics_nl.scenes.gradient_damage_bar import GradientDamageBar, pull
+
+    law = _gradient_law(model, 0.5)
+    bar = GradientDamageBar(law, 1.0, 40, acceleration=acceleration,
+                            comm=comm or MPI.COMM_WORLD)
+    record = pull(bar, _peak_strain(law) * np.linspace(0, 2, 21)[1:])
+    return bar, record
+
+
+def test_accelerated_alternate_minimization_finds_the_plain_answer():
+    # the short AT1 bar through its bifurcation and its crack: over-relaxed and Anderson
+    # iterations end where the plain one does (stress to 1e-5, measured 1.8e-6 past the
+    # crack, where σ is (1 - α)² E ε and the stop is |Δα| < 1e-8; dissipated energy to 1e-6):
+    # their energy safeguard keeps them off the unstable homogeneous
+    # state, where an unguarded Anderson iteration converged (stress 0.108 instead of 0.0033)
+    plain_bar, plain = _pulled_short_bar("at1", "none")
+    for name in ("overrelaxed", "anderson"):
+        bar, record = _pulled_short_bar("at1", name)
+        assert record.bifurcation_strain == pytest.approx(plain.bifurcation_strain, rel=1e-9)
+        assert record.stress == pytest.approx(plain.stress, rel=1e-5)
+        assert bar.dissipated_energy() == pytest.approx(plain_bar.dissipated_energy(),
+                                                        rel=1e-6)
+
+
+@pytest.mark.mpi
+def test_gradient_damage_crack_and_bifurcation_on_two_ranks():
+    # the bar cut in two against the same bar on one rank (each rank computes it alone)
+    from mpi4py import MPI
+
+    for cut, whole in zip(crack_in_a_held_bar(MPI.COMM_WORLD),
+                          crack_in_a_held_bar(MPI.COMM_SELF), strict=True):
+        assert cut["dissipated_energy"] == pytest.approx(whole["dissipated_energy"], rel=1e-7)
+        assert cut["profile"]["damage"] == pytest.approx(whole["profile"]["damage"], abs=1e-7)
+    _, cut = _pulled_short_bar("at1", "anderson")
+    _, whole = _pulled_short_bar("at1", "anderson", MPI.COMM_SELF)
+    assert cut.bifurcation_strain == pytest.approx(whole.bifurcation_strain, rel=1e-9)
+    assert cut.stress == pytest.approx(whole.stress, rel=1e-5)

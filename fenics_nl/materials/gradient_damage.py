@@ -62,15 +62,20 @@ class GradientDamage(Isotropic):
         """a(α) = (1 − α)² + k."""
         return (1 - alpha) ** 2 + self.residual_stiffness
 
+    def fracture_energy(self, alpha):
+        """The dissipated energy density (Gc/c_w)(w(α)/ell + ell |∇α|²).
+
+        Over the optimal profile of a crack it integrates to Gc per unit crack area.
+        """
+        return self.Gc / self.c_w * (self.w(alpha) / self.ell
+                                     + self.ell * ufl.inner(ufl.grad(alpha), ufl.grad(alpha)))
+
     def energy(self, u, alpha, model: str = "3d"):
         """The energy density of (u, α) (times 2πr in the axisymmetric model)."""
         eps = kinematics.small_strain(u, model)
         psi0 = LinearElastic(self.E, self.nu).energy(eps)
-        fracture = self.Gc / self.c_w * (self.w(alpha) / self.ell
-                                         + self.ell * ufl.inner(ufl.grad(alpha),
-                                                                ufl.grad(alpha)))
         weight = kinematics.measure_weight(kinematics.domain(u), model)
-        return (self.stiffness(alpha) * psi0 + fracture) * weight
+        return (self.stiffness(alpha) * psi0 + self.fracture_energy(alpha)) * weight
 
     @property
     def critical_strain(self) -> float:
@@ -88,6 +93,21 @@ class GradientDamage(Isotropic):
         g = self.Gc / self.ell
         eps = math.sqrt(g / (3 * self.E))
         return self.homogeneous_stress(eps)
+
+    def bifurcation_strain(self, length: float) -> float:
+        """The strain where the homogeneous uniaxial bar of `length` stops being stable.
+
+        The bar: u held at both ends, ∇α·n = 0 there, ν = 0, the residual stiffness k → 0.
+
+        Its second variation on (v, β), v condensed out, is ∫ (½a'' − a'²/a) E ε² β²
+        + (Gc/c_w)(w''/ell β² + 2 ell β'²) for a β of zero mean, and ½a'' − a'²/a = 1 − 4 = −3
+        whatever α: the first mode, cos(πx/L), makes it negative past
+        3 E ε_b² = (Gc/c_w)(w''/ell + 2 ell π²/L²), and not before the damage starts (AT1).
+        """
+        w2 = 0.0 if self.model == "at1" else 2.0
+        eb = math.sqrt(self.Gc / self.c_w * (w2 / self.ell + 2 * self.ell * math.pi**2
+                                             / length**2) / (3 * self.E))
+        return max(eb, self.critical_strain)
 
     def homogeneous_damage(self, strain: float) -> float:
         """α of the homogeneous uniaxial state at `strain` (ν = 0), loading monotonically."""

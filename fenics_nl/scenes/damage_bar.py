@@ -27,10 +27,67 @@ from fenics_nl.domain import boundary
 from fenics_nl.materials import kinematics
 from fenics_nl.parallel import global_max
 
-__all__ = ["DamageBar"]
+__all__ = ["BarStrip", "DamageBar"]
 
 
-class DamageBar:
+class BarStrip:
+    """The bar's geometry: its mesh, displacement, supports and right end (no material).
+
+    Args:
+        length: L.
+        cells: cells along the bar (h = L/cells).
+        height: H, the cross-section per unit thickness (default one cell's length).
+    """
+
+    MODEL = "plane_strain"
+
+    def __init__(self, length: float, cells: int, *, height: float | None = None,
+                 comm: MPI.Comm = MPI.COMM_WORLD):
+        if cells < 2:
+            raise ValueError(f"a bar needs at least 2 cells, got {cells}")
+        self.L, self.cells = length, cells
+        self.h = h = length / cells
+        self.height = H = height or h
+        self.mesh = msh = mesh.create_rectangle(comm, [[0.0, 0.0], [length, H]], [cells, 1],
+                                                mesh.CellType.quadrilateral)
+        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+        self.u = fem.Function(V, name="displacement")
+
+        def edge(where):
+            return mesh.locate_entities_boundary(msh, 1, where)
+
+        self.left = edge(lambda x: np.isclose(x[0], 0.0))
+        self.right = edge(lambda x: np.isclose(x[0], length))
+        self.supports = [boundary.component(V, 0, self.left),
+                         boundary.component(V, 1, edge(lambda x: np.isclose(x[1], 0.0)))]
+        self.cross_section = H  # per unit thickness
+        # u_x at the right end: this rank's owned dofs there (read at every step)
+        n = V.dofmap.index_map.size_local
+        self._end_dofs = 2 * np.flatnonzero(np.isclose(V.tabulate_dof_coordinates()[:n, 0],
+                                                       length))
+
+    @property
+    def dofs(self) -> int:
+        """Global number of displacement unknowns."""
+        im = self.V.dofmap.index_map
+        return im.size_global * self.V.dofmap.index_map_bs
+
+    def stretch_supports(self, strain: float) -> list:
+        """The supports and the right end moved by strain · L (displacement control)."""
+        return [*self.supports, boundary.component(self.V, 0, self.right, strain * self.L)]
+
+    def end_displacement(self) -> float:
+        """u_x at the right end."""
+        return global_max(self.mesh.comm, self.u.x.array[self._end_dofs])
+
+    def reaction_stress(self, internal) -> float:
+        """σ from the right end's reaction to the internal work `internal` (a form in u)."""
+        held = boundary.reactions(internal, self.u, {"right": self.right},
+                                  {"right": [0]}, space=self.V)["right"][0]
+        return held / self.cross_section
+
+
+class DamageBar(BarStrip):
     """The bar, its damage material bound to it, its supports and its two ways of loading.
 
     Args:
@@ -41,21 +98,13 @@ class DamageBar:
         height: H, the cross-section per unit thickness (default one cell's length).
     """
 
-    MODEL = "plane_strain"
-
     def __init__(self, material, length: float, cells: int, *, weak: float = 1.0,
                  height: float | None = None, comm: MPI.Comm = MPI.COMM_WORLD):
-        if cells < 2:
-            raise ValueError(f"a bar needs at least 2 cells, got {cells}")
         if material.nu != 0:
             raise ValueError("the bar is the course's 1D bar: ν = 0 (uniaxial stress)")
-        self.material, self.L, self.cells = material, length, cells
-        self.h = h = length / cells
-        self.height = H = height or h
-        self.mesh = msh = mesh.create_rectangle(comm, [[0.0, 0.0], [length, H]], [cells, 1],
-                                                mesh.CellType.quadrilateral)
-        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
-        self.u = fem.Function(V, name="displacement")
+        super().__init__(length, cells, height=height, comm=comm)
+        self.material = material
+        msh, V, h = self.mesh, self.V, self.h
         material.bind(msh, 2)
         self.dx = kinematics.quadrature_measure("dx", msh, 2)
         if weak != 1.0:
@@ -63,14 +112,6 @@ class DamageBar:
             material.weaken(first, weak)
         self.weak = weak
         self.sigma_ref = math.sqrt(material.E * material.w_c * weak)
-
-        def edge(where):
-            return mesh.locate_entities_boundary(msh, 1, where)
-
-        self.right = edge(lambda x: np.isclose(x[0], length))
-        self.supports = [boundary.component(V, 0, edge(lambda x: np.isclose(x[0], 0.0))),
-                         boundary.component(V, 1, edge(lambda x: np.isclose(x[1], 0.0)))]
-        self.cross_section = H  # per unit thickness
         tags = mesh.meshtags(msh, 1, self.right, np.ones(len(self.right), dtype=np.int32))
         ds = ufl.Measure("ds", msh, subdomain_data=tags)
         self.load_factor = fem.Constant(msh, 0.0)
@@ -80,20 +121,6 @@ class DamageBar:
         Vx, _ = V.sub(0).collapse()
         self.opening_dofs = fem.locate_dofs_geometrical(
             (V.sub(0), Vx), lambda x: np.isclose(x[0], h))[0]
-        # u_x at the right end: this rank's owned dofs there (read at every step)
-        n = V.dofmap.index_map.size_local
-        self._end_dofs = 2 * np.flatnonzero(np.isclose(V.tabulate_dof_coordinates()[:n, 0],
-                                                       length))
-
-    @property
-    def dofs(self) -> int:
-        """Global number of unknowns."""
-        im = self.V.dofmap.index_map
-        return im.size_global * self.V.dofmap.index_map_bs
-
-    def stretch_supports(self, strain: float) -> list:
-        """The supports and the right end moved by strain · L (displacement control)."""
-        return [*self.supports, boundary.component(self.V, 0, self.right, strain * self.L)]
 
     def set_load(self, lam: float) -> None:
         """The right end's traction λ σ_ref (force control, for arc-length)."""
@@ -103,15 +130,9 @@ class DamageBar:
         """The converged state's damage becomes the committed one."""
         self.material.commit(self.u, self.MODEL)
 
-    def end_displacement(self) -> float:
-        """u_x at the right end."""
-        return global_max(self.mesh.comm, self.u.x.array[self._end_dofs])
-
     def reaction_stress(self) -> float:
         """σ from the right end's reaction under displacement control."""
-        held = boundary.reactions(self.internal, self.u, {"right": self.right},
-                                  {"right": [0]}, space=self.V)["right"][0]
-        return held / self.cross_section
+        return super().reaction_stress(self.internal)
 
     def stored_energy(self) -> float:
         """The elastic energy of the committed state: ∫ (1 − α) W0 / 2."""

@@ -10,6 +10,7 @@ leaves it as it was.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -18,8 +19,10 @@ import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from fenics_nl.errors import SolveError
+from fenics_nl.solvers.acceleration import accelerator
 from fenics_nl.solvers.newton import NewtonSolver
 
 __all__ = ["AlternateMinimization", "AlternateResult"]
@@ -33,6 +36,7 @@ class AlternateResult:
     newton_iterations: int
     damage_iterations: int
     change: float  # the last iteration's max |Δα|
+    rejected: int = 0  # accelerated iterates that did not lower the energy
 
 
 class AlternateMinimization:
@@ -42,54 +46,119 @@ class AlternateMinimization:
         energy: ∫ e(u, α) dx.
         u, alpha: the unknowns (their values start each step).
         bcs: Dirichlet conditions of u (set anew for each step through `solve(bcs)`).
+        damage_bcs: Dirichlet conditions of α (e.g. α = 0 where a bar is gripped).
         force_scale: the force scale of the u-problem's absolute tolerance.
+        damage_scale: that of the α-problem (its residual, E's derivative in α: Gc/ell
+            times a cell's measure is a nodal value of it).
         tol: stop when max |Δα| < tol.
         max_it: alternate iterations before SolveError.
         prefix: PETSc options prefix of the damage problem's SNES (``{prefix}snes_view``).
+        acceleration: ``none`` (the plain alternate iteration), ``overrelaxed`` (α moved
+            `omega` times its update) or ``anderson`` (`depth` past iterates combined): see
+            `solvers.acceleration`. The accelerated damage is put back within the bounds
+            before the next u-solve; the stop is on the plain iteration's change.
     """
 
     def __init__(self, energy: ufl.Form, u: fem.Function, alpha: fem.Function,
-                 bcs: Sequence[fem.DirichletBC] = (), *, force_scale: float = 1.0,
-                 tol: float = 1e-8, max_it: int = 500, prefix: str = "damage_"):
+                 bcs: Sequence[fem.DirichletBC] = (), *,
+                 damage_bcs: Sequence[fem.DirichletBC] = (), force_scale: float = 1.0,
+                 damage_scale: float = 1.0,
+                 tol: float = 1e-8, max_it: int = 500, prefix: str = "damage_",
+                 acceleration: str = "none", omega: float = 1.5, depth: int = 5):
         self.u, self.alpha, self.bcs = u, alpha, list(bcs)
+        A = alpha.function_space
+        self.accelerate = accelerator(acceleration, A.mesh.comm, A.dofmap.index_map.size_local,
+                                      omega=omega, depth=depth)
         self.force_scale, self.tol, self.max_it = force_scale, tol, max_it
         self.residual_u = ufl.derivative(energy, u, ufl.TestFunction(u.function_space))
+        self._energy_form = fem.form(energy)
         residual_a = ufl.derivative(energy, alpha, ufl.TestFunction(alpha.function_space))
-        opts = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-12, "snes_atol": 1e-14,
-                "snes_stol": 0.0, "snes_max_it": 50, "ksp_type": "preonly", "pc_type": "lu",
-                "pc_factor_mat_solver_type": "mumps"}
+        # E is quadratic in α (a and w are): one full Newton step solves it on an active set
+        opts = {"snes_type": "vinewtonrsls", "snes_linesearch_type": "basic",
+                "snes_rtol": 1e-12, "snes_stol": 0.0, "snes_max_it": 50,
+                "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
         self.damage_problem = petsc.NonlinearProblem(
-            residual_a, alpha, bcs=[], petsc_options_prefix=prefix, petsc_options=opts)
+            residual_a, alpha, bcs=list(damage_bcs), petsc_options_prefix=prefix,
+            petsc_options=opts)
+        self.damage_scale = damage_scale
+        # the α-residual's round-off grows with the elastic energy that drives damage: its
+        # scale at a step is that of ∂E/∂α at α = 0 (−a'(0) ψ0 + the local dissipation)
+        undamaged = fem.Function(alpha.function_space)
+        self._driving = fem.form(ufl.replace(residual_a, {alpha: undamaged}))
         self.lower = fem.Function(alpha.function_space, name="committed_damage")
         self.lower.x.array[:] = alpha.x.array
         self._upper = self.damage_problem.x.duplicate()
         self._upper.set(1.0)
+
+    def _damage_atol(self) -> float:
+        """The damage problem's absolute tolerance.
+
+        1e-11 of the larger of `damage_scale` and the driving force's norm (its round-off is
+        1e-16 of it).
+        """
+        driving = petsc.assemble_vector(self._driving)
+        driving.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        norm = driving.norm()
+        driving.destroy()
+        return 1e-11 * max(self.damage_scale, norm)
 
     def commit(self) -> None:
         """The current damage becomes the lower bound of the next steps (irreversibility)."""
         self.lower.x.array[:] = self.alpha.x.array
 
     def solve(self, bcs: Sequence[fem.DirichletBC] | None = None) -> AlternateResult:
-        """One load step from the current (u, α), with the Dirichlet conditions `bcs`."""
+        """One load step from the current (u, α), with the Dirichlet conditions `bcs`.
+
+        With an acceleration, the accelerated damage is kept only if, after its u-solve, the
+        energy is below that of the plain iterate (u_k, G(α_k)), which the plain next step
+        would lower further: the energy falls at every iteration, as in the plain scheme, so
+        that the iteration cannot be drawn to an unstable stationary state (a fixed point
+        that is not a minimum: the homogeneous bar past its bifurcation). Otherwise the plain
+        iterate is restored and the history forgotten.
+        """
         bcs = self.bcs if bcs is None else list(bcs)
         snes = self.damage_problem.solver
-        displacement = NewtonSolver(self.residual_u, self.u, bcs, rtol=1e-12, atol=1e-14,
+        displacement = NewtonSolver(self.residual_u, self.u, bcs, rtol=1e-12, atol=1e-10,
                                     force_scale=self.force_scale)
-        newton_its = damage_its = 0
+        counts = AlternateResult(0, 0, 0, math.inf)
+        if self.accelerate is not None:
+            self.accelerate.reset()
+        plain = None  # (G(α_k), E(u_k, G(α_k))) while an accelerated α is on trial
         for k in range(1, self.max_it + 1):
-            newton_its += displacement.solve().iterations
+            counts.iterations = k
+            counts.newton_iterations += displacement.solve().iterations
+            if plain is not None and self._energy() > plain[1]:
+                self.alpha.x.array[:] = plain[0]  # rejected: back to the plain iterate
+                self.accelerate.reset()
+                counts.rejected += 1
+                counts.newton_iterations += displacement.solve().iterations
+            if k == 1:  # once per step: the driving force of its first u
+                snes.setTolerances(atol=self._damage_atol())
             before = self.alpha.x.array.copy()
-            snes.setVariableBounds(self.lower.x.petsc_vec, self._upper)
-            self.damage_problem.solve()
-            if snes.getConvergedReason() <= 0:
-                raise SolveError(f"the damage problem did not converge (SNES reason "
-                                 f"{snes.getConvergedReason()}) at alternate iteration {k}")
-            damage_its += snes.getIterationNumber()
-            change = self.alpha.function_space.mesh.comm.allreduce(
-                float(np.abs(self.alpha.x.array - before).max(initial=0.0)),
-                op=MPI.MAX)
-            if change < self.tol:
-                return AlternateResult(k, newton_its, damage_its, change)
+            counts.damage_iterations += self._minimize_damage(k)
+            counts.change = self.alpha.function_space.mesh.comm.allreduce(
+                float(np.abs(self.alpha.x.array - before).max(initial=0.0)), op=MPI.MAX)
+            if counts.change < self.tol:
+                return counts
+            if self.accelerate is not None:
+                plain = (self.alpha.x.array.copy(), self._energy())
+                moved = self.accelerate(before, self.alpha.x.array)
+                # α's Dirichlet values stay: they are the same in `before` and in G(before)
+                self.alpha.x.array[:] = np.clip(moved, self.lower.x.array, 1.0)
         raise SolveError(f"alternate minimization did not converge in {self.max_it} "
-                         f"iterations (last max |Δα| = {change:.3g})")
+                         f"iterations (last max |Δα| = {counts.change:.3g})")
 
+    def _minimize_damage(self, k: int) -> int:
+        """α at fixed u within the bounds (SNES VI): its iterations."""
+        snes = self.damage_problem.solver
+        snes.setVariableBounds(self.lower.x.petsc_vec, self._upper)
+        self.damage_problem.solve()
+        if snes.getConvergedReason() <= 0:
+            raise SolveError(f"the damage problem did not converge (SNES reason "
+                             f"{snes.getConvergedReason()}) at alternate iteration {k}")
+        return snes.getIterationNumber()
+
+    def _energy(self) -> float:
+        """E(u, α) as they are."""
+        comm = self.alpha.function_space.mesh.comm
+        return comm.allreduce(fem.assemble_scalar(self._energy_form), op=MPI.SUM)

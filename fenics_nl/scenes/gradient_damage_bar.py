@@ -1,0 +1,199 @@
+"""A bar in tension with gradient damage (AT1, AT2): homogeneous, unstable, cracked.
+
+The bar is `damage_bar.BarStrip` (plane strain at ν = 0, one cell high: the uniaxial bar),
+with a P1 damage field α and the energy of `GradientDamage`, minimized by
+`AlternateMinimization` under αⁿ ≤ α ≤ 1 at each prescribed end displacement.
+
+* Free ends (`held_ends=False`): ∇α·n = 0 at both ends, the natural condition, so that a
+  uniform bar has a homogeneous solution (the closed form) until it stops being stable
+  (`stability`: the second variation on the damage's inactive set).
+* Held ends (`held_ends=True`): α = 0 at both ends (the bar is gripped there, undamaged), so
+  that the damage starts in the middle and a crack forms there, with its full profile on
+  both sides.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.parallel import global_max
+from fenics_nl.scenes.damage_bar import BarStrip
+from fenics_nl.solvers.alternate import AlternateMinimization, AlternateResult
+from fenics_nl.solvers.damage_stability import DamageStability
+
+__all__ = ["GradientDamageBar", "PullRecord", "pull"]
+
+
+class GradientDamageBar(BarStrip):
+    """The bar of a `GradientDamage` law, its damage, its solver and its stability check."""
+
+    def __init__(self, law, length: float, cells: int, *, height: float | None = None,
+                 held_ends: bool = False, acceleration: str = "none",
+                 comm: MPI.Comm = MPI.COMM_WORLD):
+        if law.nu != 0:
+            raise ValueError("the bar is the course's 1D bar: ν = 0 (uniaxial stress)")
+        super().__init__(length, cells, height=height, comm=comm)
+        self.law = law
+        self.A = A = fem.functionspace(self.mesh, ("Lagrange", 1))
+        self.alpha = fem.Function(A, name="damage")
+        self.energy = law.energy(self.u, self.alpha, self.MODEL) * ufl.dx
+        self.damage_bcs = []
+        if held_ends:
+            ends = fem.locate_dofs_topological(A, 1, np.concatenate([self.left, self.right]))
+            self.damage_bcs = [fem.dirichletbc(0.0, ends, A)]
+        self.solver = AlternateMinimization(
+            self.energy, self.u, self.alpha, damage_bcs=self.damage_bcs,
+            force_scale=law.critical_stress * self.cross_section,
+            damage_scale=law.Gc / law.ell * self.h * self.cross_section,
+            acceleration=acceleration)
+        self._fracture = fem.form(law.fracture_energy(self.alpha) * ufl.dx)
+        self._stability = None
+
+    def stretch(self, strain: float) -> AlternateResult:
+        """Minimize at the mean strain `strain` (the right end at strain · L), not committed."""
+        return self.solver.solve(self.stretch_supports(strain))
+
+    def commit(self) -> None:
+        """The converged damage becomes the lower bound of the next steps."""
+        self.solver.commit()
+
+    def save(self) -> tuple[np.ndarray, np.ndarray]:
+        """(u, α) as they are (to try a strain and come back)."""
+        return self.u.x.array.copy(), self.alpha.x.array.copy()
+
+    def restore(self, state) -> None:
+        """(u, α) as `save` returned them."""
+        self.u.x.array[:], self.alpha.x.array[:] = state
+
+    def stress(self) -> float:
+        """σ from the right end's reaction."""
+        return self.reaction_stress(self.solver.residual_u)
+
+    def dissipated_energy(self) -> float:
+        """∫ (Gc/c_w)(w(α)/ell + ell |∇α|²): the energy spent in damage (per unit thickness)."""
+        return self.mesh.comm.allreduce(fem.assemble_scalar(self._fracture), op=MPI.SUM)
+
+    def largest_damage(self) -> float:
+        """max α over the bar."""
+        return global_max(self.mesh.comm, self.alpha.x.array)
+
+    def damage_profile(self) -> tuple[np.ndarray, np.ndarray]:
+        """(x, α) along the bottom edge, sorted by x, gathered on every rank."""
+        n = self.A.dofmap.index_map.size_local
+        x = self.A.tabulate_dof_coordinates()[:n]
+        bottom = np.isclose(x[:, 1], 0.0)
+        pairs = self.mesh.comm.allgather(np.column_stack([x[bottom, 0],
+                                                          self.alpha.x.array[:n][bottom]]))
+        xa = np.concatenate(pairs)
+        xa = xa[np.argsort(xa[:, 0])]
+        return xa[:, 0], xa[:, 1]
+
+    def stability(self, strain: float) -> tuple[float, fem.Function | None]:
+        """The second variation's smallest eigenvalue on the inactive set, and its mode.
+
+        At the current state, the right end held at `strain`.
+        """
+        if self._stability is None:
+            self._stability = DamageStability(self.energy, self.u, self.alpha,
+                                              self.solver.lower, self.stretch_supports(0.0),
+                                              self.damage_bcs, density=self.law.Gc / self.law.ell)
+        return self._stability.lowest_mode()
+
+    def perturb(self, mode: fem.Function, amplitude: float) -> None:
+        """α + amplitude · mode, kept within αⁿ ≤ α ≤ 1: the start of the next step."""
+        a = self.alpha.x.array
+        a[:] = np.clip(a + amplitude * mode.x.array, self.solver.lower.x.array, 1.0)
+
+
+@dataclass
+class PullRecord:
+    """A bar pulled through a list of strains: every converged step, and its bifurcation."""
+
+    strain: list[float] = field(default_factory=list)
+    stress: list[float] = field(default_factory=list)
+    largest_damage: list[float] = field(default_factory=list)
+    lowest_eigenvalue: list[float] = field(default_factory=list)  # inf: no damage can grow
+    iterations: list[int] = field(default_factory=list)  # alternate iterations per step
+    bifurcation_strain: float | None = None
+    bifurcation_step: int | None = None
+
+
+def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
+         amplitude: float = 0.01, progress=None) -> PullRecord:
+    """Pull `bar` through `strains`, committing each step.
+
+    With `stability`, the second variation's lowest eigenvalue at each step until it turns
+    negative. There the bar leaves
+    its branch along the critical mode (α + `amplitude` · β, max β = 1) and the step is
+    solved again from there; the bifurcation strain is where the eigenvalue crosses 0, by
+    linear interpolation in ε² (exact for the homogeneous bar, whose eigenvalue is affine in
+    ε²), or the step's strain if no damage could grow at the step before.
+    """
+    record = PullRecord()
+    for k, strain in enumerate(strains):
+        result = bar.stretch(strain)
+        if stability and record.bifurcation_step is None:
+            lam, mode = bar.stability(strain)
+            record.lowest_eigenvalue.append(lam)
+            if lam < 0:
+                record.bifurcation_step = k
+                record.bifurcation_strain = _crossing(record, strain, lam)
+                bar.perturb(mode, amplitude)
+                more = bar.stretch(strain)
+                result.iterations += more.iterations
+        bar.commit()
+        record.strain.append(float(strain))
+        record.stress.append(bar.stress())
+        record.largest_damage.append(bar.largest_damage())
+        record.iterations.append(result.iterations)
+        if progress:
+            progress(k, record)
+    return record
+
+
+def _crossing(record: PullRecord, strain: float, lam: float) -> float:
+    """Where λ crossed 0 between the last step and this one (λ affine in ε²)."""
+    if len(record.strain) == 0 or not math.isfinite(record.lowest_eigenvalue[-2]):
+        return float(strain)
+    e0, l0 = record.strain[-1], record.lowest_eigenvalue[-2]
+    return math.sqrt(e0**2 + (strain**2 - e0**2) * l0 / (l0 - lam))
+
+
+def crack(law, length: float, cells: int, strains, *, height: float | None = None,
+          acceleration: str = "none", comm: MPI.Comm = MPI.COMM_WORLD) -> dict:
+    """A crack in the middle of a bar held undamaged at its ends, pulled through `strains`.
+
+    Its dissipated energy is compared with Gc (1 + h/(c_w ell)) per unit cross-section, and
+    its damage profile with the closed form.
+
+    With an odd number of cells the middle of the bar is the middle of a cell, whose two
+    nodes reach α = 1: a band one cell wide, which dissipates (Gc/c_w)(w(1)/ell) h on top of
+    the two half profiles' Gc. The profile on each side, at a distance d from the band,
+    is (1 − d/(2 ell))² (AT1) or exp(−d/ell) (AT2).
+    """
+    bar = GradientDamageBar(law, length, cells, height=height, held_ends=True,
+                            acceleration=acceleration, comm=comm)
+    record = pull(bar, strains, stability=False)
+    x, alpha = bar.damage_profile()
+    band = x[alpha >= alpha.max() - 1e-9 * max(alpha.max(), 1.0)]
+    d = np.min(np.abs(x[:, None] - band[None, :]), axis=1)
+    exact = (np.clip(1 - d / (2 * law.ell), 0, 1) ** 2 if law.model == "at1"
+             else np.exp(-d / law.ell))
+    D = bar.dissipated_energy() / bar.cross_section
+    expected = law.Gc * (1 + bar.h / (law.c_w * law.ell))
+    return {"cells": cells, "h": bar.h, "h_over_ell": bar.h / law.ell,
+            "dissipated_energy": D * bar.cross_section,
+            "dissipated_energy_expected": expected * bar.cross_section,
+            "dissipated_energy_rel_error": D / expected - 1,
+            "largest_damage": bar.largest_damage(), "band_width": float(np.ptp(band)),
+            "profile_max_error": float(np.max(np.abs(alpha - exact))),
+            "profile": {"x": x.tolist(), "damage": alpha.tolist(),
+                        "damage_exact": exact.tolist()},
+            "final_stress": record.stress[-1], "iterations": sum(record.iterations),
+            "steps": len(record.strain), "dofs": bar.dofs + bar.A.dofmap.index_map.size_global}
