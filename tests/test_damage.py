@@ -51,6 +51,46 @@ def test_the_course_damage_law_refuses_what_it_cannot_be():
         1e-2)
 
 
+def test_damage_bar_at1_bifurcates_and_cracks_as_the_closed_forms_say(demo):
+    # the demo's AT1 run: the bar of L = 10 ell is unstable as soon as it damages (the
+    # bifurcation is at eps_c, a step of the grid); a crack in a held bar dissipates
+    # Gc (1 + h/(c_w ell)) per unit section: measured +0.035, -0.008, -0.011 % at h = ell/5.1,
+    # ell/10.1, ell/20.1
+    d = demo.json("damage_bar.py", "--model", "at1")
+    assert d["critical_stress"] == pytest.approx(d["critical_stress_exact"], rel=1e-9)
+    assert d["critical_stress_exact"] == pytest.approx(math.sqrt(3 * 1.0 / (8 * 0.1)),
+                                                       rel=2e-6)  # (1 + k), k = 1e-6
+    assert d["uniform_max_rel_error"] < 1e-9
+    assert d["bifurcation_strain"] == pytest.approx(d["bifurcation_strain_exact"], rel=1e-9)
+    assert d["bifurcation_strain_exact"] == pytest.approx(d["critical_strain"], rel=1e-12)
+    assert d["localized"] and max(d["largest_damage_history"]) > 0.99
+    for t in d["mesh_table"]:
+        assert abs(t["dissipated_energy_rel_error"]) < 0.01 and t["profile_max_error"] < 0.01
+    assert d["warnings"] == []
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--model", "at1", "--ell", "0"], "--ell: must be > 0"),
+    (["--model", "at2", "--Gc", "-1"], "--Gc: must be > 0"),
+    (["--model", "at3"], "--model"),
+])
+def test_gradient_damage_bar_bad_input_is_one_line(demo, args, words):
+    proc = demo.run(["damage_bar.py", *args], check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and words in lines[0], proc.stderr
+
+
+def test_ell_below_two_elements_is_said_with_its_effective_toughness(demo):
+    # ell = 1.5 h: a warning with Gc (1 + h/(c_w ell)) = 1.25, and that is what the crack
+    # dissipates (per unit section, within 1 %): the answer is right, its Gc is not the user's
+    d = demo.json("damage_bar.py", "--model", "at1", "--resolution", "1.5",
+                  "--refinements", "1", "--steps", "6")
+    assert len(d["warnings"]) == 1 and "1.25" in d["warnings"][0]
+    t = d["mesh_table"][0]
+    assert t["dissipated_energy"] / d["cross_section"] == pytest.approx(
+        1 + t["h"] / (8 / 3 * 0.1), rel=0.01)
+
+
 @pytest.mark.spawns_mpi
 def test_damage_bar_two_ranks_give_the_serial_answer(demo):
     s, p = demo.json("damage_bar.py"), demo.json("damage_bar.py", ranks=2)

@@ -90,6 +90,12 @@ class CourseDamage(Isotropic, SmallStrain):
         """σ_c = √(E w_c), the peak of the uniaxial response."""
         return math.sqrt(self.E * self.w_c)
 
+    def homogeneous_stress(self, strain: float) -> float:
+        """σ of the uniaxial bar loaded monotonically (ν = 0): E ε, then w_c/ε past ε_c."""
+        if abs(strain) <= self.critical_strain:
+            return self.E * strain
+        return self.w_c / strain
+
     def bind(self, mesh, degree: int) -> None:
         """Create the state (no damage) at the quadrature points of `degree` on `mesh`."""
         self.state.bind(mesh, degree)

@@ -122,6 +122,7 @@ class PullRecord:
     iterations: list[int] = field(default_factory=list)  # alternate iterations per step
     bifurcation_strain: float | None = None
     bifurcation_step: int | None = None
+    bifurcation_stress: float | None = None  # on the homogeneous branch, before leaving it
 
 
 def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
@@ -144,6 +145,7 @@ def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
             if lam < 0:
                 record.bifurcation_step = k
                 record.bifurcation_strain = _crossing(record, strain, lam)
+                record.bifurcation_stress = bar.stress()
                 bar.perturb(mode, amplitude)
                 more = bar.stretch(strain)
                 result.iterations += more.iterations
