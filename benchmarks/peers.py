@@ -26,7 +26,7 @@ from fenics_nl.solvers.snes import (
     all_event_names,
     petsc_work,
     scale_absolute_tolerance,
-    unless_set,
+    solver_options,
 )
 
 __all__ = ["solve_friction_penalty", "solve_penalty", "solve_snes_vi"]
@@ -49,9 +49,9 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     opts = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_stol": 0.0,
             "snes_max_it": 100, "ksp_type": "preonly", "pc_type": "lu",
             "pc_factor_mat_solver_type": "mumps"}
-    problem = petsc.NonlinearProblem(punch.residual, u, bcs=punch.bcs,
-                                     petsc_options_prefix=prefix,
-                                     petsc_options=unless_set(prefix, opts))
+    with solver_options(prefix, opts) as passed:
+        problem = petsc.NonlinearProblem(punch.residual, u, bcs=punch.bcs,
+                                         petsc_options_prefix=prefix, petsc_options=passed)
     lower, upper = problem.x.duplicate(), problem.x.duplicate()
     lower.set(PETSc.NINFINITY)
     upper.set(PETSc.INFINITY)

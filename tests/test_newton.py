@@ -196,3 +196,17 @@ def test_bfgs_keeps_at_most_its_memory():
                      max_it=200)
     r = s.solve()
     assert r.iterations > 3 and len(s.bfgs.pairs) == 3
+
+
+def test_a_snes_solver_leaves_no_option_behind_for_the_next_one():
+    # dolfinx writes a problem's options into PETSc's global database and deleted them by
+    # their unprefixed names: they stayed, and the next SnesSolver under the same prefix took
+    # them for the user's, so a modified Newton after a full one refactorized every iteration
+    # (a flaky test: the prefixes here are made of id(), which Python reuses)
+    p = cantilever_3d(MATERIAL, cells=CELLS, traction=LOAD)
+    SnesSolver(p.residual, p.u, p.bcs, prefix="reused_", method="full")
+    assert not [k for k in PETSc.Options().getAll() if k.startswith("reused_")]
+    p.u.x.array[:] = 0.0
+    modified = SnesSolver(p.residual, p.u, p.bcs, prefix="reused_", method="modified",
+                          max_it=200).solve()
+    assert modified.converged and modified.work.factorizations == 1

@@ -37,7 +37,7 @@ from fenics_nl.solvers.snes import (
     all_event_names,
     petsc_work,
     scale_absolute_tolerance,
-    unless_set,
+    solver_options,
 )
 
 __all__ = ["MultiplierSystem", "dofs_at"]
@@ -84,9 +84,10 @@ class MultiplierSystem:
                 "snes_linesearch_type": "bt" if line_search else "basic",
                 "snes_stol": 0.0, "snes_max_it": max_it,
                 "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-        self.problem = petsc.NonlinearProblem(
-            [F_u, F_l], [u, self.lam], bcs=list(bcs), kind="mpi", entity_maps=[emap],
-            petsc_options_prefix=prefix, petsc_options=unless_set(prefix, opts))
+        with solver_options(prefix, opts) as passed:
+            self.problem = petsc.NonlinearProblem(
+                [F_u, F_l], [u, self.lam], bcs=list(bcs), kind="mpi", entity_maps=[emap],
+                petsc_options_prefix=prefix, petsc_options=passed)
         self.problem.solver.setConvergenceHistory(reset=True)
         scale_absolute_tolerance(self.problem.solver, atol, force_scale)
         self.counter = EventCounter(all_event_names())

@@ -170,13 +170,14 @@ class Beam:
         t = fem.Constant(self.mesh, np.array([-1.0 / self.h, 0.0]))
         from dolfinx.fem.petsc import LinearProblem
 
-        from fenics_nl.solvers.snes import unless_set
+        from fenics_nl.solvers.snes import solver_options
 
-        LinearProblem(a, ufl.dot(t, f.v) * self.ds_end, u=w0, bcs=self.bcs,
-                      petsc_options_prefix="beam_prestress_",
-                      petsc_options=unless_set("beam_prestress_", {
-                          "ksp_type": "preonly", "pc_type": "lu",
-                          "pc_factor_mat_solver_type": "mumps"})).solve()
+        direct = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+        with solver_options("beam_prestress_", direct) as passed:
+            prestress = LinearProblem(a, ufl.dot(t, f.v) * self.ds_end, u=w0, bcs=self.bcs,
+                                      petsc_options_prefix="beam_prestress_",
+                                      petsc_options=passed)
+        prestress.solve()
         u0, p0 = self._split(w0)
         sigma0 = (mixed.cauchy_stress(lin, u0, p0, self.model) if f.mixed
                   else lin.stress(kinematics.small_strain(u0, self.model)))

@@ -24,6 +24,7 @@ from petsc4py import PETSc
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.acceleration import accelerator
 from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.snes import solver_options
 
 __all__ = ["AlternateMinimization", "AlternateResult"]
 
@@ -77,9 +78,10 @@ class AlternateMinimization:
         opts = {"snes_type": "vinewtonrsls", "snes_linesearch_type": "basic",
                 "snes_rtol": 1e-12, "snes_stol": 0.0, "snes_max_it": 50,
                 "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-        self.damage_problem = petsc.NonlinearProblem(
-            residual_a, alpha, bcs=list(damage_bcs), petsc_options_prefix=prefix,
-            petsc_options=opts)
+        with solver_options(prefix, opts) as passed:
+            self.damage_problem = petsc.NonlinearProblem(
+                residual_a, alpha, bcs=list(damage_bcs), petsc_options_prefix=prefix,
+                petsc_options=passed)
         self.damage_scale = damage_scale
         # the α-residual's round-off grows with the elastic energy that drives damage: its
         # scale at a step is that of ∂E/∂α at α = 0 (−a'(0) ψ0 + the local dissipation)

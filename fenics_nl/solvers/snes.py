@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from contextlib import contextmanager
 
 import ufl
 from dolfinx import fem
@@ -83,6 +84,26 @@ def all_event_names() -> list[str]:
     return out
 
 
+@contextmanager
+def solver_options(prefix: str, options: dict):
+    """The `options` to give a dolfinx problem built under `prefix`, cleaned up after it.
+
+    Yields `unless_set(prefix, options)`. dolfinx writes them into PETSc's global database
+    and means to delete them once its solver has read them, but deletes the unprefixed
+    names: they stay, and a later solver built under the same prefix took them for the
+    user's (`unless_set`) and kept an earlier solver's method (a modified Newton that
+    refactorized at every iteration, after a full one). Here they are deleted by their
+    full names.
+    """
+    passed = unless_set(prefix, options)
+    try:
+        yield passed
+    finally:
+        db = PETSc.Options()
+        for key in passed:
+            db.delValue(prefix + key)
+
+
 def unless_set(prefix: str, options: dict) -> dict:
     """`options` without those the command line set under `prefix`: the user's value wins.
 
@@ -144,9 +165,10 @@ class SnesSolver:
             "pc_factor_mat_solver_type": "mumps",
         }
         J = ufl.derivative(residual, u) if tangent is None else tangent
-        self.problem = petsc.NonlinearProblem(residual, u, bcs=self.bcs, J=J,
-                                              petsc_options_prefix=prefix,
-                                              petsc_options=unless_set(prefix, opts))
+        with solver_options(prefix, opts) as passed:
+            self.problem = petsc.NonlinearProblem(residual, u, bcs=self.bcs, J=J,
+                                                  petsc_options_prefix=prefix,
+                                                  petsc_options=passed)
         if linear_solver == "cholesky":
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
