@@ -111,7 +111,18 @@ def test_gradient_damage_homogeneous_bar_on_two_ranks():
     homogeneous_gradient_damage_bar("at1")  # the same closed form, the bar cut in two
 
 
-def homogeneous_gradient_damage_bar(model):
+@pytest.mark.parametrize("model", ["at1", "at2"])
+def test_the_volumetric_split_spares_compression_as_its_closed_form_says(model):
+    # the bar held laterally (uniaxial strain; at ν = 0 the same state as uniaxial stress
+    # while intact): in compression only the deviatoric energy (2/3 of E ε²/2) is degraded,
+    # so AT1 damages from √(3/2) ε_c and keeps κ = E/3 when broken; in tension the split
+    # changes nothing. Without the lateral hold a broken bar would carry no compression
+    # either: with no shear stiffness left it bulges freely (tr ε = 0)
+    homogeneous_gradient_damage_bar(model, split="volumetric", sign=-1)
+    homogeneous_gradient_damage_bar(model, split="volumetric", sign=1, steps=3)
+
+
+def homogeneous_gradient_damage_bar(model, split="none", sign=1, steps=10):
     # the uniform bar (plane strain at ν = 0, one cell high: uniaxial stress, ∇α = 0) pulled
     # in 10 steps to 2 ε_c (AT2: to 2 × the peak's strain) by alternate minimization with
     # the bound αⁿ ≤ α ≤ 1: σ and α against the closed form of the same energy, to 1e-9
@@ -126,7 +137,8 @@ def homogeneous_gradient_damage_bar(model):
     from fenics_nl.scenes.damage_bar import DamageBar
     from fenics_nl.solvers.alternate import AlternateMinimization
 
-    law = GradientDamage(1.0, 0.0, Gc=1.0, ell=0.1, model=model, residual_stiffness=1e-6)
+    law = GradientDamage(1.0, 0.0, Gc=1.0, ell=0.1, model=model, residual_stiffness=1e-6,
+                         split=split)
     bar = DamageBar(CourseDamage(1.0, 0.0, w_c=1.0), 1.0, 10)  # its mesh and supports
     alpha = fem.Function(fem.functionspace(bar.mesh, ("Lagrange", 1)))
     energy = law.energy(bar.u, alpha, bar.MODEL) * ufl.dx
@@ -137,8 +149,14 @@ def homogeneous_gradient_damage_bar(model):
     if model == "at1":
         assert law.critical_stress == pytest.approx(
             (1 + 1e-6) * math.sqrt(3 * 1.0 * 1.0 / (8 * 0.1)), rel=1e-14)
-    for strain in np.linspace(0, 2 * peak, 11)[1:]:
-        solver.solve(bar.stretch_supports(strain))
+    lateral = []
+    if split != "none":
+        from dolfinx import mesh
+
+        top = mesh.locate_entities_boundary(bar.mesh, 1, lambda x: np.isclose(x[1], bar.height))
+        lateral = [boundary.component(bar.V, 1, top)]
+    for strain in sign * np.linspace(0, 2 * peak, steps + 1)[1:]:
+        solver.solve([*bar.stretch_supports(strain), *lateral])
         solver.commit()
         held = boundary.reactions(solver.residual_u, bar.u, {"right": bar.right},
                                   {"right": [0]}, space=bar.V)["right"][0]

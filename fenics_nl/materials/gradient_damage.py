@@ -4,7 +4,9 @@
 
 AT1: w(α) = α, c_w = 8/3 (an elastic phase up to σ_c = √(3 Gc E / (8 ell)));
 AT2: w(α) = α², c_w = 2 (damage from the first strain). ψ0 is Hooke's energy (E, ν) and k a
-residual stiffness. Irreversibility is a bound, αⁿ ≤ α ≤ 1, on the damage problem
+residual stiffness. With `split="volumetric"` (Amor, Marigo & Maurini 2009) only
+ψ0⁺ = μ dev ε : dev ε + κ/2 ⟨tr ε⟩₊² is degraded and ψ0⁻ = κ/2 ⟨tr ε⟩₋² is not: a crack does
+not open, nor the damage grow, under a volumetric compression. Irreversibility is a bound, αⁿ ≤ α ≤ 1, on the damage problem
 (`solvers.alternate`); the energy's derivatives in u and α, and their tangents, are UFL's.
 
 The uniaxial homogeneous state (ν = 0, ∇α = 0) has a closed form from the same energy:
@@ -12,7 +14,9 @@ stationarity in α gives (1 − α) E ε² = (Gc/c_w) w'(α)/ell, so
 
     AT1: 1 − α = ε_c²/ε² past ε_c = √(3 Gc/(8 ell E)),    AT2: α = E ε² / (E ε² + Gc/ell),
 
-and σ = a(α) E ε (`homogeneous_stress`).
+and σ = a(α) E ε (`homogeneous_stress`). With the volumetric split, in uniaxial compressive
+strain (ν = 0: κ = E/3, μ = E/2) a share c = 2/3 of ψ0 = E ε²/2 is degraded: ε² becomes c ε²
+in the criterion and σ = (c a(α) + 1 − c) E ε.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from fenics_nl.materials.laws import Isotropic, LinearElastic, check_range
 __all__ = ["GradientDamage"]
 
 MODELS = {"at1": 8.0 / 3.0, "at2": 2.0}  # c_w
+SPLITS = ("none", "volumetric")
 
 
 @dataclass(frozen=True)
@@ -38,6 +43,7 @@ class GradientDamage(Isotropic):
     ell: float = 1.0
     model: str = "at1"
     residual_stiffness: float = 0.0
+    split: str = "none"
 
     def __post_init__(self):
         super().__post_init__()
@@ -45,6 +51,8 @@ class GradientDamage(Isotropic):
         check_range("ell", self.ell, 0.0, math.inf)
         if self.model not in MODELS:
             raise ValueError(f"model must be at1 or at2, got {self.model!r}")
+        if self.split not in SPLITS:
+            raise ValueError(f"split must be none or volumetric, got {self.split!r}")
         if not 0 <= self.residual_stiffness < 1:
             raise ValueError(f"residual stiffness must be in [0, 1), got "
                              f"{self.residual_stiffness!r}")
@@ -73,9 +81,18 @@ class GradientDamage(Isotropic):
     def energy(self, u, alpha, model: str = "3d"):
         """The energy density of (u, α) (times 2πr in the axisymmetric model)."""
         eps = kinematics.small_strain(u, model)
-        psi0 = LinearElastic(self.E, self.nu).energy(eps)
         weight = kinematics.measure_weight(kinematics.domain(u), model)
-        return (self.stiffness(alpha) * psi0 + self.fracture_energy(alpha)) * weight
+        return (self.elastic_energy(eps, alpha) + self.fracture_energy(alpha)) * weight
+
+    def elastic_energy(self, eps, alpha):
+        """a(α) ψ0(ε), or a(α) ψ0⁺ + ψ0⁻ with the volumetric split (ε: 3x3 for it)."""
+        hooke = LinearElastic(self.E, self.nu)
+        if self.split == "none":
+            return self.stiffness(alpha) * hooke.energy(eps)
+        deviatoric, trace, kappa = hooke.volumetric_split(eps)
+        opening, closing = ufl.max_value(trace, 0), ufl.min_value(trace, 0)
+        return (self.stiffness(alpha) * (deviatoric + kappa / 2 * opening**2)
+                + kappa / 2 * closing**2)
 
     @property
     def critical_strain(self) -> float:
@@ -109,15 +126,21 @@ class GradientDamage(Isotropic):
                                              / length**2) / (3 * self.E))
         return max(eb, self.critical_strain)
 
+    def degraded_share(self, strain: float) -> float:
+        """c: the share of ψ0 that a(α) multiplies in the uniaxial state (ν = 0)."""
+        return 2.0 / 3.0 if self.split == "volumetric" and strain < 0 else 1.0
+
     def homogeneous_damage(self, strain: float) -> float:
         """α of the homogeneous uniaxial state at `strain` (ν = 0), loading monotonically."""
         E, g = self.E, self.Gc / self.ell
+        e2 = self.degraded_share(strain) * strain**2
         if self.model == "at1":
             ec = self.critical_strain
-            return 0.0 if abs(strain) <= ec else 1.0 - ec**2 / strain**2
-        return E * strain**2 / (E * strain**2 + g)
+            return 0.0 if e2 <= ec**2 else 1.0 - ec**2 / e2
+        return E * e2 / (E * e2 + g)
 
     def homogeneous_stress(self, strain: float) -> float:
-        """σ = a(α) E ε of the homogeneous uniaxial state (ν = 0)."""
+        """σ = (c a(α) + 1 − c) E ε of the homogeneous uniaxial state (ν = 0)."""
         a = self.stiffness(self.homogeneous_damage(strain))
-        return a * self.E * strain
+        c = self.degraded_share(strain)
+        return (c * a + 1 - c) * self.E * strain
