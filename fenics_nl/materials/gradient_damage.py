@@ -6,8 +6,9 @@ AT1: w(α) = α, c_w = 8/3 (an elastic phase up to σ_c = √(3 Gc E / (8 ell)))
 AT2: w(α) = α², c_w = 2 (damage from the first strain). ψ0 is Hooke's energy (E, ν) and k a
 residual stiffness. With `split="volumetric"` (Amor, Marigo & Maurini 2009) only
 ψ0⁺ = μ dev ε : dev ε + κ/2 ⟨tr ε⟩₊² is degraded and ψ0⁻ = κ/2 ⟨tr ε⟩₋² is not: a crack does
-not open, nor the damage grow, under a volumetric compression. Irreversibility is a bound, αⁿ ≤ α ≤ 1, on the damage problem
-(`solvers.alternate`); the energy's derivatives in u and α, and their tangents, are UFL's.
+not open, nor the damage grow, under a volumetric compression. Irreversibility is a bound,
+αⁿ ≤ α ≤ 1, on the damage problem (`solvers.alternate`); the energy's derivatives in u and α,
+and their tangents, are UFL's.
 
 The uniaxial homogeneous state (ν = 0, ∇α = 0) has a closed form from the same energy:
 stationarity in α gives (1 − α) E ε² = (Gc/c_w) w'(α)/ell, so
