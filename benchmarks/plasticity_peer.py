@@ -68,7 +68,7 @@ from fenics_nl.materials import kinematics
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
-from fenics_nl.solvers.snes import EventCounter, all_event_names, petsc_work
+from fenics_nl.solvers.snes import EventCounter, all_event_names, petsc_work, solver_options
 
 HERE = Path(__file__).resolve().parent
 A, B, E, NU, SIGMA0 = 1.0, 1.3, 70e3, 0.3, 250.0
@@ -210,8 +210,9 @@ def peer(vb: VesselBody, snes_type: str = "vinewtonrsls") -> dict:
     options = {"snes_type": snes_type, "snes_linesearch_type": "basic",
                "snes_rtol": TOL, "snes_atol": TOL, "snes_stol": 0.0, "snes_max_it": 50,
                "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-    problem = NonlinearProblem(F_hat, du, J=J_hat, bcs=vb.supports,
-                               petsc_options_prefix="peer_eo_", petsc_options=options)
+    with solver_options("peer_eo_", options) as passed:  # none left behind (see snes.py)
+        problem = NonlinearProblem(F_hat, du, J=J_hat, bcs=vb.supports,
+                                   petsc_options_prefix="peer_eo_", petsc_options=passed)
     problem.solver.setFunction(partial(assemble_residual_with_callback, problem.u, problem.F,
                                        problem.J, vb.supports, update, []), problem.b)
     iterations, path = [], []

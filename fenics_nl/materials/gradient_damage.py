@@ -91,7 +91,10 @@ class GradientDamage(Isotropic):
         if self.split == "none":
             return self.stiffness(alpha) * hooke.energy(eps)
         deviatoric, trace, kappa = hooke.volumetric_split(eps)
-        opening, closing = ufl.max_value(trace, 0), ufl.min_value(trace, 0)
+        # at tr ε = 0 the bulk stiffness goes with the opening part (max_value and min_value
+        # would both give it a zero derivative there: no κ in the tangent at u = 0)
+        opening = ufl.conditional(ufl.ge(trace, 0), trace, 0)
+        closing = ufl.conditional(ufl.lt(trace, 0), trace, 0)
         return (self.stiffness(alpha) * (deviatoric + kappa / 2 * opening**2)
                 + kappa / 2 * closing**2)
 
@@ -128,11 +131,15 @@ class GradientDamage(Isotropic):
         return max(eb, self.critical_strain)
 
     def degraded_share(self, strain: float) -> float:
-        """c: the share of ψ0 that a(α) multiplies in the uniaxial state (ν = 0)."""
+        """c: the share of ψ0 that a(α) multiplies in uniaxial strain (ν = 0)."""
         return 2.0 / 3.0 if self.split == "volumetric" and strain < 0 else 1.0
 
     def homogeneous_damage(self, strain: float) -> float:
-        """α of the homogeneous uniaxial state at `strain` (ν = 0), loading monotonically."""
+        """α of the homogeneous uniaxial state at `strain` (ν = 0), loading monotonically.
+
+        With the volumetric split, in compression: uniaxial strain (laterally held); a free
+        bar in compression bulges once it has lost its shear stiffness.
+        """
         E, g = self.E, self.Gc / self.ell
         e2 = self.degraded_share(strain) * strain**2
         if self.model == "at1":

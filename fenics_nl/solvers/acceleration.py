@@ -71,6 +71,8 @@ class Anderson:
         dF = np.column_stack([d[:n] for d in self._dF])
         normal = self.comm.allreduce(dF.T @ dF, op=MPI.SUM)
         rhs = self.comm.allreduce(dF.T @ f[:n], op=MPI.SUM)
+        if np.trace(normal) == 0:  # the residual did not change: nothing to combine
+            return gx
         # a small Tikhonov term: successive differences become parallel near convergence
         normal += 1e-12 * np.trace(normal) * np.eye(len(rhs))
         gamma = np.linalg.solve(normal, rhs)

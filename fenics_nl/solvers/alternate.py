@@ -83,6 +83,7 @@ class AlternateMinimization:
                 residual_a, alpha, bcs=list(damage_bcs), petsc_options_prefix=prefix,
                 petsc_options=passed)
         self.damage_scale = damage_scale
+        self._user_atol = PETSc.Options().hasName(f"{prefix}snes_atol")  # the user's stays
         # the α-residual's round-off grows with the elastic energy that drives damage: its
         # scale at a step is that of ∂E/∂α at α = 0 (−a'(0) ψ0 + the local dissipation)
         undamaged = fem.Function(alpha.function_space)
@@ -134,7 +135,7 @@ class AlternateMinimization:
                 self.accelerate.reset()
                 counts.rejected += 1
                 counts.newton_iterations += displacement.solve().iterations
-            if k == 1:  # once per step: the driving force of its first u
+            if k == 1 and not self._user_atol:  # once per step: its first u's driving force
                 snes.setTolerances(atol=self._damage_atol())
             before = self.alpha.x.array.copy()
             counts.damage_iterations += self._minimize_damage(k)

@@ -84,13 +84,31 @@ class DamageStability:
         mark.sub(part).interpolate(marker)  # the same element: a nodal copy
         return np.flatnonzero(mark.x.array > 0.5).astype(np.int32)
 
-    def active_set(self) -> np.ndarray:
-        """α's local dofs at a bound: α = αⁿ pushed down by E, or α = 1."""
+    def _driving_force(self) -> np.ndarray:
+        """∂E/∂α at the current state, nodal (ghosts updated)."""
         b = fem.assemble_vector(self.driving)
         b.scatter_reverse(la.InsertMode.add)
         b.scatter_forward()
+        return b.array
+
+    def driving_margin(self) -> float:
+        """How far the state is from the damage criterion, in units of `density`.
+
+        The minimum over the free nodes of ∂E/∂α over the node's share of ∫ density: > 0
+        where α can grow nowhere; affine in ε² on an elastic branch.
+        """
+        n = self.alpha.function_space.dofmap.index_map.size_local
+        share = self._threshold[:n] / DRIVING
+        free = np.ones(n, dtype=bool)
+        free[[d for d in self._fixed_alpha if d < n]] = False
+        margin = self._driving_force()[:n][free] / share[free]
+        return self.W.mesh.comm.allreduce(float(margin.min(initial=np.inf)), op=MPI.MIN)
+
+    def active_set(self) -> np.ndarray:
+        """α's local dofs at a bound: α = αⁿ pushed down by E, or α = 1."""
+        g = self._driving_force()
         a, low = self.alpha.x.array, self.lower.x.array
-        at_lower = (a - low <= BOUND_TOLERANCE) & (b.array > self._threshold)
+        at_lower = (a - low <= BOUND_TOLERANCE) & (g > self._threshold)
         return np.flatnonzero(at_lower | (a >= 1 - BOUND_TOLERANCE)).astype(np.int32)
 
     def lowest_mode(self) -> tuple[float, fem.Function | None]:
