@@ -9,7 +9,8 @@ with a P1 damage field α and the energy of `GradientDamage`, minimized by
   (`stability`: the second variation on the damage's inactive set).
 * Held ends (`held_ends=True`): α = 0 at both ends (the bar is gripped there, undamaged), so
   that the damage starts in the middle and a crack forms there, with its full profile on
-  both sides.
+  both sides. `held_ends="right"`: the crack forms at the free left end, half a crack on a
+  node: the symmetric half of a crack centred on a line of nodes (`end_crack`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from fenics_nl.scenes.damage_bar import BarStrip
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateResult
 from fenics_nl.solvers.damage_stability import DamageStability
 
-__all__ = ["GradientDamageBar", "PullRecord", "pull"]
+__all__ = ["GradientDamageBar", "PullRecord", "crack", "end_crack", "pull"]
 
 
 class GradientDamageBar(BarStrip):
@@ -44,8 +45,10 @@ class GradientDamageBar(BarStrip):
         self.alpha = fem.Function(A, name="damage")
         self.energy = law.energy(self.u, self.alpha, self.MODEL) * ufl.dx
         self.damage_bcs = []
-        if held_ends:
-            ends = fem.locate_dofs_topological(A, 1, np.concatenate([self.left, self.right]))
+        if held_ends:  # True: both; "right": the right one only
+            facets = self.right if held_ends == "right" else np.concatenate([self.left,
+                                                                            self.right])
+            ends = fem.locate_dofs_topological(A, 1, facets)
             self.damage_bcs = [fem.dirichletbc(0.0, ends, A)]
         self.solver = AlternateMinimization(
             self.energy, self.u, self.alpha, damage_bcs=self.damage_bcs,
@@ -226,3 +229,16 @@ def crack(law, length: float, cells: int, strains, *, height: float | None = Non
                         "damage_exact": exact.tolist()},
             "final_stress": record.stress[-1], "iterations": sum(record.iterations),
             "steps": len(record.strain), "dofs": bar.dofs + bar.A.dofmap.index_map.size_global}
+
+
+def end_crack(law, length: float, cells: int, strains, *, comm: MPI.Comm = MPI.COMM_WORLD
+              ) -> float:
+    """The dissipated energy, per unit section, of a crack at the free end of a bar.
+
+    The bar is held undamaged at its right end only: the crack forms at its left end, the
+    half of a crack centred on a node, with no band. Twice it is the toughness of a mesh of
+    cells h = length/cells for a crack along a line of nodes (`scenes.surfing`).
+    """
+    bar = GradientDamageBar(law, length, cells, held_ends="right", comm=comm)
+    pull(bar, strains, stability=False)
+    return bar.dissipated_energy() / bar.cross_section

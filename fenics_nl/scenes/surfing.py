@@ -1,0 +1,170 @@
+"""The surfing test: a crack driven along a straight line by a moving mode-I K-field.
+
+A strip [0, L] x [0, H] is the upper half of a cracked plate (plane strain), the crack on
+y = 0: u_y = 0 there (the symmetric half; the crack's opening is the strain of its damaged
+band, as in the whole plate), a pre-crack α = 1 on y = 0 up to x = `notch`, and on the rest
+of the boundary Irwin's displacement field of a crack tip at (x_c, 0),
+
+    u = K/(2μ) √(r/(2π)) (κ − cos θ) (cos(θ/2), sin(θ/2)),    κ = 3 − 4ν,
+
+with K = √(G E/(1 − ν²)). Moving x_c step by step drags the crack along (Hossain et al.
+2014). However the tip trails the field's centre, in steady propagation the elastic energy
+only translates: the external work goes into the crack, whose dissipated energy grows by the
+discrete toughness per unit length. In the half strip that is half of it:
+
+    dD/da = G_h / 2,
+
+G_h: the toughness of the mesh, here that of a crack along a line of nodes (the 1D half bar
+cracked at its free end, `gradient_damage_bar`, gives it independently).
+
+The mesh: square cells of h = ell/`resolution` up to `band` ell above the crack line, then
+rows growing geometrically (ratio 1.3) up to H.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl.domain import boundary
+from fenics_nl.solvers.alternate import AlternateMinimization
+
+__all__ = ["Surfing", "SurfingRecord"]
+
+
+def row_heights(height: float, h: float, band: float) -> np.ndarray:
+    """The y of the mesh's rows: steps h up to `band`, then growing by 1.3 up to `height`."""
+    ys = list(np.arange(0.0, band + 0.5 * h, h))
+    step = h
+    while ys[-1] < height:
+        step *= 1.3
+        ys.append(min(ys[-1] + step, height))
+    if ys[-1] - ys[-2] < 0.5 * step:  # no sliver row at the top
+        ys.pop(-2)
+    return np.array(ys)
+
+
+@dataclass
+class SurfingRecord:
+    """Every converged step: the field's centre, the crack tip, the dissipated energy."""
+
+    centre: list[float] = field(default_factory=list)
+    tip: list[float] = field(default_factory=list)
+    dissipated_energy: list[float] = field(default_factory=list)  # of the half strip
+    iterations: list[int] = field(default_factory=list)
+
+
+class Surfing:
+    """The half strip of a `GradientDamage` law (plane strain), its K-field and its crack.
+
+    Args:
+        law: the gradient damage law (E, ν, Gc, ell).
+        length, height: L and H of the half strip.
+        notch: the pre-crack's length (α = 1 on y = 0, x <= notch).
+        resolution: ell/h along the crack's path.
+        band: height of the uniform rows, in units of ell.
+        load: G/G_h, the K-field's energy release rate over the mesh's toughness.
+        toughness: G_h (default Gc (1 + h/(c_w ell)), the band estimate).
+    """
+
+    MODEL = "plane_strain"
+
+    def __init__(self, law, *, length: float = 1.0, height: float = 0.3, notch: float = 0.3,
+                 resolution: float = 4.0, band: float = 3.0, load: float = 1.0,
+                 toughness: float | None = None, acceleration: str = "none",
+                 comm: MPI.Comm = MPI.COMM_WORLD):
+        self.law, self.notch = law, notch
+        self.h = h = law.ell / resolution
+        nx = round(length / h)
+        ys = row_heights(height, h, band * law.ell)
+        msh = mesh.create_rectangle(comm, [[0.0, 0.0], [length, 1.0]], [nx, len(ys) - 1],
+                                    mesh.CellType.quadrilateral)
+        rows = np.rint(msh.geometry.x[:, 1] * (len(ys) - 1)).astype(int)
+        msh.geometry.x[:, 1] = ys[rows]  # the unit rows mapped onto the graded ones
+        self.mesh = msh
+        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+        self.A = A = fem.functionspace(msh, ("Lagrange", 1))
+        self.u = fem.Function(V, name="displacement")
+        self.alpha = fem.Function(A, name="damage")
+        self.energy = law.energy(self.u, self.alpha, self.MODEL) * ufl.dx
+        bottom = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[1], 0.0))
+        symmetry = boundary.component(V, 1, bottom)
+        outer = fem.locate_dofs_geometrical(V, lambda x: (x[1] > 1e-12 * height) & (
+            np.isclose(x[0], 0.0) | np.isclose(x[0], length) | np.isclose(x[1], height)))
+        self.g = fem.Function(V)
+        self.bcs = [symmetry, fem.dirichletbc(self.g, outer)]
+        cracked = fem.locate_dofs_geometrical(
+            A, lambda x: np.isclose(x[1], 0.0) & (x[0] <= notch + 1e-9 * length))
+        self.alpha.x.array[cracked] = 1.0
+        precrack = fem.dirichletbc(1.0, cracked, A)
+        E, nu = law.E, law.nu
+        self.toughness = toughness or law.Gc * (1 + h / (law.c_w * law.ell))
+        self.K = math.sqrt(load * self.toughness * E / (1 - nu**2))
+        self.solver = AlternateMinimization(
+            self.energy, self.u, self.alpha, self.bcs, damage_bcs=[precrack],
+            force_scale=self.K * math.sqrt(h), damage_scale=law.Gc / law.ell * h * h,
+            acceleration=acceleration)
+        self.solver.lower.x.array[:] = self.alpha.x.array
+        self._fracture = fem.form(law.fracture_energy(self.alpha) * ufl.dx)
+        n = A.dofmap.index_map.size_local
+        x = A.tabulate_dof_coordinates()[:n]
+        self._path = np.flatnonzero(np.isclose(x[:, 1], 0.0))
+        self._path_x = x[self._path, 0]
+
+    def k_field(self, centre: float) -> None:
+        """Irwin's mode-I displacement around a tip at (centre, 0) into the boundary data."""
+        E, nu, K = self.law.E, self.law.nu, self.K
+        mu, kappa = E / (2 * (1 + nu)), 3 - 4 * nu
+
+        def irwin(x):
+            r = np.hypot(x[0] - centre, x[1])
+            theta = np.arctan2(x[1], x[0] - centre)
+            amplitude = K / (2 * mu) * np.sqrt(r / (2 * np.pi)) * (kappa - np.cos(theta))
+            return np.vstack([amplitude * np.cos(theta / 2), amplitude * np.sin(theta / 2)])
+
+        self.g.interpolate(irwin)
+
+    def advance(self, centres, progress=None) -> SurfingRecord:
+        """Move the field's centre through `centres`, minimizing and committing each step."""
+        record = SurfingRecord()
+        for k, centre in enumerate(centres):
+            self.k_field(centre)
+            result = self.solver.solve()
+            self.solver.commit()
+            record.centre.append(float(centre))
+            record.tip.append(self.tip())
+            record.dissipated_energy.append(self.dissipated_energy())
+            record.iterations.append(result.iterations)
+            if progress:
+                progress(k, record)
+        return record
+
+    def tip(self, level: float = 0.5) -> float:
+        """The crack tip: the largest x on the crack line where α >= `level`."""
+        a = self.alpha.x.array[self._path]
+        local = float(self._path_x[a >= level].max(initial=-np.inf))
+        return self.mesh.comm.allreduce(local, op=MPI.MAX)
+
+    def dissipated_energy(self) -> float:
+        """∫ (Gc/c_w)(w(α)/ell + ell |∇α|²) over the half strip (per unit thickness)."""
+        return self.mesh.comm.allreduce(fem.assemble_scalar(self._fracture), op=MPI.SUM)
+
+    @property
+    def dofs(self) -> int:
+        """Unknowns: the displacement's and the damage's."""
+        return (self.V.dofmap.index_map.size_global * 2
+                + self.A.dofmap.index_map.size_global)
+
+
+def release_rate(record: SurfingRecord, skip: int) -> tuple[float, float]:
+    """(2 dD/da, the tip's lag behind the centre): least squares over the steps after `skip`."""
+    tip = np.array(record.tip[skip:])
+    D = np.array(record.dissipated_energy[skip:])
+    slope = np.polyfit(tip, D, 1)[0]
+    lag = float(np.mean(np.array(record.centre[skip:]) - tip))
+    return 2 * slope, lag
