@@ -130,6 +130,8 @@ class PullRecord:
     largest_damage: list[float] = field(default_factory=list)
     lowest_eigenvalue: list[float] = field(default_factory=list)  # inf: no damage can grow
     iterations: list[int] = field(default_factory=list)  # alternate iterations per step
+    newton_iterations: int = 0  # the displacement's, over the path
+    damage_iterations: int = 0  # the bound-constrained damage solves', over the path
     bifurcation_strain: float | None = None
     bifurcation_step: int | None = None
     bifurcation_stress: float | None = None  # on the homogeneous branch, before leaving it
@@ -167,11 +169,15 @@ def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
                 bar.perturb(mode, amplitude)
                 more = bar.stretch(strain)
                 result.iterations += more.iterations
+                record.newton_iterations += more.newton_iterations
+                record.damage_iterations += more.damage_iterations
         bar.commit()
         record.strain.append(float(strain))
         record.stress.append(bar.stress())
         record.largest_damage.append(bar.largest_damage())
         record.iterations.append(result.iterations)
+        record.newton_iterations += result.newton_iterations
+        record.damage_iterations += result.damage_iterations
         if progress:
             progress(k, record)
     return record
@@ -228,6 +234,8 @@ def crack(law, length: float, cells: int, strains, *, height: float | None = Non
             "profile": {"x": x.tolist(), "damage": alpha.tolist(),
                         "damage_exact": exact.tolist()},
             "final_stress": record.stress[-1], "iterations": sum(record.iterations),
+            "newton_iterations": record.newton_iterations,
+            "damage_iterations": record.damage_iterations, "cross_section": bar.cross_section,
             "steps": len(record.strain), "dofs": bar.dofs + bar.A.dofmap.index_map.size_global}
 
 

@@ -56,7 +56,9 @@ class SurfingRecord:
     centre: list[float] = field(default_factory=list)
     tip: list[float] = field(default_factory=list)
     dissipated_energy: list[float] = field(default_factory=list)  # of the half strip
-    iterations: list[int] = field(default_factory=list)
+    iterations: list[int] = field(default_factory=list)  # alternate iterations per step
+    newton_iterations: int = 0  # the displacement's, over the steps
+    damage_iterations: int = 0  # the bound-constrained damage solves', over the steps
 
 
 class Surfing:
@@ -140,6 +142,8 @@ class Surfing:
             record.tip.append(self.tip())
             record.dissipated_energy.append(self.dissipated_energy())
             record.iterations.append(result.iterations)
+            record.newton_iterations += result.newton_iterations
+            record.damage_iterations += result.damage_iterations
             if progress:
                 progress(k, record)
         return record
