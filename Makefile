@@ -68,7 +68,7 @@ test: test-serial test-mpi
 
 # one BLAS thread per process: the tests run two processes (xdist workers or MPI ranks) on
 # two cores, and OpenBLAS's own threads (MUMPS's dense kernels) would fight them for the
-# cores: the serial suite 5:14 -> 4:41, the spawning one 1:48 -> 1:20 on 2 cores
+# cores: the serial suite 5:14 -> 4:41 on 2 cores
 test-serial test-mpi: export OPENBLAS_NUM_THREADS = 1
 test-serial test-mpi: export OMP_NUM_THREADS = 1
 
