@@ -47,9 +47,13 @@
 # homogeneous solution from the same energy (AT1: elastic up to
 # $\sigma_c = \sqrt{3 G_c E/(8\ell)}$, then $1 - \alpha = \varepsilon_c^2/\varepsilon^2$),
 # but it is an equilibrium, not necessarily a minimum: its second variation on the damage's
-# inactive set, $-3E\varepsilon^2 \int \beta^2 + \frac{G_c}{c_w}\int \frac{w''}{\ell}\beta^2
-# + 2\ell\,\beta'^2$ for a damage perturbation $\beta$ of zero mean (the displacement
-# condensed out), turns negative along $\cos(\pi x/L)$ at
+# inactive set, for a damage perturbation $\beta$ of zero mean (the displacement condensed
+# out),
+#
+# $$ -3E\varepsilon^2 \int \beta^2 + \frac{G_c}{c_w}\int \Big(\frac{w''}{\ell}\beta^2 +
+#    2\ell\,\beta'^2\Big), $$
+#
+# turns negative along $\cos(\pi x/L)$ at
 #
 # $$ 3E\varepsilon_b^2 = \frac{G_c}{c_w}\Big(\frac{w''}{\ell} + \frac{2\ell\pi^2}{L^2}\Big)
 #    \quad (\text{AT1: not before } \varepsilon_c). $$

@@ -141,8 +141,8 @@ material.bind(body.mesh, body.quadrature_degree)
 
 # ### The residual
 #
-# $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega
-# + \int_{r=a} p\,N \cdot v\,dS$ ($N$ the outward normal, into the cavity; $2\pi r$ in
+# $R(u; v) = \int_\Omega \sigma(\varepsilon(u)) : \varepsilon(v)\,d\Omega +
+# \int_{r=a} p\,N \cdot v\,dS$ ($N$ the outward normal, into the cavity; $2\pi r$ in
 # both for the sphere). With `--mixed`, the mean stress is an unknown too: the first term
 # is the variation of $\Pi(u, p)$ (`fenics_nl.materials.mixed`).
 

@@ -4,7 +4,8 @@
 
 Every page is opened from disk; a page fails when a request fails (an image, a script, a
 style sheet), an image does not decode (naturalWidth 0), the browser logs an error, a
-formula is left untypeset or MathJax cannot read it, or a link inside the site points to a
+formula is left untypeset, MathJax cannot read it or its dollars are left in the text
+(Markdown broke it apart), or a link inside the site points to a
 missing page or anchor. The landing page and one demo page are saved as full-page
 screenshots to look at.
 """
@@ -39,6 +40,17 @@ PAGE_STATE = """() => ({
   typeset: document.querySelectorAll('div.math mjx-container, span.math mjx-container')
       .length,
   math_errors: document.querySelectorAll('mjx-merror').length,
+  // a formula Markdown broke apart (a line of it read as a list item, say) is no math
+  // element: its dollars are left in the text
+  stray_dollars: (() => {
+    const main = document.querySelector('article') || document.body, found = [];
+    const walk = document.createTreeWalker(main, NodeFilter.SHOW_TEXT);
+    for (let n = walk.nextNode(); n; n = walk.nextNode()) {
+      if (n.parentElement.closest('pre, code, .math, mjx-container, script, style')) continue;
+      if (n.textContent.includes('$')) found.push(n.textContent.trim().slice(0, 60));
+    }
+    return found;
+  })(),
   links: Array.from(document.querySelectorAll('a[href]')).map(a => a.href)
       .filter(h => h.startsWith('file:')),
   ids: Array.from(document.querySelectorAll('[id]')).map(e => e.id),
@@ -65,6 +77,7 @@ def check_page(page, path: Path) -> tuple[list[str], dict]:
     if state["typeset"] < state["math"]:
         problems.append(f"{state['math'] - state['typeset']} of {state['math']} formulas not "
                         "typeset (MathJax)")
+    problems += [f"a formula left as text: {t!r}" for t in state["stray_dollars"]]
     if state["math_errors"]:
         problems.append(f"{state['math_errors']} formulas MathJax could not read")
     return problems, state
