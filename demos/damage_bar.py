@@ -271,7 +271,7 @@ else:
 # (before the bar leaves it)
 branch = [s for _, s in uniform[:stable]] + ([] if local or bifurcation is None
                                              else [record.bifurcation_stress])
-peak = (max(branch), uniform[int(np.argmax(branch))][0] if branch else None)
+peak = (max(branch), uniform[int(np.argmax(branch))][0])
 if args.model == "at1" and record.damage_onset_strain is not None:
     e_el, s_el = uniform[len(record.elastic_margins) - 1]
     peak = (s_el * record.damage_onset_strain / e_el, record.damage_onset_strain)

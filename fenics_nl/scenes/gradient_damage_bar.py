@@ -25,7 +25,7 @@ from mpi4py import MPI
 
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes.damage_bar import BarStrip
-from fenics_nl.solvers.alternate import AlternateMinimization, AlternateResult
+from fenics_nl.solvers.alternate import AlternateMinimization, AlternateResult, AlternateWork
 from fenics_nl.solvers.damage_stability import DamageStability
 
 __all__ = ["GradientDamageBar", "PullRecord", "crack", "end_crack", "pull"]
@@ -66,14 +66,6 @@ class GradientDamageBar(BarStrip):
         """The converged damage becomes the lower bound of the next steps."""
         self.solver.commit()
 
-    def save(self) -> tuple[np.ndarray, np.ndarray]:
-        """(u, α) as they are (to try a strain and come back)."""
-        return self.u.x.array.copy(), self.alpha.x.array.copy()
-
-    def restore(self, state) -> None:
-        """(u, α) as `save` returned them."""
-        self.u.x.array[:], self.alpha.x.array[:] = state
-
     def stress(self) -> float:
         """σ from the right end's reaction."""
         return self.reaction_stress(self.solver.residual_u)
@@ -108,10 +100,10 @@ class GradientDamageBar(BarStrip):
         """How far the state is from the damage criterion (`DamageStability.driving_margin`)."""
         return self._checker().driving_margin()
 
-    def stability(self, strain: float) -> tuple[float, fem.Function | None]:
+    def stability(self) -> tuple[float, fem.Function | None]:
         """The second variation's smallest eigenvalue on the inactive set, and its mode.
 
-        At the current state, the right end held at `strain`.
+        At the current state, with v = 0 where u is prescribed.
         """
         return self._checker().lowest_mode()
 
@@ -122,16 +114,16 @@ class GradientDamageBar(BarStrip):
 
 
 @dataclass
-class PullRecord:
-    """A bar pulled through a list of strains: every converged step, and its bifurcation."""
+class PullRecord(AlternateWork):
+    """A bar pulled through a list of strains: every converged step and its bifurcation.
+
+    The solves' work is counted as `AlternateWork`'s.
+    """
 
     strain: list[float] = field(default_factory=list)
     stress: list[float] = field(default_factory=list)
     largest_damage: list[float] = field(default_factory=list)
     lowest_eigenvalue: list[float] = field(default_factory=list)  # inf: no damage can grow
-    iterations: list[int] = field(default_factory=list)  # alternate iterations per step
-    newton_iterations: int = 0  # the displacement's, over the path
-    damage_iterations: int = 0  # the bound-constrained damage solves', over the path
     bifurcation_strain: float | None = None
     bifurcation_step: int | None = None
     bifurcation_stress: float | None = None  # on the homogeneous branch, before leaving it
@@ -154,9 +146,9 @@ def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
     """
     record = PullRecord()
     for k, strain in enumerate(strains):
-        result = bar.stretch(strain)
+        solves = [bar.stretch(strain)]
         if stability and record.bifurcation_step is None:
-            lam, mode = bar.stability(strain)
+            lam, mode = bar.stability()
             record.lowest_eigenvalue.append(lam)
             if not math.isfinite(lam):
                 record.elastic_margins.append((float(strain), bar.driving_margin()))
@@ -167,17 +159,12 @@ def pull(bar: GradientDamageBar, strains, *, stability: bool = True,
                 record.bifurcation_strain = _crossing(record, strain, lam)
                 record.bifurcation_stress = bar.stress()
                 bar.perturb(mode, amplitude)
-                more = bar.stretch(strain)
-                result.iterations += more.iterations
-                record.newton_iterations += more.newton_iterations
-                record.damage_iterations += more.damage_iterations
+                solves.append(bar.stretch(strain))
         bar.commit()
         record.strain.append(float(strain))
         record.stress.append(bar.stress())
         record.largest_damage.append(bar.largest_damage())
-        record.iterations.append(result.iterations)
-        record.newton_iterations += result.newton_iterations
-        record.damage_iterations += result.damage_iterations
+        record.count(*solves)
         if progress:
             progress(k, record)
     return record
@@ -244,8 +231,10 @@ def end_crack(law, length: float, cells: int, strains, *, comm: MPI.Comm = MPI.C
     """The dissipated energy, per unit section, of a crack at the free end of a bar.
 
     The bar is held undamaged at its right end only: the crack forms at its left end, the
-    half of a crack centred on a node, with no band. Twice it is the toughness of a mesh of
-    cells h = length/cells for a crack along a line of nodes (`scenes.surfing`).
+    half of a crack centred on a node. Broken, it has a band of one cell at α = 1 (a P1 bar
+    carries no stress only where a whole cell is at α = 1): Gc/2 (1 + 2h/(c_w ell)) for AT1.
+    Twice it is the toughness of a mesh of cells h = length/cells for a crack along a line
+    of nodes (`scenes.surfing`).
     """
     bar = GradientDamageBar(law, length, cells, held_ends="right", comm=comm)
     pull(bar, strains, stability=False)

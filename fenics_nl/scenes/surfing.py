@@ -32,7 +32,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
-from fenics_nl.solvers.alternate import AlternateMinimization
+from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
 
 __all__ = ["Surfing", "SurfingRecord"]
 
@@ -50,15 +50,15 @@ def row_heights(height: float, h: float, band: float) -> np.ndarray:
 
 
 @dataclass
-class SurfingRecord:
-    """Every converged step: the field's centre, the crack tip, the dissipated energy."""
+class SurfingRecord(AlternateWork):
+    """Every converged step: the field's centre, the crack tip, the dissipated energy.
+
+    The solves' work is counted as `AlternateWork`'s.
+    """
 
     centre: list[float] = field(default_factory=list)
     tip: list[float] = field(default_factory=list)
     dissipated_energy: list[float] = field(default_factory=list)  # of the half strip
-    iterations: list[int] = field(default_factory=list)  # alternate iterations per step
-    newton_iterations: int = 0  # the displacement's, over the steps
-    damage_iterations: int = 0  # the bound-constrained damage solves', over the steps
 
 
 class Surfing:
@@ -110,8 +110,7 @@ class Surfing:
         self.solver = AlternateMinimization(
             self.energy, self.u, self.alpha, self.bcs, damage_bcs=[precrack],
             force_scale=self.K * math.sqrt(h), damage_scale=law.Gc / law.ell * h * h,
-            acceleration=acceleration)
-        self.solver.lower.x.array[:] = self.alpha.x.array
+            acceleration=acceleration)  # its lower bound: α now, the pre-crack at 1
         self._fracture = fem.form(law.fracture_energy(self.alpha) * ufl.dx)
         n = A.dofmap.index_map.size_local
         x = A.tabulate_dof_coordinates()[:n]
@@ -136,14 +135,11 @@ class Surfing:
         record = SurfingRecord()
         for k, centre in enumerate(centres):
             self.k_field(centre)
-            result = self.solver.solve()
+            record.count(self.solver.solve())
             self.solver.commit()
             record.centre.append(float(centre))
             record.tip.append(self.tip())
             record.dissipated_energy.append(self.dissipated_energy())
-            record.iterations.append(result.iterations)
-            record.newton_iterations += result.newton_iterations
-            record.damage_iterations += result.damage_iterations
             if progress:
                 progress(k, record)
         return record

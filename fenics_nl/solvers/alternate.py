@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import ufl
@@ -26,7 +26,7 @@ from fenics_nl.solvers.acceleration import accelerator
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import solver_options
 
-__all__ = ["AlternateMinimization", "AlternateResult"]
+__all__ = ["AlternateMinimization", "AlternateResult", "AlternateWork"]
 
 
 @dataclass
@@ -38,6 +38,21 @@ class AlternateResult:
     damage_iterations: int
     change: float  # the last iteration's max |Δα|
     rejected: int = 0  # accelerated iterates that did not lower the energy
+
+
+@dataclass
+class AlternateWork:
+    """The work of alternate minimization over load steps (a record's counts)."""
+
+    iterations: list[int] = field(default_factory=list)  # alternate iterations per step
+    newton_iterations: int = 0  # the displacement's, over the steps
+    damage_iterations: int = 0  # the bound-constrained damage solves', over the steps
+
+    def count(self, *solves: AlternateResult) -> None:
+        """One load step's solves (a step solved again counts in the same step)."""
+        self.iterations.append(sum(r.iterations for r in solves))
+        self.newton_iterations += sum(r.newton_iterations for r in solves)
+        self.damage_iterations += sum(r.damage_iterations for r in solves)
 
 
 class AlternateMinimization:
