@@ -163,16 +163,27 @@ warnings = []
 
 # +
 strains = np.linspace(0.0, args.strain * peak_strain, args.steps + 1)[1:]
+
+
+def keep(k, strain, stress):
+    """A converged step, kept for the JSON of a run that fails later."""
+    cli.converged_step({"load_factor": (k + 1) / args.steps, "strain": strain,
+                        "stress": stress})
+
+
+
 height = args.length / args.cells  # the local bars' cross-section, the same on every mesh
 if local:
     uniform, iterations = damage_bar.uniform(law, args.length, args.cells, strains,
-                                             height=height)
+                                             height=height,
+                                             on_step=lambda k, p: keep(k, *p[-1]))
     bifurcation = None
 else:
     cells = math.ceil(args.resolution * args.length / args.ell)
     bar = GradientDamageBar(law, args.length, cells, acceleration=args.acceleration)
     height = bar.cross_section
-    record = gradient_damage_bar.pull(bar, strains)
+    record = gradient_damage_bar.pull(
+        bar, strains, progress=lambda k, r: keep(k, r.strain[-1], r.stress[-1]))
     uniform = list(zip(record.strain, record.stress, strict=True))
     iterations = sum(record.iterations)
     bifurcation = record.bifurcation_strain

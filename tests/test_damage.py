@@ -307,3 +307,18 @@ def test_a_surfing_crack_on_two_ranks_is_the_serial_one():
     _, whole = surfing_run(MPI.COMM_SELF, 4)
     assert cut.tip == whole.tip
     assert cut.dissipated_energy == pytest.approx(whole.dissipated_energy, rel=1e-7)
+
+
+def test_a_damage_bar_that_fails_keeps_its_converged_steps(demo, tmp_path):
+    # the damage SNES allowed one iteration: the first damaged step fails; the JSON says so
+    # and keeps the two elastic steps before it (status 2, one line)
+    out = tmp_path / "f.json"
+    proc = demo.run(["damage_bar.py", "--model", "at1", "-damage_snes_max_it", "1",
+                     "--json", out], check=False)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+    import json
+
+    d = json.loads(out.read_text())
+    assert d["status"] == "failed" and d["converged_steps"] == 2
+    assert [s["strain"] for s in d["steps"]] == pytest.approx(
+        [math.sqrt(3 / 0.8) * k / 3 for k in (1, 2)], rel=1e-12)

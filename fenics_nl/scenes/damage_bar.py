@@ -153,10 +153,11 @@ class DamageBar(BarStrip):
 
 
 def uniform(law, length: float, cells: int, strains, *, height: float,
-            prefix: str = "bar_") -> tuple[list[tuple[float, float]], int]:
+            prefix: str = "bar_", on_step=None) -> tuple[list[tuple[float, float]], int]:
     """The uniform bar of `law` (`CourseDamage`) through `strains`, by Newton at each step.
 
-    Returns the (strain, stress) of every step and the Newton iterations.
+    Returns the (strain, stress) of every step and the Newton iterations; `on_step(k, path)`
+    after each converged step.
     """
     from fenics_nl.solvers.newton import NewtonSolver
 
@@ -169,6 +170,8 @@ def uniform(law, length: float, cells: int, strains, *, height: float,
         iterations += solve.solve().iterations
         bar.commit()
         path.append((float(strain), bar.reaction_stress()))
+        if on_step:
+            on_step(len(path) - 1, path)
     return path, iterations
 
 

@@ -71,7 +71,10 @@ class Surfing:
         resolution: ell/h along the crack's path.
         band: height of the uniform rows, in units of ell.
         load: G/G_h, the K-field's energy release rate over the mesh's toughness.
-        toughness: G_h (default Gc (1 + h/(c_w ell)), the band estimate).
+        toughness: G_h, the K-field's reference. By default Gc (1 + h/(c_w ell)), the band
+            of a crack inside the mesh; a crack on this strip's symmetry line has twice the
+            band, Gc (1 + 2h/(c_w ell)) (`gradient_damage_bar.end_crack`), so the default
+            load is about 0.92 of that toughness.
     """
 
     MODEL = "plane_strain"
