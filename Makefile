@@ -60,6 +60,7 @@ demo: $(VENV)/.installed
 	  > results/newton_scalar.txt
 	$(PY) demos/snap_through.py --plot results/snap_through.png --png results/snap_shapes.png \
 	  --json results/snap_through.json
+	$(PY) demos/crack.py --plot results/crack.png --json results/crack.json
 	$(PY) -m fenics_nl run cases/thick_cylinder.toml --png results/thick_cylinder.png \
 	  --json results/thick_cylinder.json
 	@echo "make demo: pictures (*.png) and results (*.json) in $(CURDIR)/results/"

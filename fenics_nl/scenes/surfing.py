@@ -32,33 +32,24 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
+from fenics_nl.domain.graded_grid import graded_axis, graded_rectangle
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
 
 __all__ = ["Surfing", "SurfingRecord"]
-
-
-def row_heights(height: float, h: float, band: float) -> np.ndarray:
-    """The y of the mesh's rows: steps h up to `band`, then growing by 1.3 up to `height`."""
-    ys = list(np.arange(0.0, band + 0.5 * h, h))
-    step = h
-    while ys[-1] < height:
-        step *= 1.3
-        ys.append(min(ys[-1] + step, height))
-    if ys[-1] - ys[-2] < 0.5 * step:  # no sliver row at the top
-        ys.pop(-2)
-    return np.array(ys)
 
 
 @dataclass
 class SurfingRecord(AlternateWork):
     """Every converged step: the field's centre, the crack tip, the dissipated energy.
 
-    The solves' work is counted as `AlternateWork`'s.
+    `damage` keeps each step's damage (this rank's array) for the pictures; the solves'
+    work is counted as `AlternateWork`'s.
     """
 
     centre: list[float] = field(default_factory=list)
     tip: list[float] = field(default_factory=list)
     dissipated_energy: list[float] = field(default_factory=list)  # of the half strip
+    damage: list[np.ndarray] = field(default_factory=list, repr=False)  # this rank's
 
 
 class Surfing:
@@ -85,13 +76,10 @@ class Surfing:
                  comm: MPI.Comm = MPI.COMM_WORLD):
         self.law, self.notch = law, notch
         self.h = h = law.ell / resolution
-        nx = round(length / h)
-        ys = row_heights(height, h, band * law.ell)
-        msh = mesh.create_rectangle(comm, [[0.0, 0.0], [length, 1.0]], [nx, len(ys) - 1],
-                                    mesh.CellType.quadrilateral)
-        rows = np.rint(msh.geometry.x[:, 1] * (len(ys) - 1)).astype(int)
-        msh.geometry.x[:, 1] = ys[rows]  # the unit rows mapped onto the graded ones
-        self.mesh = msh
+        xs = h * np.arange(round(length / h) + 1)  # steps of h: the field moves by whole cells
+        length = xs[-1]
+        ys = graded_axis(height, h, (0.0, band * law.ell), through=0.0)
+        self.mesh = msh = graded_rectangle(comm, xs, ys)
         self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
         self.A = A = fem.functionspace(msh, ("Lagrange", 1))
         self.u = fem.Function(V, name="displacement")
@@ -143,6 +131,7 @@ class Surfing:
             record.centre.append(float(centre))
             record.tip.append(self.tip())
             record.dissipated_energy.append(self.dissipated_energy())
+            record.damage.append(self.alpha.x.array.copy())
             if progress:
                 progress(k, record)
         return record
