@@ -34,8 +34,9 @@ $(VENV)/.docs-installed: $(VENV)/.installed
 	  open('pyproject.toml', 'rb'))['project']['optional-dependencies']['docs']))"))
 	@touch $@
 
-# the benchmarks' extra: numba and the J2 peer (see pyproject.toml's bench extra)
-PEER := dolfinx-external-operator==0.11.0
+# the benchmarks' extra and the peers, with --no-deps (see pyproject.toml's bench extra):
+# the J2 peer and the phase-field peer (it declares nothing; it needs pandas, in the extra)
+PEER := dolfinx-external-operator==0.11.0 phasefieldx==0.4.1
 $(VENV)/.bench-installed: $(VENV)/.installed
 	$(call install,-e ".[test,bench]")
 	$(call install,--no-deps $(PEER))
@@ -87,7 +88,7 @@ test-mpi: $(VENV)/.installed
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
 BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed friction \
-	continuation damage
+	continuation damage damage_peer
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done

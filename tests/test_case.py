@@ -859,3 +859,41 @@ def test_a_case_file_in_the_old_spellings_reads_in_the_new_ones(tmp_path):
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
     case = read_case(write(tmp_path, "old.toml", text))
     assert (case.model, case.newton, case.linear) == ("plane_strain", "bfgs", "gamg")
+
+
+def test_a_damage_case_follows_the_homogeneous_closed_form(demo):
+    # cases/damage_strip.toml: AT2, a strip in uniaxial stress to 0.9 of its peak strain,
+    # stable and homogeneous: α, σ and the dissipated energy (Gc/2) α²/ell × area against
+    # the closed form of the same energy at each step (P1 is exact for a uniform state:
+    # measured 1e-14; 1e-9 asked, above the alternate minimization's stop on max |Δα|, 1e-6,
+    # which a uniform state meets exactly)
+    from fenics_nl.materials.gradient_damage import AT2
+
+    law = AT2(210000.0, 0.0, Gc=2.7, ell=0.1, residual_stiffness=1e-6)
+    d = demo.case(CASES / "damage_strip.toml")
+    assert d["law"] == "at2" and d["warnings"] == [] and len(d["steps"]) == 4
+    for s in d["steps"]:
+        eps = s["load_factor"] * 0.0118 / 2.0
+        alpha, sigma = law.homogeneous_damage(eps), law.homogeneous_stress(eps)
+        assert s["largest_damage"] == pytest.approx(alpha, rel=1e-9)
+        assert s["probes"]["middle"]["stress"][0][0] == pytest.approx(sigma, rel=1e-9)
+        assert s["reactions"]["right"][0] == pytest.approx(sigma * 0.2, rel=1e-9)
+        assert s["dissipated_energy"] == pytest.approx(2.7 / 2 * alpha**2 / 0.1 * 2.0 * 0.2,
+                                                       rel=1e-9)
+
+
+@pytest.mark.parametrize("change,message", [
+    (('model = "plane_strain"', 'model = "plane_stress"'),
+     "mesh.model: at2 has no plane-stress form"),
+    (("nu = 0.0", 'nu = 0.0\nsplit = "spectral"'), "material.split: 'spectral' is not one of"),
+    (("ell = 0.1 ", "ell = -0.1 "), "material.ell"),
+    (("Gc = 2.7 ", "# "), "material.Gc: missing"),
+    (("steps = 4", 'steps = 4\n\n[solver]\nnewton = "modified"'),
+     "solver.newton: at2 is solved by alternate minimization"),
+])
+def test_what_a_damage_case_cannot_be_is_one_line_each(tmp_path, demo, change, message):
+    text = (CASES / "damage_strip.toml").read_text()
+    assert change[0] in text
+    write(tmp_path, "damage_strip.geo", (CASES / "damage_strip.geo").read_text())
+    lines = check(demo, tmp_path, text.replace(*change))
+    assert any(message in line for line in lines), lines

@@ -17,6 +17,7 @@ from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
+from fenics_nl.case.damage import DamageSteps
 from fenics_nl.case.mesh import load_mesh
 from fenics_nl.case.spec import Case, CaseError, Condition
 from fenics_nl.contact.active_set import ActiveSetContact
@@ -25,6 +26,7 @@ from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, plane_stress
 from fenics_nl.materials import mixed as mixed_form
+from fenics_nl.materials.gradient_damage import DamagedElastic, GradientDamage
 from fenics_nl.materials.laws import von_mises_of
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.newton import NewtonSolver
@@ -50,6 +52,8 @@ class CaseProblem:
         if problems + outside:
             raise CaseError(problems + outside)
         self.material = case.material()
+        if isinstance(self.material, GradientDamage):  # its damage field: a state
+            self.material = DamagedElastic(self.material)
         # 2 × degree: exact for the linear part of every law on affine cells (bracket's table)
         q = 2 * case.degree
         # `unknown`: what the solver updates; `u`: the displacement in forms (its part, if
@@ -108,16 +112,26 @@ class CaseProblem:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
         tag = {n: g.tag for n, g in data.physical_groups.items()}
         v = self.fields.v  # the displacement's test function (a part, if mixed)
-        R = self.fields.internal_work(self.material, self.model) * self.dx
+        loads = 0
         w = self.weight
         for c in self.case.conditions:
             ds = self.ds(tag[c.group])
             if c.kind == "traction":
                 T = ufl.as_vector(c.value)
-                R -= self.t * ufl.dot(T, v) * w * ds
+                loads -= self.t * ufl.dot(T, v) * w * ds
             elif c.kind == "pressure":
-                R += self.t * c.value * ufl.dot(self._pressure_direction(c), v) * w * ds
-        return R
+                loads += self.t * c.value * ufl.dot(self._pressure_direction(c), v) * w * ds
+        self._loads = loads
+        return self.fields.internal_work(self.material, self.model) * self.dx + loads
+
+    def load_potential(self):
+        """The dead loads' potential, −(their work); 0 without loads.
+
+        The residual's load terms with the displacement for the test function.
+        """
+        if isinstance(self._loads, int):
+            return 0
+        return ufl.replace(self._loads, {self.fields.v: self.u})
 
     def _load_magnitude(self, data) -> float | None:
         """Σ |traction| or |pressure| × area over the loaded groups at load factor 1.
@@ -272,6 +286,8 @@ class CaseProblem:
 
     def _solver(self):
         case = self.case
+        if self.damage:
+            return DamageSteps(self, PREFIX + "damage_")
         method, linear = case.newton, case.linear
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": self.line_search(), "force_scale": self.force_scale}
@@ -300,9 +316,15 @@ class CaseProblem:
     # -- loads and results --------------------------------------------------------------
 
     @property
+    def damage(self) -> bool:
+        """Whether the case is in gradient damage (its solver: alternate minimization)."""
+        return isinstance(self.material, DamagedElastic)
+
+    @property
     def dofs(self) -> int:
-        """Global number of scalar unknowns (with the pressure's, if mixed)."""
-        return output.dofs(self.unknown.function_space)
+        """Global number of scalar unknowns (with the pressure's, if mixed; the damage's)."""
+        damage = output.dofs(self.material.alpha.function_space) if self.damage else 0
+        return output.dofs(self.unknown.function_space) + damage
 
     def displacement(self) -> fem.Function:
         """The displacement as a Function (a copy of the mixed unknown's part)."""

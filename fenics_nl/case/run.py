@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from fenics_nl.case.damage import cell_sizes
 from fenics_nl.case.problem import CaseProblem
 from fenics_nl.case.resume import case_checkpoints
 from fenics_nl.io import cli
@@ -212,6 +213,12 @@ def step_record(problem: CaseProblem, t: float, result) -> dict:
     """What one converged step reports (collective)."""
     rec = {"load_factor": t, "newton_iterations": result.iterations,
            "probes": problem.probe_values(), "reactions": problem.reactions()}
+    if problem.damage:
+        d = problem.solver
+        rec |= {"alternate_iterations": d.last.iterations,
+                "damage_iterations": d.last.damage_iterations,
+                "dissipated_energy": d.dissipated_energy(),
+                "largest_damage": global_max(problem.mesh.comm, d.alpha.x.array)}
     if problem.contact is not None:
         c = problem.solver.contact
         rec["active_set_iterations"] = result.active_set_iterations
@@ -219,6 +226,9 @@ def step_record(problem: CaseProblem, t: float, result) -> dict:
         rec["nodes_in_contact"] = c.surface.count(c.active)
     extra = (f", {result.active_set_iterations} active-set iterations"
              if problem.contact is not None else "")
+    if problem.damage:
+        extra = (f" in {rec['alternate_iterations']} alternate iterations, largest damage "
+                 f"{rec['largest_damage']:.3g}")
     say(f"load factor {t:.4g}: {result.iterations} Newton iterations{extra}")
     return rec
 
@@ -234,6 +244,13 @@ def warnings(problem: CaseProblem) -> list[str]:
     if not problem.material.finite_strain and u_max > 0.05 * size:
         notes.append(f"the largest displacement is {100 * u_max / size:.0f} % of the body's "
                      f"size: a small-strain law ({problem.case.law}) is not valid there")
+    if problem.damage:
+        law = problem.material.law
+        h = comm.allreduce(float(cell_sizes(problem.mesh).max(initial=0.0)), op=MPI.MAX)
+        if law.ell < 2 * h:  # the band of a crack is then a visible share of its cost
+            notes.append(f"ell is smaller than two cells (ell/h = {law.ell / h:.3g}, h the "
+                         f"largest cell): a crack there dissipates Gc (1 + h/(c_w ell)) = "
+                         f"{law.Gc * (1 + h / (law.c_w * law.ell)):.4g}, not Gc = {law.Gc:g}")
     return notes
 
 

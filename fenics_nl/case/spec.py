@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from fenics_nl.materials import laws
+from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.vocabulary import canonical
 
@@ -32,10 +33,18 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
+                         # | at1 | at2
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
                          # plane stress: linear-elastic, saint-venant-kirchhoff or j2
+# at1, at2 (gradient damage: a damage field 0 <= alpha <= 1 that never decreases, minimized
+# with u at each step by alternate minimization, Anderson-accelerated): also Gc (toughness,
+# energy per unit crack area) and ell (length; the mesh's cells at most ell/2 where a crack
+# goes), and optionally residual_stiffness (default 1e-6: what a broken cell keeps) and
+# split = "volumetric" (no damage under volumetric compression; default "none"). Small strain,
+# not plane stress, no contact, no arc-length, newton = "full"; the JSON adds per step the
+# dissipated energy and the largest damage
 
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
@@ -91,9 +100,16 @@ LAWS: dict[str, type[laws.Material]] = {
     "saint-venant-kirchhoff": laws.StVenantKirchhoff,
     "neo-hookean": laws.NeoHookean,
     "j2": J2Plasticity,
+    "at1": AT1,
+    "at2": AT2,
 }
-# parameters a case may leave out, and their values: J2 without hardening is perfect plasticity
-OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}}
+DAMAGE = ("at1", "at2")
+# parameters a case may leave out, and their values: J2 without hardening is perfect
+# plasticity; a broken cell of a damage law keeps 1e-6 of its stiffness (a body cut in two
+# by a crack would otherwise have a singular tangent)
+OPTIONAL = {"j2": {"H": 0.0, "C": 0.0},
+            **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
+WORDS = {"split": SPLITS}  # parameters that are words, and their choices
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "bfgs", "snes")
 LINEAR = ("lu", "gamg")
@@ -313,12 +329,34 @@ def read_case(path: str | Path) -> Case:
             if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
                 r.fail(f"{c.key}", "arc-length control scales loads only: a contact or a "
                                    "prescribed non-zero displacement cannot take part")
+    if law in DAMAGE:
+        _damage_limits(r, law, model, formulation, newton, linear, conditions, arc)
     probes = _probes(r, data, dim)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation)
+
+
+def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, conditions,
+                   arc) -> None:
+    """What a gradient damage case cannot have: each one line."""
+    if model == "plane_stress":
+        r.fail("mesh.model", f"{law} has no plane-stress form: use plane_strain, 3d or "
+                             "axisymmetric")
+    if formulation == "mixed":
+        r.fail("mesh.formulation", f"{law} is in the displacement formulation only")
+    if arc is not None:
+        r.fail("loading.control", f"{law}: the damage is irreversible and the load driven "
+                                  "step by step: no arc-length control")
+    if newton != "full" or linear != "lu":
+        r.fail("solver.newton" if newton != "full" else "solver.linear",
+               f"{law} is solved by alternate minimization, its u-solves by full Newton with "
+               "LU: newton = \"full\", linear = \"lu\"")
+    for c in conditions:
+        if c.kind == "contact":
+            r.fail(f"{c.key}", f"{law}: no contact (the damage case has no active set)")
 
 
 def _material(r: _Reader, data: dict, model: str | None):
@@ -337,8 +375,9 @@ def _material(r: _Reader, data: dict, model: str | None):
     parameters = {}
     defaults = OPTIONAL.get(law, {})
     for f in params:  # every parameter but a documented optional one: say it
-        value = r.get(m, f.name, "material", float, required=f.name not in defaults,
-                      default=defaults.get(f.name))
+        kind = str if f.name in WORDS else float
+        value = r.get(m, f.name, "material", kind, required=f.name not in defaults,
+                      default=defaults.get(f.name), choices=WORDS.get(f.name))
         if value is not None:
             parameters[f.name] = value
     if len(parameters) == len(params):

@@ -23,14 +23,14 @@ in the criterion and σ = (c a(α) + 1 − c) E ε.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import ufl
 
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.laws import Isotropic, LinearElastic, check_range
+from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["GradientDamage"]
+__all__ = ["AT1", "AT2", "DamagedElastic", "GradientDamage"]
 
 MODELS = {"at1": 8.0 / 3.0, "at2": 2.0}  # c_w
 SPLITS = ("none", "volumetric")
@@ -39,6 +39,8 @@ SPLITS = ("none", "volumetric")
 @dataclass(frozen=True)
 class GradientDamage(Isotropic):
     """AT1 or AT2 gradient damage on Hooke's law (E, ν): toughness Gc, length ell."""
+
+    finite_strain = False  # (not a field) small strain
 
     Gc: float = 1.0
     ell: float = 1.0
@@ -152,3 +154,58 @@ class GradientDamage(Isotropic):
         a = self.stiffness(self.homogeneous_damage(strain))
         c = self.degraded_share(strain)
         return (c * a + 1 - c) * self.E * strain
+
+
+@dataclass(frozen=True)
+class AT1(GradientDamage):
+    """`GradientDamage` with w(α) = α (a case file's ``law = "at1"``)."""
+
+    model: str = field(default="at1", init=False)
+
+
+@dataclass(frozen=True)
+class AT2(GradientDamage):
+    """`GradientDamage` with w(α) = α² (a case file's ``law = "at2"``)."""
+
+    model: str = field(default="at2", init=False)
+
+
+class DamagedElastic(SmallStrain):
+    """A `GradientDamage` law on a mesh, seen as a path-dependent small-strain material.
+
+    Its energy is the law's elastic part at the damage field α (P1): a(α) ψ0(ε) (with the
+    split, a(α) ψ0⁺ + ψ0⁻), so σ, the internal work and σ_eq are `SmallStrain`'s. Its state
+    is α and its irreversibility bound, the last committed damage (`lower`); the damage
+    itself is found by an alternate minimization (`solvers.alternate`, which takes `lower`
+    as its bound), and `commit` moves the bound up to it after a converged step.
+    """
+
+    path_dependent = True
+
+    def __init__(self, law: GradientDamage):
+        self.law = law
+        self.alpha = self.lower = None
+
+    def bind(self, mesh, degree: int) -> None:
+        """The damage field (P1, zero) and its bound on `mesh` (`degree`: unused, P1)."""
+        from dolfinx import fem
+
+        A = fem.functionspace(mesh, ("Lagrange", 1))
+        self.alpha = fem.Function(A, name="damage")
+        self.lower = fem.Function(A, name="committed_damage")
+
+    def energy(self, eps):
+        """a(α) ψ0(ε), or with the split a(α) ψ0⁺ + ψ0⁻ (ε: 3x3)."""
+        return self.law.elastic_energy(eps, self.alpha)
+
+    def state_functions(self) -> dict:
+        """The damage and its bound (to checkpoint and restore)."""
+        return {"damage": self.alpha, "committed_damage": self.lower}
+
+    def output_fields(self) -> list:
+        """What --output writes of the state: the damage."""
+        return [self.alpha]
+
+    def commit(self, u=None, model: str = "3d") -> None:
+        """The converged damage becomes the bound of the next steps (irreversibility)."""
+        self.lower.x.array[:] = self.alpha.x.array

@@ -104,9 +104,9 @@ class NotchedSpecimen:
         cracked = fem.locate_dofs_geometrical(
             A, lambda x: (np.abs(x[1] - a) <= 0.5001 * h) & (x[0] <= a + 1e-9 * side))
         self.alpha.x.array[cracked] = 1.0
-        precrack = fem.dirichletbc(1.0, cracked, A)
+        self.precrack = fem.dirichletbc(1.0, cracked, A)
         self.solver = AlternateMinimization(
-            self.energy, self.u, self.alpha, self.bcs, damage_bcs=[precrack],
+            self.energy, self.u, self.alpha, self.bcs, damage_bcs=[self.precrack],
             force_scale=law.critical_stress * h, damage_scale=law.Gc / law.ell * h * h,
             tol=tol, max_it=2000, acceleration=acceleration)
         self._residual = fem.form(self.solver.residual_u)

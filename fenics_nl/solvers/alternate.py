@@ -63,12 +63,15 @@ class AlternateMinimization:
         u, alpha: the unknowns (their values start each step).
         bcs: Dirichlet conditions of u (set anew for each step through `solve(bcs)`).
         damage_bcs: Dirichlet conditions of α (e.g. α = 0 where a bar is gripped).
-        force_scale: the force scale of the u-problem's absolute tolerance.
+        force_scale: the force scale of the u-problem's absolute tolerance (None: the
+            largest first residual of a step's Newton solves, `NewtonSolver`'s default).
         damage_scale: that of the α-problem (its residual, E's derivative in α: Gc/ell
             times a cell's measure is a nodal value of it).
         tol: stop when max |Δα| < tol.
         max_it: alternate iterations before SolveError.
         prefix: PETSc options prefix of the damage problem's SNES (``{prefix}snes_view``).
+        lower: the irreversibility bound αⁿ, if another object keeps it (a material's
+            state); by default a copy of α, owned here.
         acceleration: ``none`` (the plain alternate iteration), ``overrelaxed`` (α moved
             `omega` times its update) or ``anderson`` (`depth` past iterates combined): see
             `solvers.acceleration`. The accelerated damage is put back within the bounds
@@ -77,8 +80,9 @@ class AlternateMinimization:
 
     def __init__(self, energy: ufl.Form, u: fem.Function, alpha: fem.Function,
                  bcs: Sequence[fem.DirichletBC] = (), *,
-                 damage_bcs: Sequence[fem.DirichletBC] = (), force_scale: float = 1.0,
-                 damage_scale: float = 1.0,
+                 damage_bcs: Sequence[fem.DirichletBC] = (),
+                 force_scale: float | None = 1.0, damage_scale: float = 1.0,
+                 lower: fem.Function | None = None,
                  tol: float = 1e-8, max_it: int = 500, prefix: str = "damage_",
                  acceleration: str = "none", omega: float = 1.5, depth: int = 5):
         self.u, self.alpha, self.bcs = u, alpha, list(bcs)
@@ -103,8 +107,10 @@ class AlternateMinimization:
         # scale at a step is that of ∂E/∂α at α = 0 (−a'(0) ψ0 + the local dissipation)
         undamaged = fem.Function(alpha.function_space)
         self._driving = fem.form(ufl.replace(residual_a, {alpha: undamaged}))
-        self.lower = fem.Function(alpha.function_space, name="committed_damage")
-        self.lower.x.array[:] = alpha.x.array
+        if lower is None:
+            lower = fem.Function(alpha.function_space, name="committed_damage")
+            lower.x.array[:] = alpha.x.array
+        self.lower = lower
         self._upper = self.damage_problem.x.duplicate()
         self._upper.set(1.0)
 

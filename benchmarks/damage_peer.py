@@ -1,0 +1,186 @@
+"""Gradient damage against a peer: phasefieldx 0.4.1 on Miehe's notched square in tension.
+
+The same specimen, mesh, pre-crack and load steps (`scenes.notched_specimen`: the square
+[0, 1]² mm, E = 210 kN/mm², ν = 0.3, Gc = 2.7e-3 kN/mm, plane strain, the notch a band of one
+cell at α = 1, h = ell/2 where the crack goes, the top moved up in equal steps), AT2 with no
+split (the one model both have: phasefieldx's history solver is AT2 only), residual
+stiffness 1e-6:
+
+* **ours**: `AlternateMinimization`, irreversibility as a bound αⁿ ≤ α ≤ 1 (SNES
+  `vinewtonrsls`), plain and Anderson-accelerated, stopped at max |Δα| < 1e-6;
+* **peer**: phasefieldx's staggered solver with Miehe's history field
+  (`Element.Phase_Field_Fracture.solver.solver_history.solve`, `irreversibility="miehe"`):
+  the damage equation is driven by H = max over the past of ψ0⁺, not bounded; its loop stops
+  when the relative L2 increments of u and of the damage are both below 1e-6.
+
+The two are different irreversibility models, so they are compared on what a user reads: the
+peak force and where it is, the crack's path (the tip at each step) and the energy
+dissipated at the end. Every quantity of both is measured by our functionals on the same
+spaces (the peer's u and damage are read at each converged step through a wrapper of its
+per-step energy routine; our residual at its state gives its top force), and times are of the
+load loop only, after a warm-up run of each that compiles the forms.
+
+Needs the bench extra (`make bench` installs it): `pip install -e ".[bench]"` and
+`pip install --no-deps phasefieldx==0.4.1`. phasefieldx imports `scifem`, a compiled extension
+that does not build here, only for its two energy-minimizing solvers: the history solver used
+here runs without it, so an empty module stands in for it at import time.
+
+    python benchmarks/damage_peer.py [--quick] [--update-docs]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import sys
+import tempfile
+import time
+import types
+from importlib.metadata import version
+from pathlib import Path
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+from common import machine, options, publish
+from mpi4py import MPI
+
+from fenics_nl.materials.gradient_damage import GradientDamage
+from fenics_nl.scenes.notched_specimen import NotchedSpecimen
+
+sys.modules.setdefault("scifem", types.ModuleType("scifem"))  # see the docstring
+try:
+    import dolfinx.log
+    from phasefieldx.Element.Phase_Field_Fracture import Input as peer_input
+    from phasefieldx.Element.Phase_Field_Fracture.solver import solver_history as peer
+except ImportError as err:
+    raise SystemExit("benchmarks/damage_peer.py needs the bench extra: pip install -e "
+                     "'.[bench]' && pip install --no-deps phasefieldx==0.4.1") from err
+
+E, NU, GC, K = 210.0, 0.3, 2.7e-3, 1e-6
+TOL = 1e-6
+
+
+def law(ell):
+    return GradientDamage(E, NU, Gc=GC, ell=ell, model="at2", residual_stiffness=K)
+
+
+def say(msg):
+    if MPI.COMM_WORLD.rank == 0:
+        print(msg, flush=True)
+
+
+def summary(specimen: NotchedSpecimen, loads, force, tips, dissipated, seconds, **extra):
+    k = int(np.argmax(force))
+    return {"time_s": seconds, "peak_force": force[k], "peak_displacement": float(loads[k]),
+            "force_history": force, "crack_tip_history": tips,
+            "dissipated_energy": dissipated[-1], "dissipated_energy_history": dissipated,
+            "final_tip": tips[-1], "dofs": specimen.dofs, **extra}
+
+
+def ours(ell, loads, acceleration) -> dict:
+    """`NotchedSpecimen.load`: alternate minimization, the damage bounded."""
+    NotchedSpecimen(law(ell), resolution=2, acceleration=acceleration).load(loads[:1])
+    specimen = NotchedSpecimen(law(ell), resolution=2, acceleration=acceleration)
+    t0 = time.perf_counter()
+    record = specimen.load(loads)
+    seconds = time.perf_counter() - t0
+    return summary(specimen, loads, record.force, record.tip, record.dissipated_energy,
+                   seconds, scheme=acceleration, alternate_iterations=record.iterations,
+                   newton_iterations=record.newton_iterations,
+                   damage_iterations=record.damage_iterations)
+
+
+def phasefieldx(ell, loads, folder: Path) -> dict:
+    """phasefieldx's history solver on a fresh specimen's mesh, spaces, supports, pre-crack."""
+    specimen = NotchedSpecimen(law(ell), resolution=2)
+    states = []  # (u, damage, the time it converged) of each step
+
+    def move_top(bcs, t):
+        specimen._top_bc.g.x.array[:] = loads[round(t)]
+        return 0.0, float(loads[round(t)]), 0.0
+
+    energies = peer.compute_total_energies
+
+    def converged(u, phi, *args, **kwargs):  # called once per step, after its loop
+        states.append((u.x.array.copy(), phi.x.array.copy(), time.perf_counter()))
+        return energies(u, phi, *args, **kwargs)
+
+    data = peer_input.Input(E=E, nu=NU, Gc=GC, l=ell, degradation="isotropic",
+                            split_energy="no", degradation_function="quadratic",
+                            irreversibility="miehe", fatigue=False, k=K,
+                            save_solution_xdmf=False, save_solution_vtu=False,
+                            results_folder_name=str(folder / "results"))
+    peer.compute_total_energies = converged
+    t0 = time.perf_counter()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):  # its "deleted ..." lines
+            peer.solve(data, specimen.mesh, float(len(loads)), specimen.V, specimen.A,
+                       bc_list_u=specimen.bcs, bc_list_phi=[specimen.precrack],
+                       update_boundary_conditions=move_top, dt=1.0, path=str(folder),
+                       bcs_list_u_names=["bottom", "top", "top_x"],
+                       max_stagger_iter=10000, stagger_error_tol=TOL)
+    finally:
+        peer.compute_total_energies = energies
+        dolfinx.log.set_log_level(dolfinx.log.LogLevel.WARNING)  # it leaves INFO
+    seconds = time.perf_counter() - t0
+    force, tips, dissipated = [], [], []
+    for u, phi, _ in states:  # its states, measured as ours are
+        specimen.u.x.array[:] = u
+        specimen.alpha.x.array[:] = phi
+        force.append(specimen.force())
+        tips.append(specimen.tip())
+        dissipated.append(specimen.dissipated_energy())
+    stagger = np.loadtxt(folder / "results" / "phasefieldx.conv", skiprows=1, ndmin=2)
+    return summary(specimen, loads, force, tips, dissipated, seconds, scheme="phasefieldx",
+                   staggered_iterations=stagger[:, 1].astype(int).tolist())
+
+
+def compare(ell, steps, final):
+    loads = np.linspace(0.0, final, steps + 1)[1:]
+    rows = [ours(ell, loads, "none"), ours(ell, loads, "anderson")]
+    with tempfile.TemporaryDirectory() as warm, tempfile.TemporaryDirectory() as run:
+        phasefieldx(ell, loads[:1], Path(warm))
+        rows.append(phasefieldx(ell, loads, Path(run)))
+    for r in rows:
+        r["ell"], r["steps"] = ell, steps
+        its = (sum(r["alternate_iterations"]) if "alternate_iterations" in r
+               else sum(r["staggered_iterations"]))
+        say(f"ell = {ell}: {r['scheme']:11s} {r['time_s']:7.2f} s, {its:5d} iterations, peak "
+            f"{r['peak_force']:.4f} kN at {r['peak_displacement']:.4g} mm, tip "
+            f"({r['final_tip'][0]:.3f}, {r['final_tip'][1]:.3f}), D {r['dissipated_energy']:.5g}")
+    return rows
+
+
+def table(out):
+    lines = ["| ell (mm) | solver | iterations | time (s) | peak force (kN) | at U (mm) "
+             "| final tip | dissipated (kN mm/mm) |", "|---|---|---|---|---|---|---|---|"]
+    for r in out["rows"]:
+        its = (f"{sum(r['alternate_iterations'])} alternate" if "alternate_iterations" in r
+               else f"{sum(r['staggered_iterations'])} staggered")
+        name = {"none": "ours, plain", "anderson": "ours, Anderson"}.get(r["scheme"],
+                                                                         "phasefieldx")
+        lines.append(f"| {r['ell']:g} | {name} | {its} | {r['time_s']:.1f} | "
+                     f"{r['peak_force']:.4f} | {r['peak_displacement']:.4g} | "
+                     f"({r['final_tip'][0]:.3f}, {r['final_tip'][1]:.3f}) | "
+                     f"{r['dissipated_energy']:.5g} |")
+    lines.append("")
+    lines.append(f"Miehe's notched square in tension, AT2 without split, the same mesh "
+                 f"(h = ell/2 where the crack goes), pre-crack and {out['rows'][0]['steps']} "
+                 f"equal steps; phasefieldx {out['peer_version']} (its history field) against "
+                 f"ours (the damage bounded); times of the load loop, "
+                 f"{out['machine']['cores']} cores, 1 rank.")
+    return "\n".join(lines)
+
+
+def main():
+    args = options(__doc__, "ell = 0.05 mm only, nothing written")
+    out = {"machine": machine(), "peer_version": version("phasefieldx"), "rows": []}
+    for ell in (0.05,) if args.quick else (0.05, 0.03):
+        out["rows"] += compare(ell, 13, 6.5e-3)
+    publish("damage_peer", out, table, args, say)
+
+
+main()
