@@ -130,15 +130,20 @@ class Demos:
     def json(self, name, *args, ranks=1) -> dict:
         """Run demos/`name` with `args` and return its JSON.
 
-        In a test that compares ranks (spawns_mpi), the serial reference is a serial run
-        with the same arguments made earlier in this session, by such a test (the 2- and
-        3-rank tests of a scene share one) or by the serial suite, which ran just before
-        on both cores: its runs are kept in pytest's cache under the digest of the library
-        and the demos, so a reference is never one of other code.
+        A serial run is made once per code: two tests that ask for the same serial run
+        (a scene's test and its notebook's, whose script run has the page's flags; a test
+        of ranks, whose serial reference the serial suite ran just before on both cores)
+        share it. Runs are kept in this process and in pytest's cache (the other xdist
+        worker's, an earlier session's) under the digest of the library, the demos and the
+        pins, so a shared run is never one of other code; one that writes files (--png,
+        --output, checkpoints) is not shared.
         """
         key = (name, *map(str, args))
         cache_key = f"fenics_nl/serial/{SOURCE_DIGEST}/{'_'.join(key)}"
-        if self.spawns_mpi and ranks == 1:
+        shared = ranks == 1 and not any(
+            str(a).startswith(("--png", "--plot", "--output", "--checkpoint", "--restart"))
+            for a in args)
+        if shared:
             if key in _serial_references:
                 return copy.deepcopy(_serial_references[key])
             kept = self.cache.get(cache_key, None)
@@ -147,11 +152,8 @@ class Demos:
         out = self.tmp_path / f"{Path(name).stem}{next(_runs)}.json"
         self.run([name, *args, "--json", out], ranks=ranks)
         result = json.loads(out.read_text())
-        if ranks == 1 and not any(
-                str(a).startswith(("--png", "--plot", "--output", "--checkpoint", "--restart"))
-                for a in args):
-            if self.spawns_mpi:
-                _serial_references[key] = copy.deepcopy(result)
+        if shared:
+            _serial_references[key] = copy.deepcopy(result)
             self.cache.set(cache_key, result)
         return result
 
