@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from notebooks import SMALL
+from test_friction import BRACKET_ON_FLOOR
 
 
 def test_newton_scalar_orders(tmp_path, demo):
@@ -466,12 +468,15 @@ def test_bracket_iterative_solver_matches_direct(demo):
     assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-7)
 
 
-@pytest.mark.parametrize("support", ["clamped", "contact"])
+# the serial runs the serial suite makes (the clamped bracket's page, the bracket on its floor
+# of tests/test_friction.py): their answers are the references
+@pytest.mark.parametrize("args", [tuple(SMALL["bracket.py"]), BRACKET_ON_FLOOR],
+                         ids=["clamped", "contact"])
 @pytest.mark.spawns_mpi
-def test_bracket_two_ranks_match_serial(support, demo):
+def test_bracket_two_ranks_match_serial(args, demo):
     # 20 mm elements (11.6k unknowns): the partition still cuts the holes and the floor
-    s = demo.bracket("--support", support, "--size", "20")
-    p = demo.bracket("--support", support, "--size", "20", ranks=2)
+    s = demo.bracket(*args)
+    p = demo.bracket(*args, ranks=2)
     assert p["ranks"] == 2 and p["dofs"] == s["dofs"]
     assert p["load_point_displacement"] == pytest.approx(s["load_point_displacement"], rel=1e-8)
     for group, r in s["reactions"].items():
