@@ -24,6 +24,11 @@ def test_a_notched_square_in_tension_breaks_straight_and_dissipates_the_mesh_tou
     assert d["crack_straightness"] <= d["h"] / 2 + 1e-12  # its tip stays on the band
     assert d["mesh_toughness"] == pytest.approx(mesh_toughness(d), rel=1e-12)
     assert d["dissipated_energy_per_width"] == pytest.approx(d["mesh_toughness"], rel=0.01)
+    assert d["dissipated_energy_per_width_rel_error"] == pytest.approx(
+        d["dissipated_energy_per_width"] / d["mesh_toughness"] - 1, rel=1e-12)
+    # (D_end − D_1)/Δa: low by the damage ahead of the notch's tip, about Gc ell
+    assert d["energy_release_rate_rel_error"] == pytest.approx(
+        d["energy_release_rate"] / d["mesh_toughness"] - 1, rel=1e-12)
     F = d["force_history"]
     k = F.index(max(F))
     assert 0 < k < len(F) - 1 and d["peak_force"] == F[k]
@@ -50,11 +55,13 @@ def test_a_notched_square_in_shear_cracks_downwards(demo):
     assert y < 0.5 - 2 * d["h"]
     assert all(b[1] <= a[1] + 1e-12 for a, b in itertools.pairwise(d["crack_tip_history"]))
     assert d["force_history"][-1] < 0.02 * d["peak_force"]
+    # its length, and so its release rate, are not measured (it turns within a step)
+    assert d["energy_release_rate"] is None and d["crack_straightness"] is None
 
 
 def test_a_surfing_crack_in_the_demo_dissipates_the_mesh_toughness(demo):
-    # the demo's defaults (AT1, ell = 0.03 mm, h = ell/2, 13 steps of 2h): 2 dD/da against
-    # Gc (1 + 2h/(c_w ell)) (a crack on the strip's symmetry line): -0.8 %, 2 % asked
+    # the demo's defaults (AT1, ell = 0.03 mm, h = ell/2, 13 positions 2h apart): 2 dD/da
+    # against Gc (1 + 2h/(c_w ell)) (a crack on the strip's symmetry line): -1.4 %, 2 % asked
     d = demo.json("crack.py", "--test", "surfing")
     assert d["mesh_toughness"] == pytest.approx(2.7e-3 * (1 + 2 * 0.015 / (8 / 3 * 0.03)),
                                                 rel=1e-12)
@@ -69,6 +76,9 @@ def test_a_surfing_crack_in_the_demo_dissipates_the_mesh_toughness(demo):
     (["--Gc", "-1"], "--Gc"),
     (["--test", "bend"], "--test"),
     (["--ell", "0.05", "--steps", "1"], "--steps"),
+    (["--resolution", "0.5"], "--resolution"),
+    (["--test", "surfing", "--displacement", "0.01"], "moves its K-field"),
+    (["--test", "surfing", "--steps", "30"], "the strip holds 14 positions"),
 ])
 def test_crack_bad_input_is_one_line(demo, args, words):
     proc = demo.run(["crack.py", *args], check=False)

@@ -57,7 +57,7 @@ class GradientDamage(Isotropic):
         if self.split not in SPLITS:
             raise ValueError(f"split must be none or volumetric, got {self.split!r}")
         if not 0 <= self.residual_stiffness < 1:
-            raise ValueError(f"residual stiffness must be in [0, 1), got "
+            raise ValueError(f"residual_stiffness must be in [0, 1), got "
                              f"{self.residual_stiffness!r}")
 
     @property

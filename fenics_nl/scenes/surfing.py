@@ -77,7 +77,7 @@ class Surfing:
         self.law, self.notch = law, notch
         self.h = h = law.ell / resolution
         xs = h * np.arange(round(length / h) + 1)  # steps of h: the field moves by whole cells
-        length = xs[-1]
+        self.length, self.height = length, height = xs[-1], height
         ys = graded_axis(height, h, (0.0, band * law.ell), through=0.0)
         self.mesh = msh = graded_rectangle(comm, xs, ys)
         self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
