@@ -872,6 +872,8 @@ def test_a_damage_case_follows_the_homogeneous_closed_form(demo):
     law = AT2(210000.0, 0.0, Gc=2.7, ell=0.1, residual_stiffness=1e-6)
     d = demo.case(CASES / "damage_strip.toml")
     assert d["law"] == "at2" and d["warnings"] == [] and len(d["steps"]) == 4
+    # the work: the u-solves' factorizations and one per damage SNES iteration
+    assert d["factorizations"] >= sum(s["damage_iterations"] for s in d["steps"]) > 0
     for s in d["steps"]:
         eps = s["load_factor"] * 0.0118 / 2.0
         alpha, sigma = law.homogeneous_damage(eps), law.homogeneous_stress(eps)

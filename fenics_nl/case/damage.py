@@ -16,7 +16,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateResult
-from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.result import SolveResult
 
 __all__ = ["DamageSteps", "cell_sizes"]
 
@@ -51,7 +51,7 @@ class DamageSteps:
         self.alpha.x.array[:] = self.lower.x.array  # a cut step leaves no damage behind
         t0 = time.perf_counter()
         self.last = self.alternate.solve()
-        return SolveResult(True, "converged", self.last.newton_iterations, [], WorkCounts(),
+        return SolveResult(True, "converged", self.last.newton_iterations, [], self.last.work,
                            wall_time=time.perf_counter() - t0)
 
     def dissipated_energy(self) -> float:

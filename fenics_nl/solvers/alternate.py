@@ -24,6 +24,7 @@ from petsc4py import PETSc
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.acceleration import accelerator
 from fenics_nl.solvers.newton import NewtonSolver
+from fenics_nl.solvers.result import WorkCounts
 from fenics_nl.solvers.snes import solver_options
 
 __all__ = ["AlternateMinimization", "AlternateResult", "AlternateWork"]
@@ -38,6 +39,9 @@ class AlternateResult:
     damage_iterations: int
     change: float  # the last iteration's max |Δα|
     rejected: int = 0  # accelerated iterates that did not lower the energy
+    # the u-solves' counts (NewtonSolver's), and the damage solves': each SNES VI iteration
+    # assembles the Jacobian and factorizes it (LU) once
+    work: WorkCounts = field(default_factory=WorkCounts)
 
 
 @dataclass
@@ -150,16 +154,20 @@ class AlternateMinimization:
         plain = None  # (G(α_k), E(u_k, G(α_k))) while an accelerated α is on trial
         for k in range(1, self.max_it + 1):
             counts.iterations = k
-            counts.newton_iterations += displacement.solve().iterations
+            self._count_u(counts, displacement.solve())
             if plain is not None and self._energy() > plain[1]:
                 self.alpha.x.array[:] = plain[0]  # rejected: back to the plain iterate
                 self.accelerate.reset()
                 counts.rejected += 1
-                counts.newton_iterations += displacement.solve().iterations
+                self._count_u(counts, displacement.solve())
             if k == 1 and not self._user_atol:  # once per step: its first u's driving force
                 snes.setTolerances(atol=self._damage_atol())
             before = self.alpha.x.array.copy()
-            counts.damage_iterations += self._minimize_damage(k)
+            its = self._minimize_damage(k)
+            counts.damage_iterations += its
+            counts.work.tangent_assemblies += its
+            counts.work.factorizations += its
+            counts.work.linear_solves += its
             counts.change = self.alpha.function_space.mesh.comm.allreduce(
                 float(np.abs(self.alpha.x.array - before).max(initial=0.0)), op=MPI.MAX)
             if counts.change < self.tol:
@@ -171,6 +179,11 @@ class AlternateMinimization:
                 self.alpha.x.array[:] = np.clip(moved, self.lower.x.array, 1.0)
         raise SolveError(f"alternate minimization did not converge in {self.max_it} "
                          f"iterations (last max |Δα| = {counts.change:.3g})")
+
+    @staticmethod
+    def _count_u(counts: AlternateResult, result) -> None:
+        counts.newton_iterations += result.iterations
+        counts.work.add(result.work)
 
     def _minimize_damage(self, k: int) -> int:
         """α at fixed u within the bounds (SNES VI): its iterations."""
