@@ -22,13 +22,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
 from fenics_nl.domain.graded_grid import graded_axis, graded_rectangle
-from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
+from fenics_nl.scenes.cracked_plate import CrackedPlate, CrackRecord
 
 __all__ = ["TESTS", "NotchedSpecimen", "SpecimenRecord"]
 
@@ -36,18 +35,15 @@ TESTS = ("tension", "shear")
 
 
 @dataclass
-class SpecimenRecord(AlternateWork):
-    """Every converged step: the top's displacement and force, the tip, the dissipated energy.
+class SpecimenRecord(CrackRecord):
+    """Every converged step: the top's displacement and force, the tip.
 
-    `damage` keeps each step's damage (this rank's array) for the pictures; the solves'
-    work is counted as `AlternateWork`'s.
+    And `CrackRecord`'s: the dissipated energy, the damage, the work.
     """
 
     displacement: list[float] = field(default_factory=list)
     force: list[float] = field(default_factory=list)  # per unit thickness, along the motion
     tip: list[list[float]] = field(default_factory=list)
-    dissipated_energy: list[float] = field(default_factory=list)
-    damage: list[np.ndarray] = field(default_factory=list, repr=False)
 
     def crack_extension(self) -> list[float]:
         """The length of the tip's path from the first step, step by step (a polyline)."""
@@ -66,7 +62,7 @@ class SpecimenRecord(AlternateWork):
         return (self.dissipated_energy[-1] - self.dissipated_energy[0]) / extension[-1]
 
 
-class NotchedSpecimen:
+class NotchedSpecimen(CrackedPlate):
     """The notched square of a `GradientDamage` law, its supports, crack and solver.
 
     Args:
@@ -80,37 +76,24 @@ class NotchedSpecimen:
             its last digits changing the dissipated energy by less than 1e-5 relative).
     """
 
-    MODEL = "plane_strain"
-
     def __init__(self, law, test: str = "tension", *, side: float = 1.0,
                  resolution: float = 2.0, band: float = 3.0, acceleration: str = "anderson",
                  tol: float = 1e-6, comm: MPI.Comm = MPI.COMM_WORLD):
         if test not in TESTS:
             raise ValueError(f"test must be tension or shear, got {test!r}")
-        self.law, self.test, self.side = law, test, side
+        self.test, self.side = test, side
         self.h = h = law.ell / resolution
         a, width = side / 2, band * law.ell
         self.notch_tip = np.array([a, a])
         xs = graded_axis(side, h, (a - width, side), through=a)
         low = a - width if test == "tension" else 0.0
         ys = graded_axis(side, h, (low, a + width), through=a - h / 2)  # rows at a ± h/2
-        self.mesh = msh = graded_rectangle(comm, xs, ys)
-        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
-        self.A = A = fem.functionspace(msh, ("Lagrange", 1))
-        self.u = fem.Function(V, name="displacement")
-        self.alpha = fem.Function(A, name="damage")
-        self.energy = law.energy(self.u, self.alpha, self.MODEL) * ufl.dx
-        self.bcs = self._supports()
-        cracked = fem.locate_dofs_geometrical(
-            A, lambda x: (np.abs(x[1] - a) <= 0.5001 * h) & (x[0] <= a + 1e-9 * side))
-        self.alpha.x.array[cracked] = 1.0
-        self.precrack = fem.dirichletbc(1.0, cracked, A)
-        self.solver = AlternateMinimization(
-            self.energy, self.u, self.alpha, self.bcs, damage_bcs=[self.precrack],
-            force_scale=law.critical_stress * h, damage_scale=law.Gc / law.ell * h * h,
-            tol=tol, max_it=2000, acceleration=acceleration)
+        self._plate(law, graded_rectangle(comm, xs, ys),
+                    lambda x: (np.abs(x[1] - a) <= 0.5001 * h) & (x[0] <= a + 1e-9 * side))
+        self._solver(self._supports(), law.critical_stress * h, tol=tol, max_it=2000,
+                     acceleration=acceleration)
         self._residual = fem.form(self.solver.residual_u)
-        self._fracture = fem.form(law.fracture_energy(self.alpha) * ufl.dx)
+        A = self.A
         n = A.dofmap.index_map.size_local
         self._x = A.tabulate_dof_coordinates()[:n, :2]
         self._ahead = self._x[:, 0] > a + 1e-9 * side  # the tip is looked for off the notch
@@ -139,13 +122,10 @@ class NotchedSpecimen:
         g = self._top_bc.g
         for k, U in enumerate(displacements):
             g.x.array[:] = U
-            record.count(self.solver.solve())
-            self.solver.commit()
+            self._step(record)
             record.displacement.append(float(U))
             record.force.append(self.force())
             record.tip.append(self.tip())
-            record.dissipated_energy.append(self.dissipated_energy())
-            record.damage.append(self.alpha.x.array.copy())
             if progress:
                 progress(k, record)
         return record
@@ -180,12 +160,3 @@ class NotchedSpecimen:
             {"sides": self.sides} if self.test == "shear" else {})
         return boundary.reactions(self._residual, self.u, groups)
 
-    def dissipated_energy(self) -> float:
-        """∫ (Gc/c_w)(w(α)/ell + ell |∇α|²), per unit thickness (collective)."""
-        return self.mesh.comm.allreduce(fem.assemble_scalar(self._fracture), op=MPI.SUM)
-
-    @property
-    def dofs(self) -> int:
-        """Unknowns: the displacement's and the damage's."""
-        return (self.V.dofmap.index_map.size_global * 2
-                + self.A.dofmap.index_map.size_global)

@@ -27,32 +27,28 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
 from fenics_nl.domain.graded_grid import graded_axis, graded_rectangle
-from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
+from fenics_nl.scenes.cracked_plate import CrackedPlate, CrackRecord
 
 __all__ = ["Surfing", "SurfingRecord"]
 
 
 @dataclass
-class SurfingRecord(AlternateWork):
-    """Every converged step: the field's centre, the crack tip, the dissipated energy.
+class SurfingRecord(CrackRecord):
+    """Every converged step: the field's centre and the crack tip.
 
-    `damage` keeps each step's damage (this rank's array) for the pictures; the solves'
-    work is counted as `AlternateWork`'s.
+    And `CrackRecord`'s: the half strip's dissipated energy, the damage, the work.
     """
 
     centre: list[float] = field(default_factory=list)
     tip: list[float] = field(default_factory=list)
-    dissipated_energy: list[float] = field(default_factory=list)  # of the half strip
-    damage: list[np.ndarray] = field(default_factory=list, repr=False)  # this rank's
 
 
-class Surfing:
+class Surfing(CrackedPlate):
     """The half strip of a `GradientDamage` law (plane strain), its K-field and its crack.
 
     Args:
@@ -68,41 +64,27 @@ class Surfing:
             load is about 0.92 of that toughness.
     """
 
-    MODEL = "plane_strain"
-
     def __init__(self, law, *, length: float = 1.0, height: float = 0.3, notch: float = 0.3,
                  resolution: float = 4.0, band: float = 3.0, load: float = 1.0,
                  toughness: float | None = None, acceleration: str = "none",
                  comm: MPI.Comm = MPI.COMM_WORLD):
-        self.law, self.notch = law, notch
+        self.notch = notch
         self.h = h = law.ell / resolution
         xs = h * np.arange(round(length / h) + 1)  # steps of h: the field moves by whole cells
         self.length, self.height = length, height = xs[-1], height
         ys = graded_axis(height, h, (0.0, band * law.ell), through=0.0)
-        self.mesh = msh = graded_rectangle(comm, xs, ys)
-        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
-        self.A = A = fem.functionspace(msh, ("Lagrange", 1))
-        self.u = fem.Function(V, name="displacement")
-        self.alpha = fem.Function(A, name="damage")
-        self.energy = law.energy(self.u, self.alpha, self.MODEL) * ufl.dx
+        msh = graded_rectangle(comm, xs, ys)
+        self._plate(law, msh, lambda x: np.isclose(x[1], 0.0) & (x[0] <= notch + 1e-9 * length))
+        V, A = self.V, self.A
         bottom = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[1], 0.0))
         symmetry = boundary.component(V, 1, bottom)
         outer = fem.locate_dofs_geometrical(V, lambda x: (x[1] > 1e-12 * height) & (
             np.isclose(x[0], 0.0) | np.isclose(x[0], length) | np.isclose(x[1], height)))
         self.g = fem.Function(V)
-        self.bcs = [symmetry, fem.dirichletbc(self.g, outer)]
-        cracked = fem.locate_dofs_geometrical(
-            A, lambda x: np.isclose(x[1], 0.0) & (x[0] <= notch + 1e-9 * length))
-        self.alpha.x.array[cracked] = 1.0
-        precrack = fem.dirichletbc(1.0, cracked, A)
-        E, nu = law.E, law.nu
         self.toughness = toughness or law.Gc * (1 + h / (law.c_w * law.ell))
-        self.K = math.sqrt(load * self.toughness * E / (1 - nu**2))
-        self.solver = AlternateMinimization(
-            self.energy, self.u, self.alpha, self.bcs, damage_bcs=[precrack],
-            force_scale=self.K * math.sqrt(h), damage_scale=law.Gc / law.ell * h * h,
-            acceleration=acceleration)  # its lower bound: α now, the pre-crack at 1
-        self._fracture = fem.form(law.fracture_energy(self.alpha) * ufl.dx)
+        self.K = math.sqrt(load * self.toughness * law.E / (1 - law.nu**2))
+        self._solver([symmetry, fem.dirichletbc(self.g, outer)], self.K * math.sqrt(h),
+                     acceleration=acceleration)
         n = A.dofmap.index_map.size_local
         x = A.tabulate_dof_coordinates()[:n]
         self._path = np.flatnonzero(np.isclose(x[:, 1], 0.0))
@@ -126,12 +108,9 @@ class Surfing:
         record = SurfingRecord()
         for k, centre in enumerate(centres):
             self.k_field(centre)
-            record.count(self.solver.solve())
-            self.solver.commit()
+            self._step(record)
             record.centre.append(float(centre))
             record.tip.append(self.tip())
-            record.dissipated_energy.append(self.dissipated_energy())
-            record.damage.append(self.alpha.x.array.copy())
             if progress:
                 progress(k, record)
         return record
@@ -142,15 +121,6 @@ class Surfing:
         local = float(self._path_x[a >= level].max(initial=-np.inf))
         return self.mesh.comm.allreduce(local, op=MPI.MAX)
 
-    def dissipated_energy(self) -> float:
-        """∫ (Gc/c_w)(w(α)/ell + ell |∇α|²) over the half strip (per unit thickness)."""
-        return self.mesh.comm.allreduce(fem.assemble_scalar(self._fracture), op=MPI.SUM)
-
-    @property
-    def dofs(self) -> int:
-        """Unknowns: the displacement's and the damage's."""
-        return (self.V.dofmap.index_map.size_global * 2
-                + self.A.dofmap.index_map.size_global)
 
 
 def release_rate(record: SurfingRecord, skip: int) -> tuple[float, float]:
