@@ -123,13 +123,7 @@ if args.test == "surfing":
     body = Surfing(law, resolution=args.resolution, acceleration=args.acceleration,
                    toughness=args.Gc * (1 + 2 * h / (law.c_w * args.ell)))
     mesh_toughness = body.toughness
-    # the field's centre stays a strip's height from its end: the K-field is the far field
-    room = int((body.length - body.height - body.notch) / (2 * body.h)) + 1
-    if args.steps > room:
-        raise ValueError(f"--steps: the strip holds {room} positions of the field 2h apart "
-                         f"at ℓ/h = {args.resolution:g} (its centre {body.height:g} mm from "
-                         f"the end at most)")
-    loads = body.notch + 2 * body.h * np.arange(args.steps)
+    loads = body.centres(args.steps, flag="--steps")
 else:
     body = NotchedSpecimen(law, args.test, resolution=args.resolution,
                            acceleration=args.acceleration)

@@ -90,6 +90,19 @@ class Surfing(CrackedPlate):
         self._path = np.flatnonzero(np.isclose(x[:, 1], 0.0))
         self._path_x = x[self._path, 0]
 
+    def centres(self, count: int, flag: str = "count") -> np.ndarray:
+        """`count` positions of the field's centre, 2h apart from the notch's tip.
+
+        The centre stays a strip's height from its end (the K-field is the far field); more
+        positions than the strip holds are a ValueError naming `flag`.
+        """
+        room = int((self.length - self.height - self.notch) / (2 * self.h)) + 1
+        if count > room:
+            raise ValueError(f"{flag}: the strip holds {room} positions of the field 2h "
+                             f"apart at ell/h = {self.law.ell / self.h:g} (its centre "
+                             f"{self.height:g} from the end at most)")
+        return self.notch + 2 * self.h * np.arange(count)
+
     def k_field(self, centre: float) -> None:
         """Irwin's mode-I displacement around a tip at (centre, 0) into the boundary data."""
         E, nu, K = self.law.E, self.law.nu, self.K
