@@ -159,6 +159,7 @@ class ActiveSetContact:
                                       normal_sign=normal_sign,
                                       unknown_space=u.function_space)
         self.comm = self.surface.comm
+        self.initial = initial
         self.active = self._initial_set(initial)
         self.force = 0.0  # total normal contact force of the last solve (compression > 0)
         opts = {"method": "full", "rtol": 1e-10, "max_it": 50, **(newton_options or {})}
@@ -219,6 +220,11 @@ class ActiveSetContact:
     def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
         """New obstacle position (a load step); the active set is kept as a warm start."""
         self.surface.set_gap(gap)  # the formulation reads γ at its next set_active
+
+    def restart(self) -> None:
+        """The initial set again, for the current gap and u (a new load path from rest)."""
+        self.active = self._initial_set(self.initial)
+        self.force = 0.0
 
     def add_penetrating(self) -> None:
         """Warm start for a new load: the current set, plus every node now penetrating."""

@@ -14,7 +14,9 @@ It is written in UFL, so σ = ∂ψ/∂ε (the minimiser's own variation vanishe
 return-mapped stress) and the consistent tangent ∂²ψ/∂ε∂ε both come from UFL, not typed.
 
 The state is updated only by `commit(u)`, when a load step has converged: a cut step leaves
-it as it was, so there is nothing to restore. `bind(mesh, degree)` creates it; the residual
+it as it was, so there is nothing to restore. E, σ0, H and C may be `fem.Constant`s (checked
+at their current values): one compiled form then serves every value, and a parameter's
+derivative is taken by UFL (`solvers.sensitivity`, the identification of a material). `bind(mesh, degree)` creates it; the residual
 must then integrate with `kinematics.quadrature_measure("dx", mesh, degree)`, the same rule.
 """
 
@@ -130,6 +132,15 @@ class J2Plasticity(Isotropic, SmallStrain):
         """The committed state's quadrature Functions by name (to checkpoint and restore)."""
         st = self._bound()
         return {"plastic_strain": st.eps_p, "cumulated_plastic_strain": st.p}
+
+    def state_update(self, strain) -> dict:
+        """The state `commit` would store for `strain`, by the names of `state_functions` (UFL).
+
+        What a sensitivity differentiates: the new state as a function of the strain, the
+        committed state and the parameters.
+        """
+        eps_p, p, _ = self.return_map(strain)
+        return {"plastic_strain": eps_p, "cumulated_plastic_strain": p}
 
     def output_fields(self) -> list:
         """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0."""

@@ -4,7 +4,9 @@ Models: ``axisymmetric`` (r, z), ``3d`` (quarter block, symmetry planes x = 0 an
 ``plane_strain`` (half block, symmetry x = 0; a cylinder). The block's top z = 0 (y = 0 in
 2D) is the candidate contact surface S_C, its bottom slides on a rigid base (vertical
 displacement 0). The obstacle's gap along the outward normal +e_z is the parabola
-γ(r) = r²/(2R) − δ of Hertz's theory, or the exact sphere R − √(R² − r²) − δ.
+γ(r) = r²/(2R) − δ of Hertz's theory, the exact sphere R − √(R² − r²) − δ, or a cone of
+half-angle α, r cot α − δ (Sneddon's; instrumented indentation's Berkovich tip is the cone of
+70.3°, `BERKOVICH`).
 
 Sizes are set from the expected contact radius a = √(Rδ): element size h = a/(20·2^refine)
 (plane strain a/(40·2^refine), 3D a/(6·2^refine)) within 1.5a of the axis, growing linearly
@@ -51,6 +53,8 @@ __all__ = [
 ]
 
 MODELS = ("axisymmetric", "3d", "plane_strain")
+SHAPES = ("parabola", "sphere", "cone")
+BERKOVICH = 70.3  # the half-angle of the cone of the Berkovich tip's area function (degrees)
 MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
 FEW_NODES = 10  # below this, a and p0 are coarse: say so
 
@@ -106,7 +110,7 @@ class PunchBlock:
     `a` is the expected contact radius. Everything a residual is written with is public:
     `u`, `V`, `kinematics` (the strain model), `dx` (of degree 2·`degree`, exact for the
     linear law) and `weight` (2πr in the axisymmetric model, else 1). `degree`: of the
-    displacement, P1 by default.
+    displacement, P1 by default. `quadrature_degree` of `dx`: 2·`degree` by default.
 
     `mixed=True`: the Taylor–Hood pair (u, p) of `materials.mixed` (P2–P1) on the same
     mesh; `unknown` is the Function a solver updates (u itself otherwise), `u` and `p` the
@@ -119,7 +123,8 @@ class PunchBlock:
 
     def __init__(self, model: str, a: float, *, refine: int = 1, block: float = 1000.0,
                  growth: float | None = None, mixed: bool = False, degree: int | None = None,
-                 tangential: bool = False, comm: MPI.Comm = MPI.COMM_WORLD):
+                 tangential: bool = False, quadrature_degree: int | None = None,
+                 comm: MPI.Comm = MPI.COMM_WORLD):
         if model not in MODELS:
             raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         if tangential and model == "axisymmetric":
@@ -144,7 +149,7 @@ class PunchBlock:
         self.kinematics = ("axisymmetric" if model == "axisymmetric"
                            else "3d" if dim == 3 else "plane_strain")
         self.weight = kinematics.measure_weight(self.mesh, self.kinematics)
-        self.quadrature_degree = 2 * degree
+        self.quadrature_degree = quadrature_degree or 2 * degree
         self.dx = kinematics.quadrature_measure("dx", self.mesh, self.quadrature_degree)
 
         def facets(name):
@@ -209,29 +214,40 @@ class Punch:
             acts through the contact conditions only.
         radius: the punch radius R.
         formulation: ``elimination`` or ``multiplier`` (see `ActiveSetContact`).
-        gap: ``parabola`` (Hertz's) or ``sphere`` (exact).
+        gap: ``parabola`` (Hertz's), ``sphere`` (exact) or ``cone`` (of `cone_angle`, the
+            radius then unused; axisymmetric and 3D).
+        cone_angle: the cone's half-angle α in degrees, in (0, 90).
         friction: Coulomb's coefficient f (`FrictionalContact`), or None: frictionless.
         newton_options: passed to the Newton solver of each active-set iteration.
     """
 
     def __init__(self, block: PunchBlock, material, residual, radius: float, *,
                  formulation: str = "elimination", gap: str = "parabola",
-                 friction: float | None = None, newton_options: dict | None = None):
+                 cone_angle: float = BERKOVICH, friction: float | None = None,
+                 newton_options: dict | None = None):
         if not radius > 0:
             raise ValueError(f"radius must be > 0, got {radius}")
-        if gap not in ("parabola", "sphere"):
-            raise ValueError(f"gap must be parabola or sphere, got {gap!r}")
+        if gap not in SHAPES:
+            raise ValueError(f"gap must be one of {', '.join(SHAPES)}, got {gap!r}")
+        if gap == "cone" and not (0 < cone_angle < 90):
+            raise ValueError(f"cone_angle must be in (0, 90) degrees, got {cone_angle!r}")
+        if gap == "cone" and block.model == "plane_strain":
+            raise ValueError("a cone is axisymmetric or 3D: use --model axisymmetric or 3d")
         self.block, self.material, self.residual = block, material, residual
         self.R, self.gap_shape = radius, gap
+        self.cot = 1 / math.tan(math.radians(cone_angle))  # the cone's slope
         self.model, self.mesh, self.bcs = block.model, block.mesh, block.bcs
         self.u = block.unknown  # the Function the active-set loop updates
         # the force scale of Newton's absolute tolerance: Hertz's force for the expected a
-        # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length)
+        # (sphere P = 4/3 E* a³/R; cylinder P = π E* a²/(4R) per unit length; cone
+        # P = π/2 E* a² cot α); E may be a fem.Constant (a parameter being identified)
         a, model = block.a, block.model
-        E_star = hertz.effective_modulus(material.E, material.nu)
+        E_star = hertz.effective_modulus(float(material.E), float(material.nu))
         force = (np.pi / 4 if model == "plane_strain" else 4 / 3) * E_star * a**3 / radius
         if model == "plane_strain":
             force /= a
+        if gap == "cone":
+            force = np.pi / 2 * E_star * a * a * self.cot
         opts = {"line_search": not material.is_linear,
                 "force_scale": force / self.block.symmetry_factor}
         if block.mixed and formulation == "elimination":  # a symmetric saddle point: MUMPS
@@ -259,6 +275,8 @@ class Punch:
         """γ(r) = the punch's height above the undeformed surface at distance r, minus δ."""
         R = self.R
         r = np.asarray(r, dtype=float)
+        if self.gap_shape == "cone":
+            return r * self.cot - delta
         if self.gap_shape == "parabola":
             return r**2 / (2 * R) - delta
         return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
@@ -456,9 +474,11 @@ class Punch:
 
     def hertz(self, state: Indentation) -> dict[str, float]:
         """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""
-        E, nu = self.material.E, self.material.nu
+        E, nu = float(self.material.E), float(self.material.nu)
         if self.model == "plane_strain":  # a cylinder: no force-indentation law to check
             return hertz.cylinder_from_force(E, nu, self.R, state.force)
+        if self.gap_shape == "cone":
+            return hertz.cone_from_indentation(E, nu, self.cot, state.indentation)
         return hertz.sphere_from_indentation(E, nu, self.R, state.indentation)
 
 

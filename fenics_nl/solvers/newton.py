@@ -525,6 +525,27 @@ class NewtonSolver:
         if out is not self.du:
             self.du.copy(out)
 
+    def assemble_exact_tangent(self, work: WorkCounts) -> None:
+        """Assemble K(u) at the current u (and factorize it if the solver would) for
+        `tangent_solve`: a converged solve's last tangent is that of the iterate before.
+
+        With `reuse_factorization` the factorization already made preconditions CG on it:
+        back-solves only. ValueError for a tangent kept for the solver's life (not K(u)).
+        """
+        if self.policy.for_life:
+            raise ValueError("a constant tangent for the solver's life is not K(u): "
+                             "tangent solves need method full, periodic, or initial tangents")
+        self._assemble_tangent(work)
+
+    def tangent_solve(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
+        """out = K⁻¹ rhs with the tangent of `assemble_exact_tangent` and the current rows.
+
+        `rhs` must be zero on the Dirichlet rows (a homogeneous problem). LinearSolveError
+        if the KSP fails.
+        """
+        self._linear_solve(rhs, work)
+        self.du.copy(out)
+
     def add_secant_pair(self, s: PETSc.Vec, y: PETSc.Vec) -> None:
         """BFGS: keep the pair of a correction, s = δu and y = δR.
 

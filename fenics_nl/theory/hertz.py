@@ -1,10 +1,14 @@
-"""Hertz's closed forms for a rigid indenter on an elastic half-space (frictionless)."""
+"""Hertz's closed forms for a rigid indenter on an elastic half-space (frictionless).
+
+And Sneddon's for a rigid cone, the other axisymmetric indenter of instrumented indentation.
+"""
 
 from __future__ import annotations
 
 import math
 
 __all__ = [
+    "cone_from_indentation",
     "cylinder_from_force",
     "effective_modulus",
     "pressure_profile",
@@ -39,6 +43,17 @@ def cylinder_from_force(E: float, nu: float, R: float, P: float) -> dict[str, fl
     Es = effective_modulus(E, nu)
     a = math.sqrt(4 * P * R / (math.pi * Es))
     return {"contact_radius": a, "max_pressure": 2 * P / (math.pi * a)}
+
+
+def cone_from_indentation(E: float, nu: float, cot: float, delta: float) -> dict[str, float]:
+    """Cone of slope cot α pressed by δ (Sneddon): P = 2 E* δ² tan α / π, a = 2 δ tan α / π.
+
+    The mean pressure P/(π a²) = E* cot α / 2 does not depend on δ (a cone is self-similar);
+    the pressure is infinite (logarithmically) at the tip: no peak pressure is given.
+    """
+    Es = effective_modulus(E, nu)
+    a = 2 * delta / (math.pi * cot)
+    return {"force": 2 * Es * delta**2 / (math.pi * cot), "contact_radius": a}
 
 
 def pressure_profile(p0: float, a: float, r):

@@ -1,0 +1,260 @@
+# # Identifying a material by indentation: J2 parameters from a load–depth curve
+#
+# `indentation.py` computes the curve $P(\delta)$ of a sphere pressed into a J2 block and
+# lifted off. Instrumented indentation runs this backwards: from a measured curve, find the
+# yield stress $\sigma_0$ and the hardening modulus $H$ of the material (the course's example,
+# after Constantinescu & Tardieu, 2001). This demo fits the model's curve to a measured one by
+# Levenberg–Marquardt, with the curve's derivatives with respect to the parameters computed
+# through the whole load path by direct differentiation, and says how well the curve
+# determines each parameter.
+#
+# ## Problem definition
+#
+# The model is `indentation.py`'s: an axisymmetric block, a rigid sphere (or a cone of
+# half-angle $\alpha$, `--cone-angle`; Berkovich tips are the cone of 70.3°), frictionless
+# contact solved by the course's active set, J2 plasticity with linear isotropic hardening
+# $\sigma_{eq} \le \sigma_0 + H p$ (optionally the kinematic modulus $C$ and $E$ as unknowns
+# too). It is loaded through the measured depths $\delta_1 < \dots < \delta_L$, then unloaded
+# through the rest: its force $P_k(\theta)$ at each measured depth, for the parameters
+# $\theta$. The fit minimises
+#
+# $$ \Phi(\theta) = \tfrac12 \sum_k \big(P_k(\theta) - P_k^{measured}\big)^2, \qquad
+#    \sigma_0 > 0,\ H \ge 0. $$
+#
+# Gauss–Newton needs $\partial P_k/\partial\theta$. At a converged step $n$, equilibrium
+# $R(u_n; \alpha_{n-1}, \theta) = 0$ with the committed internal variables $\alpha_{n-1}$
+# ($\varepsilon^p$, $p$) and the return map $\alpha_n = A(\varepsilon(u_n); \alpha_{n-1},
+# \theta)$ differentiate to
+#
+# $$ K_n\, \frac{du_n}{d\theta} = -\Big(\frac{\partial R}{\partial\theta}
+#    + \frac{\partial R}{\partial\alpha}\frac{d\alpha_{n-1}}{d\theta}\Big), \qquad
+#    \frac{d\alpha_n}{d\theta} = \frac{\partial A}{\partial u}\frac{du_n}{d\theta}
+#    + \frac{\partial A}{\partial\alpha}\frac{d\alpha_{n-1}}{d\theta}
+#    + \frac{\partial A}{\partial\theta}, $$
+#
+# with $du/d\theta = 0$ on the supports and on the step's contact nodes (held: Tardieu &
+# Constantinescu's sensitivity problem). $K_n$ is the step's converged tangent, already
+# factorized by the forward solve: each parameter costs one back-solve per step, not a
+# whole forward run as a finite difference would. Every derivative is UFL's.
+#
+# ## Implementation
+
+# +
+from dataclasses import dataclass
+from typing import ClassVar
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+from mpi4py import MPI
+
+from fenics_nl.io import cli
+from fenics_nl.io.parameters import Parameters, number, text
+from fenics_nl.scenes import identification_pictures
+from fenics_nl.scenes.identification import (
+    MeasuredCurve,
+    fit_curve,
+    initial_guess,
+    parse_names,
+    parse_values,
+    report,
+)
+from fenics_nl.scenes.indentation_test import IndentationTest
+
+# -
+
+# ### Parameters
+#
+# From the command line (`python demos/indentation_identification.py --help`); in a
+# notebook, the defaults: a synthetic experiment.
+
+# +
+FIT_MESH = {"block": 100.0, "growth": 0.2, "quadrature_degree": 1}  # see "The model" below
+
+
+@dataclass
+class Identification(Parameters):
+    """Identify J2 parameters (σ0, H; optionally E, C) from an indentation curve by
+    Levenberg–Marquardt with direct-differentiation sensitivities. Without --curve, a
+    synthetic experiment: a finer model's curve with noise. Units are the user's."""
+
+    EPILOG = ("PETSc options of the model's solver take the prefix "
+              "-punch_axisymmetric_elim_ (the KSP of each active-set iteration).")
+    OUTPUTS: ClassVar = {"plot": "the measured and identified curves, and the misfit over "
+                                 "(σ0, H) with the iterates (--map² more model runs)"}
+
+    curve: str | None = text(None, "the measured curve: a CSV file, a header line then depth, "
+                             "force per line (default: a synthetic experiment)",
+                             metavar="FILE.csv")
+    E: float = number(1.0, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-", above=-1, at_most=0.499)
+    radius: float = number(1.0, "the sphere's radius R", unit="length", above=0)
+    cone_angle: float | None = number(None, "a cone of this half-angle instead of the sphere "
+                                      "(Berkovich: 70.3)", unit="degree", above=0, at_most=89)
+    fit: str = text("sigma0,hardening", "the parameters to fit, among sigma0, hardening, E, "
+                    "kinematic", metavar="NAMES")
+    initial: str | None = text(None, "their starting values, in --fit's order (default: "
+                               "synthetic, a factor 2 off the truth; a curve, Tabor's "
+                               "σ0 = P/(3πa²), H = 5σ0, C = H)", metavar="VALUES")
+    true: str = text(None, "synthetic: the true SIGMA0,H (default 0.02E,0.1E)",
+                     metavar="SIGMA0,H")
+    depth: float | None = number(None, "synthetic: the deepest indentation (default 0.05 R; "
+                                 "cone: 0.05)", unit="length", above=0)
+    steps: int = number(6, "synthetic: loading depths (unloading: half as many, to half the "
+                        "depth)", at_least=2)
+    noise: float = number(0.01, "synthetic: the noise's standard deviation, a fraction of the "
+                          "largest force", unit="-", at_least=0, at_most=0.5)
+    seed: int = number(1, "synthetic: the noise's random seed", at_least=0)
+    refine: int = number(0, "the fit's mesh: h = a/(20·2^refine) under the indenter (the "
+                         "synthetic curve's: refine + 1)", at_least=0, at_most=4)
+    max_points: int = number(12, "a denser measured curve is resampled to this many depths per "
+                             "branch", at_least=3)
+    map: int = number(5, "--plot: the misfit map's model runs per axis (0: no map)",
+                      at_least=0, at_most=15)
+
+    def check(self):
+        self.names = parse_names(self.fit)
+        synthetic_only = [f for f in ("true", "depth") if getattr(self, f) is not None]
+        if self.curve is not None and synthetic_only:
+            raise ValueError(f"--{synthetic_only[0]} is for the synthetic experiment: drop it "
+                             "or --curve")
+        self.true_values = parse_values(self.true or f"{0.02 * self.E},{0.1 * self.E}",
+                                        "--true", ["sigma0", "hardening"])
+        self.initial_values = (parse_values(self.initial, "--initial", self.names)
+                               if self.initial is not None else None)
+
+
+args = cli.arguments(Identification, {"punch_axisymmetric_elim_": "KSP"})
+warnings = []
+# -
+
+# ### The measured curve
+#
+# A user's CSV file (units as they are: the parameters come out in the force's over the
+# depth's squared), or a synthetic experiment: the model's own curve **on a finer mesh**
+# (half the element size under the indenter) at the true parameters, with Gaussian noise of
+# `--noise` times the largest force, so that the fit does not invert its own discretisation.
+
+# +
+true = None
+if args.curve is not None:
+    measured = MeasuredCurve.read(args.curve, max_points=args.max_points)
+    if measured.resampled_from is not None:
+        warnings.append(f"the curve's {measured.resampled_from} points were resampled to "
+                        f"{len(measured.depth)} depths (--max-points {args.max_points})")
+else:
+    true = args.true_values
+    deepest = args.depth or 0.05 * (args.radius if args.cone_angle is None else 1.0)
+    n_load = args.steps
+    depths = np.concatenate([np.linspace(deepest / n_load, deepest, n_load),
+                             np.linspace(deepest, 0.5 * deepest, n_load // 2 + 1)[1:]])
+    experiment = IndentationTest(E=args.E, nu=args.nu, sigma0=true["sigma0"],
+                                 hardening=true["hardening"], max_depth=deepest,
+                                 radius=args.radius, cone_angle=args.cone_angle,
+                                 refine=args.refine + 1, differentiate=(), **FIT_MESH)
+    exact = experiment.run(depths, sensitivities=False).force
+    noise = args.noise * exact.max() * np.random.default_rng(args.seed).standard_normal(
+        len(depths))
+    measured = MeasuredCurve.from_arrays(depths, exact + noise)
+    cli.say(f"synthetic curve: {len(depths)} depths to {deepest:g}, {experiment.dofs} "
+            f"unknowns, noise {100 * args.noise:g} % of P_max = {exact.max():.4g}")
+    del experiment
+# -
+
+# ### The model
+#
+# The block under the indenter on the fit's mesh, with $E$, $\sigma_0$, $H$, $C$ as
+# `fem.Constant`s: one set of compiled forms for every run of the fit. The mesh is a compromise
+# measured for this demo: under the indenter $h = a/20$; the far field grows by 20 % per
+# element in a block of 100 contact radii, and one quadrature point per triangle. Its curve
+# is 0.3 % stiffer than one on a far field graded by 5 % (what `punch.py` uses): a model
+# error that a fit of a real curve would turn into about 3 % on σ0 (`benchmarks/
+# identification.py`); against the synthetic curve, made on the same far field, it cancels.
+
+# +
+model = IndentationTest(E=args.E, nu=args.nu, sigma0=1.0, hardening=0.0,
+                        max_depth=float(measured.depth.max()), radius=args.radius,
+                        cone_angle=args.cone_angle, refine=args.refine,
+                        differentiate=tuple(args.names), **FIT_MESH)
+initial = args.initial_values or (
+    {n: (2 * true[n] if n == "sigma0" else 0.5 * true[n]) if n in true else
+     {"E": args.E, "kinematic": 0.5 * true["hardening"]}[n] for n in args.names}
+    if true else initial_guess(measured, args.names, E=args.E, radius=args.radius,
+                               cone_angle=args.cone_angle))
+cli.known(dofs=model.dofs, ranks=MPI.COMM_WORLD.size)
+cli.say(f"model: {model.dofs} unknowns; fitting {', '.join(args.names)} from "
+        + ", ".join(f"{n} = {v:.4g}" for n, v in initial.items()))
+# -
+
+# ### The fit
+#
+# Each Levenberg–Marquardt iteration runs the model once from the virgin state through the
+# measured depths, with the sensitivities: the residuals $P_k - P_k^{measured}$ and their
+# Jacobian together. A step that would cross a bound goes 90 % of the way to it.
+
+fit = fit_curve(model, measured, args.names, initial, progress=cli.say)
+
+# ## What the fit says
+#
+# The parameters and their standard deviations from $s^2 (J^TJ)^{-1}$, $s$ the residual's
+# noise, and their correlation: $\sigma_0$ and $H$ trade against each other along the curve
+# (a higher yield stress with less hardening gives nearly the same forces), so the correlation
+# is close to $-1$ and $H$ is known less well than $\sigma_0$. A parameter whose standard
+# deviation would exceed half its value for a noise of 1 % of the largest force is *not
+# identifiable* from this curve: it is reported as such, not as a number.
+
+# +
+out = report(fit, args.names, measured)
+for n in args.names:
+    if out[n] is None:
+        warnings.append(f"{n} is not identifiable from this curve: 1 % noise would leave it "
+                        f"uncertain by {100 * out[f'{n}_spread_at_1_percent_noise']:.0f} %")
+        continue
+    line = f"{n} = {out[n]:.5g} ± {out[f'{n}_std']:.2g}"
+    if true and n in true:
+        out[f"true_{n}"] = true[n]
+        out[f"{n}_rel_error"] = out[n] / true[n] - 1
+        out[f"{n}_error_in_std"] = (out[n] - true[n]) / out[f"{n}_std"]
+        line += (f" (true {true[n]:.5g}: {100 * out[f'{n}_rel_error']:+.2f} %, "
+                 f"{out[f'{n}_error_in_std']:+.2f} standard deviations)")
+    cli.say(line)
+if "correlation" in out:
+    cli.say(f"σ0–H correlation {out['correlation']:+.4f}")
+cli.say(f"{fit.iterations} iterations, {fit.evaluations} model runs, "
+        f"{fit.wall_time:.3g} s ({fit.reason})")
+if not fit.converged:
+    warnings.append(f"the fit did not converge: {fit.reason}")
+# -
+
+# ## Outputs
+#
+# The JSON, and with `--plot` the measured curve (dots) and the identified one (line), as in
+# the course's figure, beside the misfit's contours over $(\sigma_0, H)$ with the iterates.
+
+# +
+out |= {"iterations": fit.iterations, "forward_solves": fit.evaluations,
+        "converged": fit.converged, "misfit": fit.misfit,
+        "iterates": [[float(v) for v in x] for x in fit.iterates],
+        "fitted_parameters": args.names,
+        "curve": {"depth": measured.depth.tolist(), "measured": measured.force.tolist(),
+                  "fitted": (measured.force + fit.residuals).tolist(),
+                  "initial": (measured.force + fit.initial_residuals).tolist()},
+        "synthetic": true is not None, "noise_level": args.noise if true else None,
+        "sensitivity_solves": model.sensitivity.work.linear_solves,
+        "stress_unit": "stress", "dofs": model.dofs, "ranks": MPI.COMM_WORLD.size,
+        "warnings": warnings}
+
+
+def draw():
+    """The curves, and the misfit map when σ0 and H are the fitted pair (collective)."""
+    pair = args.names == ["sigma0", "hardening"] and args.map > 0
+    grid = (identification_pictures.misfit_grid(model, measured, np.array(fit.iterates),
+                                                args.map) if pair else None)
+    identification_pictures.identification_figure(out, args.plot, grid,
+                                                  units=measured.units)
+
+
+cli.results(out, [draw] if args.plot else [])
+# -

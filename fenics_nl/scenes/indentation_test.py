@@ -1,0 +1,156 @@
+"""Instrumented indentation as a forward model: the load–depth curve of a J2 block, and its
+derivatives with respect to the law's parameters through the whole load path.
+
+A rigid sphere (radius R) or cone (half-angle α) is pressed into an axisymmetric J2 block
+(`punch.Punch`, the course's active set) through a list of depths, loading then unloading; the
+force P at each converged step is the curve. The law's parameters — E, σ0, the isotropic
+hardening H and the kinematic C — are `fem.Constant`s, so one compiled set of forms serves
+every run of an identification, and each run from the virgin state may carry the
+sensitivities dP/dθ by direct differentiation (`solvers.sensitivity`): for each parameter one
+solve per step with the step's converged tangent.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.scenes.punch import BERKOVICH, Indentation, Punch, PunchBlock
+from fenics_nl.solvers.result import WorkCounts
+from fenics_nl.solvers.sensitivity import PathSensitivity
+
+__all__ = ["PARAMETERS", "Curve", "IndentationTest"]
+
+# the parameters of the curve, by the name a user writes (CLI, JSON), and J2Plasticity's field
+PARAMETERS = {"sigma0": "sigma0", "hardening": "H", "E": "E", "kinematic": "C"}
+
+
+@dataclass
+class Curve:
+    """A computed load–depth curve: P at each depth, and dP/dθ for the parameters asked."""
+
+    depth: np.ndarray
+    force: np.ndarray  # the whole body's
+    derivatives: dict[str, np.ndarray] = field(default_factory=dict)  # dP/dθ by name
+    states: list[Indentation] = field(default_factory=list)
+    wall_time: float = 0.0
+
+
+class IndentationTest:
+    """The axisymmetric J2 block under a rigid sphere or cone, run through given depths.
+
+    Args:
+        E, nu, sigma0, hardening, kinematic: the law's starting values (`set` changes E,
+            σ0, H and C between runs, without recompiling anything).
+        max_depth: the deepest indentation, for the mesh: the contact radius it is graded
+            for is √(R δ) (sphere) or 2 δ tan α / π (cone, Sneddon's), with pile-up room.
+        radius: the sphere's radius R; `cone_angle`: a cone of this half-angle (degrees)
+            instead of the sphere.
+        refine, block: the block's mesh (`punch.PunchBlock`: h = a/(20·2^refine) under the
+            indenter, the block `block` contact radii deep and wide).
+        differentiate: the parameters whose dP/dθ a run with sensitivities carries.
+    """
+
+    def __init__(self, *, E: float, nu: float, sigma0: float, hardening: float,
+                 kinematic: float = 0.0, max_depth: float, radius: float = 1.0,
+                 cone_angle: float | None = None, refine: int = 0, block: float = 200.0,
+                 growth: float | None = None, quadrature_degree: int | None = None,
+                 differentiate: tuple[str, ...] = ("sigma0", "hardening"),
+                 comm: MPI.Comm = MPI.COMM_WORLD):
+        unknown = sorted(set(differentiate) - set(PARAMETERS))
+        if unknown:
+            raise ValueError(f"unknown parameter(s) {', '.join(unknown)}: the curve's "
+                             f"parameters are {', '.join(PARAMETERS)}")
+        if not max_depth > 0:
+            raise ValueError(f"the largest depth must be > 0, got {max_depth!r}")
+        if cone_angle is None:
+            a = math.sqrt(radius * max_depth)
+        else:
+            a = 2 * max_depth * math.tan(math.radians(cone_angle)) / math.pi
+        self.block = b = PunchBlock("axisymmetric", a, refine=refine, block=block,
+                                    growth=growth, quadrature_degree=quadrature_degree,
+                                    comm=comm)
+        values = {"E": E, "sigma0": sigma0, "hardening": hardening, "kinematic": kinematic}
+        self.constants = {k: fem.Constant(b.mesh, float(v)) for k, v in values.items()}
+        c = self.constants
+        # checked at their current values; later ones by `set`
+        self.material = J2Plasticity(c["E"], nu, sigma0=c["sigma0"], H=c["hardening"],
+                                     C=c["kinematic"])
+        self.material.bind(b.mesh, b.quadrature_degree)
+        residual = b.residual(self.material)
+        self.punch = Punch(b, self.material, residual, radius,
+                           gap="sphere" if cone_angle is None else "cone",
+                           cone_angle=cone_angle or BERKOVICH)
+        self.differentiate = tuple(differentiate)
+        self.sensitivity = PathSensitivity(
+            residual, b.u, self.punch.contact.newton, self.material.state_functions(),
+            self.material.state_update(kinematics.small_strain(b.u, b.kinematics)),
+            {k: c[k] for k in self.differentiate}) if differentiate else None
+        self.runs = 0  # forward runs, with or without sensitivities
+
+    @property
+    def work(self) -> WorkCounts:
+        """What the forward solves spent so far (the sensitivities count theirs apart)."""
+        return self.punch.contact.newton.total
+
+    @property
+    def dofs(self) -> int:
+        """Global number of unknowns of the block."""
+        return self.punch.dofs
+
+    def values(self) -> dict[str, float]:
+        """The parameters' current values by name."""
+        return {k: float(c.value) for k, c in self.constants.items()}
+
+    def set(self, **values: float) -> None:
+        """New parameter values (by name): E > 0, σ0 > 0, H >= 0, C >= 0."""
+        for name, value in values.items():
+            if name not in PARAMETERS:
+                raise ValueError(f"unknown parameter {name!r}: the curve's parameters are "
+                                 f"{', '.join(PARAMETERS)}")
+            low_ok = value > 0 if name in ("E", "sigma0") else value >= 0
+            if not (math.isfinite(value) and low_ok):
+                raise ValueError(f"{name} must be {'> 0' if name in ('E', 'sigma0') else '>= 0'}"
+                                 f" and finite, got {value!r}")
+            self.constants[name].value = float(value)
+
+    def run(self, depths, *, sensitivities: bool = True) -> Curve:
+        """P at each depth of the path from the virgin state, and dP/dθ if asked.
+
+        SolveError (from the active set or Newton) if a step does not converge.
+        """
+        t0 = time.perf_counter()
+        b, punch, material = self.block, self.punch, self.material
+        contact = punch.contact
+        b.unknown.x.array[:] = 0.0
+        material.reset()
+        contact.set_gap(punch.gap(0.0))
+        contact.restart()
+        sens = self.sensitivity if sensitivities else None
+        if sens is not None:
+            sens.reset()
+        curve = Curve(np.asarray(depths, dtype=float), np.zeros(len(depths)),
+                      {k: np.zeros(len(depths)) for k in (self.differentiate if sens else ())})
+        for n, delta in enumerate(curve.depth):
+            state = punch.indent(float(delta))
+            curve.states.append(state)
+            curve.force[n] = state.force
+            if sens is not None:
+                for name, dR in zip(sens.names, sens.step(), strict=True):
+                    curve.derivatives[name][n] = self._force_of(dR)
+            material.commit(b.u, b.kinematics)
+        self.runs += 1
+        curve.wall_time = time.perf_counter() - t0
+        return curve
+
+    def _force_of(self, reactions: np.ndarray) -> float:
+        """The whole body's contact force of the nodal reactions `reactions` (as P)."""
+        s = self.punch.contact.surface
+        return -self.block.symmetry_factor * s.total(s.sign * reactions[s.dofs_V])
