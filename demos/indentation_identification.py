@@ -236,7 +236,7 @@ if not fit.converged:
 # +
 out |= {"iterations": fit.iterations, "forward_solves": fit.evaluations,
         "converged": fit.converged, "misfit": fit.misfit,
-        "iterates": [[float(v) for v in x] for x in fit.iterates],
+        "iterates": [[float(v) for v in x] for x in fit.iterates], "misfits": fit.misfits,
         "fitted_parameters": args.names,
         "curve": {"depth": measured.depth.tolist(), "measured": measured.force.tolist(),
                   "fitted": (measured.force + fit.residuals).tolist(),
@@ -250,8 +250,10 @@ out |= {"iterations": fit.iterations, "forward_solves": fit.evaluations,
 def draw():
     """The curves, and the misfit map when σ0 and H are the fitted pair (collective)."""
     pair = args.names == ["sigma0", "hardening"] and args.map > 0
+    spread = [max(3 * (out[f"{n}_std"] or 0), 0.05 * abs(x)) for n, x in
+              zip(args.names, fit.x, strict=True)]
     grid = (identification_pictures.misfit_grid(model, measured, np.array(fit.iterates),
-                                                args.map) if pair else None)
+                                                np.array(spread), args.map) if pair else None)
     identification_pictures.identification_figure(out, args.plot, grid,
                                                   units=measured.units)
 

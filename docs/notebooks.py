@@ -36,9 +36,11 @@ SMALL = {
     "snap_through.py": [],
     "damage_bar.py": [],
     "crack.py": ["--ell", "0.05", "--steps", "8"],
+    "indentation_identification.py": [],
 }
 # the pictures each page shows (the demo's own --png and --plot)
-PICTURES = {"newton_scalar.py": ["--plot"], "damage_bar.py": ["--plot"], "crack.py": ["--plot"]}
+PICTURES = {"newton_scalar.py": ["--plot"], "damage_bar.py": ["--plot"], "crack.py": ["--plot"],
+            "indentation_identification.py": ["--plot"]}
 
 _RESULTS_CELL = ("import json\nfrom fenics_nl.io import cli\n"
                  "print(json.dumps(cli.notebook_results()))")

@@ -16,8 +16,9 @@ return-mapped stress) and the consistent tangent ∂²ψ/∂ε∂ε both come fr
 The state is updated only by `commit(u)`, when a load step has converged: a cut step leaves
 it as it was, so there is nothing to restore. E, σ0, H and C may be `fem.Constant`s (checked
 at their current values): one compiled form then serves every value, and a parameter's
-derivative is taken by UFL (`solvers.sensitivity`, the identification of a material). `bind(mesh, degree)` creates it; the residual
-must then integrate with `kinematics.quadrature_measure("dx", mesh, degree)`, the same rule.
+derivative is taken by UFL (`solvers.sensitivity`, the identification of a material).
+`bind(mesh, degree)` creates the state; the residual must then integrate with
+`kinematics.quadrature_measure("dx", mesh, degree)`, the same rule.
 """
 
 from __future__ import annotations

@@ -1,30 +1,44 @@
-"""The identification's picture: the measured curve and the identified one, and the misfit
-over (σ0, H) with the fit's iterates on it (the course's figure, and how the fit got there)."""
+"""The identification's picture: the measured and identified curves, and the misfit map.
+
+The curves are the course's figure; the misfit over (σ0, H) with the fit's iterates on it
+shows how the fit got there.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 from mpi4py import MPI
 
+from fenics_nl.errors import SolveError
 from fenics_nl.io import pictures
 
 __all__ = ["identification_figure", "misfit_grid"]
 
 
-def misfit_grid(model, measured, iterates: np.ndarray, points: int):
+def misfit_grid(model, measured, iterates: np.ndarray, spread: np.ndarray, points: int):
     """(σ0 values, H values, ½‖r‖² on their grid): `points`² model runs (collective).
 
-    The grid spans the iterates with a margin; σ0 and H only (the others at their values).
+    Each axis spans the iterates with a margin, its points packed around the solution (the
+    last iterate) within ± `spread` (three standard deviations, say): the valley there is
+    narrow, and an even grid of a few runs would miss it.
     """
-    lo, hi = iterates.min(axis=0), iterates.max(axis=0)
-    span = np.maximum(hi - lo, 0.05 * np.abs(hi))
-    s = np.linspace(max(lo[0] - 0.15 * span[0], 0.5 * lo[0]), hi[0] + 0.15 * span[0], points)
-    h = np.linspace(max(lo[1] - 0.15 * span[1], 0.0), hi[1] + 0.15 * span[1], points)
-    misfit = np.full((points, points), np.nan)
+    axes = []
+    for k in range(2):
+        lo, hi, best = iterates[:, k].min(), iterates[:, k].max(), iterates[-1, k]
+        margin = 0.1 * (hi - lo)
+        lo, hi = max(lo - margin, 0.0), hi + margin
+        near = best + np.linspace(-1, 1, max(points - 2, 1)) * spread[k]
+        axis = np.unique(np.clip(np.concatenate([[lo, hi], near]), lo, hi))
+        axes.append(axis)
+    s, h = axes
+    misfit = np.full((len(h), len(s)), np.nan)
     for i, sigma0 in enumerate(s):
         for j, H in enumerate(h):
             model.set(sigma0=float(sigma0), hardening=float(H))
-            force = model.run(measured.depth, sensitivities=False).force
+            try:
+                force = model.run(measured.depth, sensitivities=False).force
+            except SolveError:  # left out of the map (the fit refuses such steps too)
+                continue
             misfit[j, i] = 0.5 * float(np.sum((force - measured.force) ** 2))
     return s, h, misfit
 
@@ -53,11 +67,19 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
     if grid is not None:
         s, h, misfit = grid
         ax = axes[0, 1]
-        levels = np.geomspace(max(np.nanmin(misfit), 1e-300), np.nanmax(misfit), 14)
-        cs = ax.contourf(s, h, misfit, levels=levels, cmap="viridis",
-                         norm=_log_norm(levels))
-        fig.colorbar(cs, ax=ax, label=f"misfit ½Σ(P − P_measured)² ({force}²)",
-                     format="%.0e")
+        # the grid's runs and the fit's own (the iterates, whose misfits are known), linear
+        # between them on triangles: no minimum where no run was made (a spline through so
+        # few runs of a narrow valley draws false ones)
+        S, Hs = np.meshgrid(s, h)
+        x = np.concatenate([S.ravel(), np.array(out["iterates"])[:, 0]])
+        y = np.concatenate([Hs.ravel(), np.array(out["iterates"])[:, 1]])
+        z = np.concatenate([misfit.ravel(), out["misfits"]])
+        x, y, z = x[np.isfinite(z)], y[np.isfinite(z)], z[np.isfinite(z)]
+        levels = np.geomspace(max(z.min(), 1e-300), z.max(), 14)
+        cs = ax.tricontourf(x, y, np.log(z), levels=np.log(levels), cmap="viridis")
+        bar = fig.colorbar(cs, ax=ax, label=f"misfit ½Σ(P − P_measured)² ({force}²)")
+        bar.set_ticks(np.log(levels[::2]), labels=[f"{v:.0e}" for v in levels[::2]])
+        ax.plot(S.ravel(), Hs.ravel(), ".", color="0.85", ms=3, label="model runs of the map")
         path_ = np.array(out["iterates"])
         ax.plot(path_[:, 0], path_[:, 1], "o-", color="w", ms=4, lw=1.2,
                 label="Levenberg–Marquardt iterates")
@@ -69,14 +91,9 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
         ax.set_xlabel(f"yield stress σ0 ({out['stress_unit']})")
         ax.set_ylabel(f"hardening modulus H ({out['stress_unit']})")
         ax.legend(loc="upper right", fontsize=8)
-        ax.set_title(f"the misfit over (σ0, H): {len(s)}×{len(h)} model runs", fontsize=9)
+        ax.set_title(f"misfit: {len(s)}×{len(h)} runs (dots) and the iterates', linear "
+                     "between them", fontsize=9)
     pictures.save_figure(fig, path)
-
-
-def _log_norm(levels):
-    from matplotlib.colors import LogNorm
-
-    return LogNorm(vmin=levels[0], vmax=levels[-1])
 
 
 def _title(out: dict) -> str:
@@ -86,5 +103,5 @@ def _title(out: dict) -> str:
             parts.append(f"{symbol} = {out[name]:.4g} ± {out[f'{name}_std']:.2g}")
         elif name in out.get("fitted_parameters", []):
             parts.append(f"{symbol}: not identifiable")
-    return (f"{', '.join(parts)}; {out['iterations']} iterations, "
+    return (f"{', '.join(parts)}\n{out['iterations']} iterations, "
             f"{out['forward_solves']} model runs")

@@ -1,5 +1,6 @@
-"""Instrumented indentation as a forward model: the load–depth curve of a J2 block, and its
-derivatives with respect to the law's parameters through the whole load path.
+"""Instrumented indentation as a forward model: a J2 block's load–depth curve, and dP/dθ.
+
+The derivatives with respect to the law's parameters are taken through the whole load path.
 
 A rigid sphere (radius R) or cone (half-angle α) is pressed into an axisymmetric J2 block
 (`punch.Punch`, the course's active set) through a list of depths, loading then unloading; the

@@ -189,6 +189,9 @@ def summary(args: PunchParameters, punch: Punch, states: list, loading: list, no
            "active_set_iterations": sum(s.active_set_iterations for s in states),
            "newton_iterations": sum(s.newton_iterations for s in states),
            "factorizations": sum(s.factorizations for s in states),
+           # every converged step, loading and unloading: the curve P(δ)
+           "indentation_history": [s.indentation for s in states],
+           "force_history": [s.force for s in states],
            "steps": [{"indentation": s.indentation, "force": s.force,
                       "contact_radius": s.contact_radius,
                       "active_set_iterations": s.active_set_iterations} for s in states],

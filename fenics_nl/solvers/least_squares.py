@@ -5,13 +5,15 @@ run: direct differentiation). Each iteration solves the damped Gauss–Newton sy
 
     (JᵀJ + λ diag(JᵀJ)) dx = −Jᵀr,
 
-Marquardt's scaling (so the parameters' units do not matter); a step that would cross a bound
-goes 90 % of the way to it (the interior methods' fraction-to-the-boundary rule: a parameter
-may tend to its bound, H → 0 for perfect plasticity, but a Gauss–Newton overshoot does not put
-it there in one step, from where the fit would have to climb back). A step that lowers the misfit is taken and λ shrinks (towards Gauss–Newton, quadratic
-convergence for a small residual); a step that does not, or whose model run fails, is refused
-and λ grows (towards a short gradient step). Converged when the step is below `xtol` of the
-parameters, or the misfit stops falling (relative `ftol`) under a step below 1e-3 of them.
+Marquardt's scaling (so the parameters' units do not matter); a step that would cross a
+bound goes 90 % of the way to it (the interior methods' fraction-to-the-boundary rule: a
+parameter may tend to its bound, H → 0 for perfect plasticity, but a Gauss–Newton overshoot
+does not put it there in one step, from where the fit would have to climb back). A step that
+lowers the misfit is taken and λ shrinks (towards Gauss–Newton, quadratic convergence for a
+small residual); a step that does not, or whose model run fails, is refused and λ grows
+(towards a short gradient step). Converged when the step is below `xtol` of the parameters,
+or the misfit stops falling (relative `ftol`) under a step below 1e-3 of them.
+
 
 At the solution, with m residuals and n parameters, the residual's noise s² = ‖r‖²/(m − n)
 gives the parameters' covariance s² (JᵀJ)⁻¹, their standard deviations and correlations.

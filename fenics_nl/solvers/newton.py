@@ -526,11 +526,12 @@ class NewtonSolver:
             self.du.copy(out)
 
     def assemble_exact_tangent(self, work: WorkCounts) -> None:
-        """Assemble K(u) at the current u (and factorize it if the solver would) for
-        `tangent_solve`: a converged solve's last tangent is that of the iterate before.
+        """Assemble K(u) at the current u for `tangent_solve` (factorized if the solver would).
 
-        With `reuse_factorization` the factorization already made preconditions CG on it:
+        A converged solve's last tangent is that of the iterate before the last. With
+        `reuse_factorization` the factorization already made preconditions CG on it:
         back-solves only. ValueError for a tangent kept for the solver's life (not K(u)).
+
         """
         if self.policy.for_life:
             raise ValueError("a constant tangent for the solver's life is not K(u): "
