@@ -202,7 +202,7 @@ fit = fit_curve(model, measured, args.names, initial, progress=cli.say)
 # noise, and their correlation: $\sigma_0$ and $H$ trade against each other along the curve
 # (a higher yield stress with less hardening gives nearly the same forces), so the correlation
 # is close to $-1$ and $H$ is known less well than $\sigma_0$. A parameter whose standard
-# deviation would exceed half its value for a noise of 1 % of the largest force is *not
+# deviation would exceed its value for a noise of 1 % of the largest force is *not
 # identifiable* from this curve: it is reported as such, not as a number.
 
 # +

@@ -25,8 +25,9 @@ __all__ = ["IDENTIFIABLE_SPREAD", "MeasuredCurve", "fit_curve", "initial_guess",
            "parse_values", "report"]
 
 # a parameter whose standard deviation, for a noise of 1 % of the largest force, would exceed
-# this fraction of its value is not determined by the curve: reported as not identifiable
-IDENTIFIABLE_SPREAD = 0.5
+# this fraction of its value (its value itself) is not determined by the curve: reported as
+# not identifiable
+IDENTIFIABLE_SPREAD = 1.0
 REFERENCE_NOISE = 0.01
 
 

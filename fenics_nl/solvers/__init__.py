@@ -7,7 +7,9 @@ PETSc SNES; `loading`: `solve_incrementally`, load steps with cuts and a secant 
 `arclength`: Crisfield's continuation through limit points, with stability checks and
 branch switching; `restart`: checkpoints of a load path; `supports`: the free-body check;
 `buckling`: SLEPc eigenproblems (critical loads, the tangent's inertia); `scalar`: the
-course's scalar Newton, modified Newton and secant, for their orders.
+course's scalar Newton, modified Newton and secant, for their orders; `sensitivity`: the
+derivatives of a path-dependent solution with respect to material parameters (direct
+differentiation); `least_squares`: Levenberg–Marquardt with bounds and its statistics.
 
     from fenics_nl.solvers import ArcLength, NewtonSolver, solve_incrementally
 """

@@ -5,15 +5,17 @@ run: direct differentiation). Each iteration solves the damped Gauss–Newton sy
 
     (JᵀJ + λ diag(JᵀJ)) dx = −Jᵀr,
 
-Marquardt's scaling (so the parameters' units do not matter); a step that would cross a
-bound goes 90 % of the way to it (the interior methods' fraction-to-the-boundary rule: a
-parameter may tend to its bound, H → 0 for perfect plasticity, but a Gauss–Newton overshoot
-does not put it there in one step, from where the fit would have to climb back). A step that
-lowers the misfit is taken and λ shrinks (towards Gauss–Newton, quadratic convergence for a
-small residual); a step that does not, or whose model run fails, is refused and λ grows
-(towards a short gradient step). Converged when the step is below `xtol` of the parameters,
-or the misfit stops falling (relative `ftol`) under a step below 1e-3 of them.
-
+Marquardt's scaling (so the parameters' units do not matter). The step is shortened so that
+no parameter changes by more than a factor `max_factor` (4: a multiplicative trust region, as
+the forces respond to the parameters' ratios far more than to their differences), and a step
+that would cross a bound goes 90 % of the way to it (the interior methods' fraction-to-the-
+boundary rule: H may tend to 0, perfect plasticity, but an overshoot does not put it there in
+one step). A step that lowers the misfit is taken and λ shrinks (towards Gauss–Newton,
+quadratic convergence for a small residual); a step that does not, or whose model run fails,
+is refused and λ grows (towards a short gradient step). Converged when the step taken, or the
+Gauss–Newton step the current Jacobian predicts (then without running the model at its end),
+is below `xtol` of the parameters or `spread_tol` of their standard deviations (finer than the
+data can tell), or the misfit stops falling (relative `ftol`) under a step below 1e-3 of them.
 
 At the solution, with m residuals and n parameters, the residual's noise s² = ‖r‖²/(m − n)
 gives the parameters' covariance s² (JᵀJ)⁻¹, their standard deviations and correlations.
@@ -92,6 +94,8 @@ def levenberg_marquardt(
     max_it: int = 30,
     xtol: float = 1e-5,
     ftol: float = 1e-6,
+    spread_tol: float = 0.01,
+    max_factor: float = 4.0,
     progress: Callable[[str], None] | None = None,
 ) -> FitResult:
     """Minimise ½‖r(x)‖² from x0 within lower ≤ x ≤ upper; `evaluate(x)` returns (r, J).
@@ -109,13 +113,26 @@ def levenberg_marquardt(
     cost = 0.5 * float(r @ r)
     result = FitResult(x, r, J, False, "max_it", 0, 1, [x.copy()], [cost], r.copy())
     lam = 1e-3
+    def negligible(dx, x, r, J) -> bool:
+        # below xtol of the parameters, or far below what the data determine (their
+        # standard deviations): a step that changes nothing a user can tell
+        std = statistics(r, J)["std"] if len(r) > len(x) else np.zeros_like(x)
+        return _small(dx, x, xtol) or bool(np.all(np.abs(dx) <= spread_tol * std))
+
     for _ in range(max_it):
         g = J.T @ r
         A = J.T @ J
+        # converged if the undamped (Gauss–Newton) step would be negligible: known from this
+        # run's Jacobian, without running the model at its end
+        gauss_newton = _towards_bounds(x, np.linalg.lstsq(J, -r, rcond=None)[0], lower,
+                                       upper) - x
+        if negligible(gauss_newton, x, r, J):
+            result.converged, result.reason = True, "Gauss–Newton step negligible"
+            break
         D = np.diag(np.diag(A)) + 1e-300
         step_taken = False
         while lam < 1e12:
-            dx = np.linalg.solve(A + lam * D, -g)
+            dx = _within_factor(x, np.linalg.solve(A + lam * D, -g), max_factor)
             x_new = _towards_bounds(x, dx, lower, upper)
             try:
                 r_new, J_new = evaluate(x_new)
@@ -133,7 +150,7 @@ def levenberg_marquardt(
             result.reason = "no step lowers the misfit"
             result.converged = _small(x_new - x, x, xtol)
             break
-        small_step = _small(x_new - x, x, xtol)
+        small_step = negligible(x_new - x, x_new, r_new, J_new)
         # a misfit that no longer falls, from a step that is small too (a heavily damped
         # step far from the minimum lowers the misfit little as well)
         small_drop = cost - cost_new <= ftol * cost and _small(x_new - x, x, 1e-3)
@@ -153,6 +170,17 @@ def levenberg_marquardt(
     result.evaluations = evaluations
     result.wall_time = time.perf_counter() - t0
     return result
+
+
+def _within_factor(x, dx, factor: float) -> np.ndarray:
+    """dx scaled (as a whole) so that no non-zero x_i changes by more than `factor`."""
+    scale = 1.0
+    for xi, di in zip(x, dx, strict=True):
+        if xi == 0 or di == 0:
+            continue
+        limit = (factor - 1) * abs(xi) if di * xi > 0 else (1 - 1 / factor) * abs(xi)
+        scale = min(scale, limit / abs(di))
+    return scale * dx
 
 
 def _towards_bounds(x, dx, lower, upper, fraction: float = 0.9) -> np.ndarray:

@@ -526,12 +526,13 @@ class NewtonSolver:
             self.du.copy(out)
 
     def assemble_exact_tangent(self, work: WorkCounts) -> None:
-        """Assemble K(u) at the current u for `tangent_solve` (factorized if the solver would).
+        """K(u) at the current u for `tangent_solve` (factorized if the solver would).
 
-        A converged solve's last tangent is that of the iterate before the last. With
+        Assembled again: a converged solve's last tangent is at its last-but-one iterate,
+        off by the last correction (using it bends a Taylor test's slope from 2 to 1.7 at
+        relative steps of 1e-4, measured on the indentation). With
         `reuse_factorization` the factorization already made preconditions CG on it:
         back-solves only. ValueError for a tangent kept for the solver's life (not K(u)).
-
         """
         if self.policy.for_life:
             raise ValueError("a constant tangent for the solver's life is not K(u): "
