@@ -82,8 +82,8 @@ test-serial test-mpi: export OMP_NUM_THREADS = 1
 # the serial suite on both cores (pytest-xdist), then the tests that start mpiexec
 # themselves, alone (their ranks need the cores), then the mpi suite under mpiexec
 test-serial: $(VENV)/.installed
-	$(PY) -m pytest -m "not mpi and not spawns_mpi" -q -n 2 --dist worksteal
-	$(PY) -m pytest -m "spawns_mpi" -q
+	$(PY) -m pytest -m "not mpi and not spawns_mpi" -q -n 2 --dist worksteal --durations=25
+	$(PY) -m pytest -m "spawns_mpi" -q --durations=10
 
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider
@@ -93,7 +93,7 @@ test-mpi: $(VENV)/.installed
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
 BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed friction \
-	continuation damage damage_peer
+	continuation damage damage_peer identification
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done

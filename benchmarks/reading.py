@@ -414,7 +414,7 @@ def reading() -> str:
         lines.append(damage(d, load("damage_peer")))
     lines += ["", run_times(["newton", "contact", "buckling", "bracket", "plasticity",
                              "plasticity_peer", "mixed", "friction", "continuation", "damage",
-                             "damage_peer"])]
+                             "damage_peer", "identification"])]
     return "\n".join(lines)
 
 

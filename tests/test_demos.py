@@ -598,7 +598,7 @@ def test_indentation_identification_recovers_sigma0_and_hardening_within_their_s
     # a factor 2 off; σ0 and H within their standard deviations (the seed is fixed: about
     # two seeds in three do so for both, as for any 1σ interval), the curve's fit as good
     # as its noise, H strongly anti-correlated with σ0
-    d = demo.json("indentation_identification.py")
+    d = demo.json("indentation_identification.py", *SMALL["indentation_identification.py"])
     assert d["converged"] and d["synthetic"]
     for name in ("sigma0", "hardening"):
         assert abs(d[f"{name}_error_in_std"]) <= 1, d
