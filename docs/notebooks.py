@@ -36,8 +36,8 @@ SMALL = {
     "snap_through.py": [],
     "damage_bar.py": [],
     "crack.py": ["--ell", "0.05", "--steps", "8"],
-    # the misfit map of its page from 4×4 runs (the default 5×5)
-    "indentation_identification.py": ["--map", "4"],
+    # the misfit map of its page from 3×3 runs (the default 5×5)
+    "indentation_identification.py": ["--map", "3"],
 }
 # the pictures each page shows (the demo's own --png and --plot)
 PICTURES = {"newton_scalar.py": ["--plot"], "damage_bar.py": ["--plot"], "crack.py": ["--plot"],

@@ -14,7 +14,7 @@ It is written in UFL, so σ = ∂ψ/∂ε (the minimiser's own variation vanishe
 return-mapped stress) and the consistent tangent ∂²ψ/∂ε∂ε both come from UFL, not typed.
 
 The state is updated only by `commit(u)`, when a load step has converged: a cut step leaves
-it as it was, so there is nothing to restore. E, σ0, H and C may be `fem.Constant`s (checked
+it as it was, so there is nothing to restore. E, σ0, H and C may be `fem.Constant` objects (checked
 at their current values): one compiled form then serves every value, and a parameter's
 derivative is taken by UFL (`solvers.sensitivity`, the identification of a material).
 `bind(mesh, degree)` creates the state; the residual must then integrate with

@@ -16,7 +16,7 @@ __all__ = ["identification_figure", "misfit_grid"]
 
 
 def misfit_grid(model, measured, iterates: np.ndarray, spread: np.ndarray, points: int):
-    """(σ0 values, H values, ½‖r‖² on their grid): `points`² model runs (collective).
+    """(σ0 values, H values, ½‖r‖² on their grid): points × points model runs (collective).
 
     Each axis spans the iterates with a margin, its points packed around the solution (the
     last iterate) within ± `spread` (three standard deviations, say): the valley there is

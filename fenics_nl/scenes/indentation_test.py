@@ -5,7 +5,7 @@ The derivatives with respect to the law's parameters are taken through the whole
 A rigid sphere (radius R) or cone (half-angle α) is pressed into an axisymmetric J2 block
 (`punch.Punch`, the course's active set) through a list of depths, loading then unloading; the
 force P at each converged step is the curve. The law's parameters — E, σ0, the isotropic
-hardening H and the kinematic C — are `fem.Constant`s, so one compiled set of forms serves
+hardening H and the kinematic C — are `fem.Constant` objects, so one compiled set of forms serves
 every run of an identification, and each run from the virgin state may carry the
 sensitivities dP/dθ by direct differentiation (`solvers.sensitivity`): for each parameter one
 solve per step with the step's converged tangent.

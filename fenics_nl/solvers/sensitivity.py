@@ -19,7 +19,7 @@ reactions' derivative (that of the contact force) is the residual's total deriva
 dR = K du + ∂R/∂θ_i + ∂R/∂α · dα_{n−1}, assembled without the Dirichlet rows.
 
 Every derivative is UFL's: of the residual and of the state update, with respect to u, to the
-state Functions and to the parameters (the law's `fem.Constant`s, taken as `ufl.variable`s).
+state Functions and to the parameters (the law's `fem.Constant` objects, each taken as a `ufl.variable`).
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ class PathSensitivity:
         newton: the `NewtonSolver` that converged the step: its Dirichlet rows and tangent.
         state: the committed internal variables by name (quadrature Functions).
         update: the state a commit would store, by the same names (UFL of u).
-        parameters: the law's parameters to differentiate by, by name (`fem.Constant`s).
+        parameters: the law's parameters to differentiate by, by name (`fem.Constant` objects).
     """
 
     def __init__(self, residual: ufl.Form, u: fem.Function, newton, state: dict,
