@@ -19,7 +19,8 @@ reactions' derivative (that of the contact force) is the residual's total deriva
 dR = K du + ∂R/∂θ_i + ∂R/∂α · dα_{n−1}, assembled without the Dirichlet rows.
 
 Every derivative is UFL's: of the residual and of the state update, with respect to u, to the
-state Functions and to the parameters (the law's `fem.Constant` objects, each taken as a `ufl.variable`).
+state Functions and to the parameters (the law's `fem.Constant` objects, each taken as a
+`ufl.variable`).
 """
 
 from __future__ import annotations
