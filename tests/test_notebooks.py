@@ -19,6 +19,9 @@ def test_every_demo_is_run_as_a_notebook():
 
 @pytest.mark.parametrize("name", sorted(SMALL))
 def test_the_demo_runs_as_a_notebook_with_the_scripts_answer(name, demo, tmp_path):
+    # the script first: its run is shared with the tests that ask for the same flags, which
+    # then find it (pytest's cache) instead of running it again while the notebook runs
+    as_script = demo.json(name, *SMALL[name])
     # with the documentation page's flags (its pictures too): the notebook is the page
     nb, in_notebook = execute(name, page_args(name), tmp_path)
     errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
@@ -27,7 +30,6 @@ def test_the_demo_runs_as_a_notebook_with_the_scripts_answer(name, demo, tmp_pat
     shown = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
              if "image/png" in o.get("data", {})]
     assert len(shown) == len(page_args(name)[len(SMALL[name]):]) // 2  # every picture
-    as_script = demo.json(name, *SMALL[name])
     assert in_notebook and differences(
         {k: as_script[k] for k in in_notebook}, in_notebook, name) == []
     CHECKS.get(name, lambda d: None)(as_script)
