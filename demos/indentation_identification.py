@@ -270,7 +270,7 @@ def draw():
     grid = (identification_pictures.misfit_grid(model, measured, np.array(fit.iterates),
                                                 np.array(spread), args.map) if pair else None)
     identification_pictures.identification_figure(out, args.plot, grid,
-                                                  units=measured.units)
+                                                  labels=measured.labels)
 
 
 cli.results(out, [draw] if args.plot else [])

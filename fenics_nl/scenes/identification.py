@@ -35,13 +35,14 @@ REFERENCE_NOISE = 0.01
 class MeasuredCurve:
     """A load–depth curve: loading to the deepest point, then (optionally) unloading.
 
-    `depth` and `force` in the user's units, in the order measured; `loading` points load.
+    `depth` and `force` in the user's units, in the order measured.
     """
 
     depth: np.ndarray
     force: np.ndarray
     resampled_from: int | None = None  # the measured points, if resampled
-    units: tuple[str, str] = ("length", "force")  # the axes' names (a file's header's)
+    # the axes' labels: a file's header, else the quantities in the user's units
+    labels: tuple[str, str] = ("depth δ (length)", "force P (force)")
 
     @classmethod
     def from_arrays(cls, depth, force, *, max_points: int = 12) -> MeasuredCurve:
@@ -107,7 +108,7 @@ class MeasuredCurve:
         curve = cls.from_arrays(data[:, 0], data[:, 1], max_points=max_points)
         header = path.read_text().splitlines()[0].split(",")
         if len(header) == 2:
-            curve.units = (header[0].strip(), header[1].strip())
+            curve.labels = (header[0].strip(), header[1].strip())
         return curve
 
     @property

@@ -43,7 +43,7 @@ def misfit_grid(model, measured, iterates: np.ndarray, spread: np.ndarray, point
     return s, h, misfit
 
 
-def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, str]) -> None:
+def identification_figure(out: dict, path: str, grid=None, *, labels: tuple[str, str]) -> None:
     """The curves (measured dots, identified line, the start dashed), and the misfit map.
 
     `grid`: `misfit_grid`'s answer, or None (one panel). Drawn on rank 0.
@@ -51,7 +51,6 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
     if MPI.COMM_WORLD.rank != 0:
         return
     plt = pictures.pyplot()
-    length, force = units
     fig, axes = plt.subplots(1, 2 if grid is not None else 1,
                              figsize=(11.5 if grid is not None else 6, 4.6), squeeze=False)
     ax = axes[0, 0]
@@ -59,8 +58,8 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
     ax.plot(c["depth"], c["initial"], "--", color="0.6", label="initial guess")
     ax.plot(c["depth"], c["fitted"], "-", color="C0", lw=2, label="identified")
     ax.plot(c["depth"], c["measured"], "o", color="C3", ms=5, label="measured")
-    ax.set_xlabel(f"depth δ ({length})")
-    ax.set_ylabel(f"force P ({force})")
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left")
     ax.set_title(_title(out), fontsize=9)
@@ -77,7 +76,7 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
         x, y, z = x[np.isfinite(z)], y[np.isfinite(z)], z[np.isfinite(z)]
         levels = np.geomspace(max(z.min(), 1e-300), z.max(), 14)
         cs = ax.tricontourf(x, y, np.log(z), levels=np.log(levels), cmap="viridis")
-        bar = fig.colorbar(cs, ax=ax, label=f"misfit ½Σ(P − P_measured)² ({force}²)")
+        bar = fig.colorbar(cs, ax=ax, label="misfit ½Σ(P − P_measured)²")
         bar.set_ticks(np.log(levels[::2]), labels=[f"{v:.0e}" for v in levels[::2]])
         ax.plot(S.ravel(), Hs.ravel(), ".", color="0.85", ms=3, label="model runs of the map")
         path_ = np.array(out["iterates"])
@@ -88,6 +87,9 @@ def identification_figure(out: dict, path: str, grid=None, *, units: tuple[str, 
         if out.get("true_sigma0") is not None:
             ax.plot(out["true_sigma0"], out["true_hardening"], "+", color="k", ms=14, mew=2,
                     label="true (synthetic)")
+        from matplotlib.ticker import MaxNLocator
+
+        ax.xaxis.set_major_locator(MaxNLocator(5))
         ax.set_xlabel(f"yield stress σ0 ({out['stress_unit']})")
         ax.set_ylabel(f"hardening modulus H ({out['stress_unit']})")
         ax.legend(loc="upper right", fontsize=8)
