@@ -52,6 +52,8 @@ class FrictionalContact(ActiveSetContact):
     nodes that slip); `stick` = active and not slip. Everything else is ActiveSetContact's.
     """
 
+    LOOSE_TOLERANCE = None  # the slip forces' settling is judged at 1e-10: tight solves
+
     # a status set may come back while the friction forces still move (they follow the
     # normal forces of the last solve); its third visit is a cycle
     STATUSES, REVISITS = "statuses", 2
