@@ -96,17 +96,20 @@ class Identification(Parameters):
     fit: str = text("sigma0,hardening", "the parameters to fit, among sigma0, hardening, E, "
                     "kinematic", metavar="NAMES")
     initial: str | None = text(None, "their starting values, in --fit's order (default: "
-                               "synthetic, a factor 2 off the truth; a curve, Tabor's "
-                               "σ0 = P/(3πa²), H = 5σ0, C = H)", metavar="VALUES")
+                               "synthetic, σ0 and H a factor 2 off the truth, C = H/2, E "
+                               "as given; a curve, Tabor's σ0 = P/(3πa²), H = 5σ0, C = H)",
+                               metavar="VALUES")
     true: str = text(None, "synthetic: the true SIGMA0,H (default 0.02E,0.1E)",
                      metavar="SIGMA0,H")
     depth: float | None = number(None, "synthetic: the deepest indentation (default 0.05 R; "
                                  "cone: 0.05)", unit="length", above=0)
-    steps: int = number(6, "synthetic: loading depths (unloading: half as many, to half the "
-                        "depth)", at_least=2)
-    noise: float = number(0.01, "synthetic: the noise's standard deviation, a fraction of the "
-                          "largest force", unit="-", at_least=0, at_most=0.5)
-    seed: int = number(1, "synthetic: the noise's random seed", at_least=0)
+    steps: int | None = number(None, "synthetic: loading depths, default 6 (unloading: half "
+                               "as many, to half the depth)", at_least=2)
+    noise: float | None = number(None, "synthetic: the noise's standard deviation, a "
+                                 "fraction of the largest force (default 0.01)", unit="-",
+                                 at_least=0, at_most=0.5)
+    seed: int | None = number(None, "synthetic: the noise's random seed (default 1)",
+                              at_least=0)
     refine: int = number(0, "the fit's mesh: h = a/(20·2^refine) under the indenter (the "
                          "synthetic curve's: refine + 1)", at_least=0, at_most=4)
     growth: float = number(0.2, "the fit's far field: elements grow by this fraction per "
@@ -119,10 +122,16 @@ class Identification(Parameters):
 
     def check(self):
         self.names = parse_names(self.fit)
-        synthetic_only = [f for f in ("true", "depth") if getattr(self, f) is not None]
+        synthetic_only = [f for f in ("true", "depth", "steps", "noise", "seed")
+                          if getattr(self, f) is not None]
         if self.curve is not None and synthetic_only:
             raise ValueError(f"--{synthetic_only[0]} is for the synthetic experiment: drop it "
                              "or --curve")
+        if self.cone_angle is not None and self.radius != 1.0:
+            raise ValueError("--radius is the sphere's: a cone (--cone-angle) has none")
+        self.steps = 6 if self.steps is None else self.steps
+        self.noise = 0.01 if self.noise is None else self.noise
+        self.seed = 1 if self.seed is None else self.seed
         self.true_values = parse_values(self.true or f"{0.02 * self.E},{0.1 * self.E}",
                                         "--true", ["sigma0", "hardening"])
         self.initial_values = (parse_values(self.initial, "--initial", self.names)
@@ -180,6 +189,7 @@ else:
 # half-space, take `--growth 0.05` (about 3 times the run time).
 
 # +
+measured.check_enough(len(args.names))
 model = IndentationTest(E=args.E, nu=args.nu, sigma0=1.0, hardening=0.0,
                         max_depth=float(measured.depth.max()), radius=args.radius,
                         cone_angle=args.cone_angle, refine=args.refine,

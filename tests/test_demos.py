@@ -617,10 +617,16 @@ def test_indentation_identification_recovers_sigma0_and_hardening_within_their_s
     (["--curve", "negative.csv"], "depth must be >= 0 (point 2 has -0.01)"),
     (["--curve", "missing.csv"], "curve file missing.csv does not exist"),
     (["--curve", "one.csv", "--true", "1,1"], "--true is for the synthetic experiment"),
+    (["--curve", "one.csv", "--noise", "0"], "--noise is for the synthetic experiment"),
+    (["--curve", "bare.csv"], "bare.csv: its first line is numbers; the curve needs a header"),
+    (["--curve", "few.csv", "--fit", "sigma0,hardening,E"],
+     "the curve has 3 points of non-zero depth for 3 parameters"),
 ])
 def test_indentation_identification_bad_input_one_clear_line(args, message, demo, tmp_path):
     (tmp_path / "one.csv").write_text("depth\n0.01\n0.02\n0.03\n")
     (tmp_path / "negative.csv").write_text("depth,force\n0.01,1\n-0.01,2\n0.02,3\n")
+    (tmp_path / "bare.csv").write_text("0.01,1\n0.02,2\n0.03,3\n")
+    (tmp_path / "few.csv").write_text("depth,force\n0.01,1\n0.02,2\n0.015,1\n")
     proc = demo.run(["indentation_identification.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr

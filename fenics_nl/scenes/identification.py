@@ -46,7 +46,11 @@ class MeasuredCurve:
 
     @classmethod
     def from_arrays(cls, depth, force, *, max_points: int = 12) -> MeasuredCurve:
-        """Checked: finite, depth > 0 up to a zero start, force >= 0 ... (ValueError)."""
+        """The curve, checked (ValueError).
+
+        Finite, depth >= 0 (zero depths dropped: they carry nothing), at least 3 points, one
+        loading then one unloading (unless dense: then resampled).
+        """
         depth, force = np.asarray(depth, dtype=float), np.asarray(force, dtype=float)
         if depth.shape != force.shape or depth.ndim != 1:
             raise ValueError("the curve needs one depth and one force per point")
@@ -97,6 +101,10 @@ class MeasuredCurve:
         path = Path(path)
         if not path.is_file():
             raise ValueError(f"curve file {path} does not exist")
+        first = path.read_text().splitlines()[:1]
+        if first and _numbers(first[0]):
+            raise ValueError(f"{path}: its first line is numbers; the curve needs a header "
+                             "line (e.g. depth,force) before its points")
         try:
             data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
         except ValueError as err:
@@ -111,10 +119,26 @@ class MeasuredCurve:
             curve.labels = (header[0].strip(), header[1].strip())
         return curve
 
+    def check_enough(self, parameters: int) -> None:
+        """ValueError unless the curve has more points than the fit has parameters."""
+        if len(self.depth) <= parameters:
+            raise ValueError(f"the curve has {len(self.depth)} points of non-zero depth for "
+                             f"{parameters} parameters: a fit needs more points than "
+                             "parameters")
+
     @property
     def largest_force(self) -> float:
         """max P: the scale of the force residuals."""
         return float(np.max(np.abs(self.force)))
+
+
+def _numbers(line: str) -> bool:
+    """Whether a CSV line is all numbers."""
+    try:
+        [float(t) for t in line.split(",")]
+    except ValueError:
+        return False
+    return True
 
 
 def parse_names(text: str) -> list[str]:
@@ -178,6 +202,7 @@ def fit_curve(model: IndentationTest, measured: MeasuredCurve, names: list[str],
     """
     if tuple(names) != model.differentiate:
         raise ValueError(f"the model differentiates {model.differentiate}, not {names}")
+    measured.check_enough(len(names))
     x0 = np.array([initial[n] for n in names], dtype=float)
     lower = np.array([1e-6 * x0[i] if n in ("sigma0", "E") else 0.0
                       for i, n in enumerate(names)])
@@ -188,7 +213,9 @@ def fit_curve(model: IndentationTest, measured: MeasuredCurve, names: list[str],
         J = np.column_stack([curve.derivatives[n] for n in names])
         return curve.force - measured.force, J
 
-    return levenberg_marquardt(evaluate, x0, lower, progress=progress)
+    fit = levenberg_marquardt(evaluate, x0, lower, progress=progress)
+    model.set(**dict(zip(names, fit.x, strict=True)))  # not a refused trial's
+    return fit
 
 
 def report(fit: FitResult, names: list[str], measured: MeasuredCurve) -> dict:
@@ -212,7 +239,10 @@ def report(fit: FitResult, names: list[str], measured: MeasuredCurve) -> dict:
         if not ok:
             out[f"{n}_estimate"] = float(fit.x[i])  # where the fit stopped, not a result
     corr = stats["correlation"]
-    out["correlation_matrix"] = [[float(v) for v in row] for row in corr]
+    def number(v):  # a parameter with no spread has no correlation: null, not NaN
+        return float(v) if math.isfinite(v) else None
+
+    out["correlation_matrix"] = [[number(v) for v in row] for row in corr]
     if "sigma0" in names and "hardening" in names:
-        out["correlation"] = float(corr[names.index("sigma0"), names.index("hardening")])
+        out["correlation"] = number(corr[names.index("sigma0"), names.index("hardening")])
     return out

@@ -24,9 +24,12 @@ def misfit_grid(model, measured, iterates: np.ndarray, spread: np.ndarray, point
     """
     axes = []
     for k in range(2):
-        lo, hi, best = iterates[:, k].min(), iterates[:, k].max(), iterates[-1, k]
+        best = iterates[-1, k]
+        lo = min(iterates[:, k].min(), best - spread[k])
+        hi = max(iterates[:, k].max(), best + spread[k])
         margin = 0.1 * (hi - lo)
-        lo, hi = max(lo - margin, 0.0), hi + margin
+        # σ0 > 0 (a model run refuses 0), H >= 0
+        lo, hi = max(lo - margin, 0.05 * best if k == 0 else 0.0), hi + margin
         near = best + np.linspace(-1, 1, max(points - 2, 1)) * spread[k]
         axis = np.unique(np.clip(np.concatenate([[lo, hi], near]), lo, hi))
         axes.append(axis)

@@ -146,14 +146,17 @@ def levenberg_marquardt(
                 step_taken = True
                 break
             lam *= 4.0
-        if not step_taken:
-            result.reason = "no step lowers the misfit"
-            result.converged = _small(x_new - x, x, xtol)
+        if not step_taken:  # and the Gauss–Newton step was not negligible (tested above)
+            result.reason, result.converged = "no step lowers the misfit", False
             break
-        small_step = negligible(x_new - x, x_new, r_new, J_new)
+        # the taken step says the fit converged only if it is close to Gauss–Newton's (a
+        # heavily damped step is short anyway)
+        near_gauss_newton = lam <= 1.0
+        small_step = near_gauss_newton and negligible(x_new - x, x_new, r_new, J_new)
         # a misfit that no longer falls, from a step that is small too (a heavily damped
         # step far from the minimum lowers the misfit little as well)
-        small_drop = cost - cost_new <= ftol * cost and _small(x_new - x, x, 1e-3)
+        small_drop = (near_gauss_newton and cost - cost_new <= ftol * cost
+                      and _small(x_new - x, x, 1e-3))
         x, r, J, cost = x_new, r_new, J_new, cost_new
         lam = max(lam / 3.0, 1e-9)
         result.iterations += 1

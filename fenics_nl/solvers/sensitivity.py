@@ -11,12 +11,13 @@ depend on θ. Differentiating both along a parameter θ_i gives, at each converg
     K du = −(∂R/∂θ_i + ∂R/∂α · dα_{n−1}),   du = 0 on the step's Dirichlet rows,
     dα_n = ∂A/∂u · du + ∂A/∂α · dα_{n−1} + ∂A/∂θ_i,
 
-one linear solve per parameter with the step's converged tangent K (the Newton solver's own
-matrix and factorization: back-solves only), and the state's derivative carried on to the
-next step. The contact nodes of the step are held, as in Tardieu & Constantinescu's
-sensitivity problem of a frictionless contact whose zone does not move with θ. The
-reactions' derivative (that of the contact force) is the residual's total derivative
-dR = K du + ∂R/∂θ_i + ∂R/∂α · dα_{n−1}, assembled without the Dirichlet rows.
+one linear solve per parameter with the step's tangent K, reassembled at the converged u
+(the Newton solver's own matrix; its solve reuses the factorization the forward solve made,
+as a CG preconditioner when the solver keeps one: no new factorization), and the state's
+derivative carried on to the next step. The contact nodes of the step are held, as in
+Tardieu & Constantinescu's sensitivity problem of a frictionless contact whose zone does not
+move with θ. The reactions' derivative (that of the contact force) is the residual's total
+derivative dR = K du + ∂R/∂θ_i + ∂R/∂α · dα_{n−1}, assembled without the Dirichlet rows.
 
 Every derivative is UFL's: of the residual and of the state update, with respect to u, to the
 state Functions and to the parameters (the law's `fem.Constant` objects, each taken as a
@@ -31,6 +32,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.solvers.newton import ConvergenceError, LinearSolveError
 from fenics_nl.solvers.result import WorkCounts
 
 __all__ = ["PathSensitivity", "parameter_derivative"]
@@ -121,7 +123,10 @@ class PathSensitivity:
             self._assemble(self._rhs, self._b)
             self._b.scale(-1.0)
             petsc.set_bc(self._b, bcs, alpha=0.0)  # du = 0 on the step's Dirichlet rows
-            self.newton.tangent_solve(self._b, self._x, self.work)
+            try:
+                self.newton.tangent_solve(self._b, self._x, self.work)
+            except LinearSolveError as err:  # a step the caller may refuse, as a solve's
+                raise ConvergenceError(f"sensitivity to {self.names[i]}: {err}") from None
             self._du.x.petsc_vec.array[:] = self._x.array_r
             self._du.x.scatter_forward()
             self._assemble(self._total, self._b)
