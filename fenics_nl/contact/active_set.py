@@ -289,13 +289,13 @@ class ActiveSetContact:
     # what the loop settles (its messages), and how often a state may come back before it
     # is a cycle (the frictionless set: never)
     STATUSES, REVISITS = "active set", 1
-    # the inner Newton solves' tolerances (rtol and atol) while the set is still moving (None: the
-    # solver's own throughout). Only the signs of T_n and of the gap decide the next set, so
-    # an iteration whose set will change need not be converged to 1e-10: once the set
-    # settles, the same solve goes on to the solver's tolerance and the set is checked again
-    # (the J2 punch of the identification: 158 Newton iterations a run down to 115, the
-    # same active sets; 1e-6 saved 10). Friction's rules
-    # compare the slip forces between solves at 1e-10: it keeps the tight solves.
+    # the inner Newton solves' tolerances (rtol and atol) while the set is still moving
+    # (None: the solver's own throughout). Only the signs of T_n and of the gap decide the
+    # next set, so an iteration whose set will change need not be converged to 1e-10: once
+    # the set settles, the same solve goes on to the solver's tolerance and the set is
+    # checked again (the J2 punch of the identification: 158 Newton iterations a run down to
+    # 115, the same active sets; 1e-6 saved 10). Friction's rules compare the slip forces
+    # between solves at 1e-10: it keeps the tight solves.
     LOOSE_TOLERANCE: float | None = 1e-3
 
     def solve(self) -> SolveResult:

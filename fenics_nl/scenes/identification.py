@@ -18,7 +18,12 @@ from pathlib import Path
 
 import numpy as np
 
-from fenics_nl.scenes.indentation_test import PARAMETERS, IndentationTest
+from fenics_nl.scenes.indentation_test import (
+    PARAMETERS,
+    POSITIVE,
+    IndentationTest,
+    check_value,
+)
 from fenics_nl.solvers.least_squares import FitResult, levenberg_marquardt, statistics
 
 __all__ = ["IDENTIFIABLE_SPREAD", "MeasuredCurve", "fit_curve", "initial_guess", "parse_names",
@@ -101,12 +106,12 @@ class MeasuredCurve:
         path = Path(path)
         if not path.is_file():
             raise ValueError(f"curve file {path} does not exist")
-        first = path.read_text().splitlines()[:1]
-        if first and _numbers(first[0]):
+        lines = path.read_text().splitlines()
+        if lines and _numbers(lines[0]):
             raise ValueError(f"{path}: its first line is numbers; the curve needs a header "
                              "line (e.g. depth,force) before its points")
         try:
-            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+            data = np.loadtxt(lines[1:], delimiter=",", ndmin=2)
         except ValueError as err:
             raise ValueError(f"{path}: not a CSV of numbers after its header line ({err})"
                              ) from None
@@ -114,7 +119,7 @@ class MeasuredCurve:
             raise ValueError(f"{path}: {data.shape[1]} column(s); the curve needs two, "
                              "depth and force (and a header line)")
         curve = cls.from_arrays(data[:, 0], data[:, 1], max_points=max_points)
-        header = path.read_text().splitlines()[0].split(",")
+        header = lines[0].split(",")
         if len(header) == 2:
             curve.labels = (header[0].strip(), header[1].strip())
         return curve
@@ -164,10 +169,10 @@ def parse_values(text: str, flag: str, names: list[str]) -> dict[str, float]:
         raise ValueError(f"{flag} {text!r}: {len(values)} value(s) for {len(names)} "
                          f"parameter(s) ({', '.join(names)})")
     for name, value in zip(names, values, strict=True):
-        strict = name in ("sigma0", "E")
-        if not (math.isfinite(value) and (value > 0 if strict else value >= 0)):
-            raise ValueError(f"{flag}: {name} must be {'> 0' if strict else '>= 0'}, got "
-                             f"{value:g}")
+        try:
+            check_value(name, value)
+        except ValueError as err:
+            raise ValueError(f"{flag}: {err}") from None
     return dict(zip(names, values, strict=True))
 
 
@@ -204,7 +209,7 @@ def fit_curve(model: IndentationTest, measured: MeasuredCurve, names: list[str],
         raise ValueError(f"the model differentiates {model.differentiate}, not {names}")
     measured.check_enough(len(names))
     x0 = np.array([initial[n] for n in names], dtype=float)
-    lower = np.array([1e-6 * x0[i] if n in ("sigma0", "E") else 0.0
+    lower = np.array([1e-6 * x0[i] if n in POSITIVE else 0.0
                       for i, n in enumerate(names)])
 
     def evaluate(x):
@@ -235,14 +240,17 @@ def report(fit: FitResult, names: list[str], measured: MeasuredCurve) -> dict:
         out[n] = float(fit.x[i]) if ok else None
         out[f"{n}_std"] = float(stats["std"][i]) if ok else None
         out[f"{n}_identifiable"] = bool(ok)
-        out[f"{n}_spread_at_1_percent_noise"] = float(spread)
+        out[f"{n}_spread_at_1_percent_noise"] = _finite_or_none(spread)
         if not ok:
             out[f"{n}_estimate"] = float(fit.x[i])  # where the fit stopped, not a result
     corr = stats["correlation"]
-    def number(v):  # a parameter with no spread has no correlation: null, not NaN
-        return float(v) if math.isfinite(v) else None
-
-    out["correlation_matrix"] = [[number(v) for v in row] for row in corr]
+    out["correlation_matrix"] = [[_finite_or_none(v) for v in row] for row in corr]
     if "sigma0" in names and "hardening" in names:
-        out["correlation"] = number(corr[names.index("sigma0"), names.index("hardening")])
+        out["correlation"] = _finite_or_none(corr[names.index("sigma0"),
+                                                  names.index("hardening")])
     return out
+
+
+def _finite_or_none(v: float) -> float | None:
+    """A JSON number, or null where there is none (no spread: no correlation; H = 0)."""
+    return float(v) if math.isfinite(v) else None

@@ -24,13 +24,24 @@ from mpi4py import MPI
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.scenes.punch import BERKOVICH, Indentation, Punch, PunchBlock
-from fenics_nl.solvers.result import WorkCounts
 from fenics_nl.solvers.sensitivity import PathSensitivity
 
-__all__ = ["PARAMETERS", "Curve", "IndentationTest"]
+__all__ = ["PARAMETERS", "POSITIVE", "Curve", "IndentationTest", "check_value"]
 
 # the parameters of the curve, by the name a user writes (CLI, JSON), and J2Plasticity's field
 PARAMETERS = {"sigma0": "sigma0", "hardening": "H", "E": "E", "kinematic": "C"}
+POSITIVE = ("sigma0", "E")  # > 0; the others >= 0
+
+
+def check_value(name: str, value: float) -> None:
+    """ValueError unless `value` is finite and in the range of parameter `name`."""
+    if name not in PARAMETERS:
+        raise ValueError(f"unknown parameter {name!r}: the curve's parameters are "
+                         f"{', '.join(PARAMETERS)}")
+    strict = name in POSITIVE
+    if not (math.isfinite(value) and (value > 0 if strict else value >= 0)):
+        raise ValueError(f"{name} must be {'> 0' if strict else '>= 0'} and finite, got "
+                         f"{value:g}")
 
 
 @dataclass
@@ -94,12 +105,6 @@ class IndentationTest:
             residual, b.u, self.punch.contact.newton, self.material.state_functions(),
             self.material.state_update(kinematics.small_strain(b.u, b.kinematics)),
             {k: c[k] for k in self.differentiate}) if differentiate else None
-        self.runs = 0  # forward runs, with or without sensitivities
-
-    @property
-    def work(self) -> WorkCounts:
-        """What the forward solves spent so far (the sensitivities count theirs apart)."""
-        return self.punch.contact.newton.total
 
     @property
     def dofs(self) -> int:
@@ -113,13 +118,7 @@ class IndentationTest:
     def set(self, **values: float) -> None:
         """New parameter values (by name): E > 0, σ0 > 0, H >= 0, C >= 0."""
         for name, value in values.items():
-            if name not in PARAMETERS:
-                raise ValueError(f"unknown parameter {name!r}: the curve's parameters are "
-                                 f"{', '.join(PARAMETERS)}")
-            low_ok = value > 0 if name in ("E", "sigma0") else value >= 0
-            if not (math.isfinite(value) and low_ok):
-                raise ValueError(f"{name} must be {'> 0' if name in ('E', 'sigma0') else '>= 0'}"
-                                 f" and finite, got {value!r}")
+            check_value(name, value)
             self.constants[name].value = float(value)
 
     def run(self, depths, *, sensitivities: bool = True) -> Curve:
@@ -147,11 +146,11 @@ class IndentationTest:
                 for name, dR in zip(sens.names, sens.step(), strict=True):
                     curve.derivatives[name][n] = self._force_of(dR)
             material.commit(b.u, b.kinematics)
-        self.runs += 1
         curve.wall_time = time.perf_counter() - t0
         return curve
 
     def _force_of(self, reactions: np.ndarray) -> float:
         """The whole body's contact force of the nodal reactions `reactions` (as P)."""
-        s = self.punch.contact.surface
-        return -self.block.symmetry_factor * s.total(s.sign * reactions[s.dofs_V])
+        c = self.punch.contact
+        return self.block.symmetry_factor * c.total_force(c.surface.sign
+                                                          * reactions[c.surface.dofs_V])

@@ -243,11 +243,12 @@ class Punch:
         # P = π/2 E* a² cot α); E may be a fem.Constant (a parameter being identified)
         a, model = block.a, block.model
         E_star = hertz.effective_modulus(float(material.E), float(material.nu))
-        force = (np.pi / 4 if model == "plane_strain" else 4 / 3) * E_star * a**3 / radius
-        if model == "plane_strain":
-            force /= a
         if gap == "cone":
             force = np.pi / 2 * E_star * a * a * self.cot
+        elif model == "plane_strain":
+            force = np.pi / 4 * E_star * a * a / radius
+        else:
+            force = 4 / 3 * E_star * a**3 / radius
         opts = {"line_search": not material.is_linear,
                 "force_scale": force / self.block.symmetry_factor}
         if block.mixed and formulation == "elimination":  # a symmetric saddle point: MUMPS

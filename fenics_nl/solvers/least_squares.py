@@ -134,12 +134,11 @@ def levenberg_marquardt(
         while lam < 1e12:
             dx = _within_factor(x, np.linalg.solve(A + lam * D, -g), max_factor)
             x_new = _towards_bounds(x, dx, lower, upper)
+            evaluations += 1
             try:
                 r_new, J_new = evaluate(x_new)
-                evaluations += 1
                 cost_new = 0.5 * float(r_new @ r_new)
             except SolveError as err:
-                evaluations += 1
                 log.info("step to %s refused: %s", x_new, err)
                 cost_new = math.inf
             if cost_new < cost:
@@ -166,7 +165,7 @@ def levenberg_marquardt(
             progress(f"iteration {result.iterations}: x = {np.array2string(x, precision=6)}, "
                      f"misfit {cost:.4e}")
         if small_step or small_drop:
-            result.converged, result.reason = True, ("step below xtol" if small_step
+            result.converged, result.reason = True, ("step negligible" if small_step
                                                      else "misfit stopped falling")
             break
     result.x, result.residuals, result.jacobian = x, r, J

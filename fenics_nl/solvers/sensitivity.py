@@ -72,14 +72,14 @@ class PathSensitivity:
         if set(state) != set(update):
             raise ValueError("state and update must name the same internal variables")
         self.names = list(parameters)
-        self.newton, self.u = newton, u
+        self.newton = newton
         V = u.function_space
         n = len(self.names)
         # the parameter of the current solve, as a unit vector: one compiled form for all
         self._which = fem.Constant(V.mesh, np.zeros(n))
         self._du = fem.Function(V)
-        self._state = state
         self._dstate = {k: fem.Function(f.function_space) for k, f in state.items()}
+        self._new = {k: fem.Function(f.function_space) for k, f in state.items()}
         explicit = sum((parameter_derivative(residual, c, self._which[i])
                         for i, c in enumerate(parameters.values())), ufl.Form([]))
         through_state = sum((ufl.derivative(residual, state[k], self._dstate[k])
@@ -96,7 +96,6 @@ class PathSensitivity:
                 d = d + ufl.derivative(new, state[j], self._dstate[j])
             self._update[k] = fem.Expression(d, points)
         self._b = petsc.create_vector(V)
-        self._x = petsc.create_vector(V)
         self.work = WorkCounts()
         self.state_derivatives = [{k: np.zeros_like(f.x.array) for k, f in state.items()}
                                   for _ in self.names]
@@ -124,21 +123,17 @@ class PathSensitivity:
             self._b.scale(-1.0)
             petsc.set_bc(self._b, bcs, alpha=0.0)  # du = 0 on the step's Dirichlet rows
             try:
-                self.newton.tangent_solve(self._b, self._x, self.work)
+                self.newton.tangent_solve(self._b, self._du.x.petsc_vec, self.work)
             except LinearSolveError as err:  # a step the caller may refuse, as a solve's
                 raise ConvergenceError(f"sensitivity to {self.names[i]}: {err}") from None
-            self._du.x.petsc_vec.array[:] = self._x.array_r
             self._du.x.scatter_forward()
             self._assemble(self._total, self._b)
             self._b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
             with self._b.localForm() as loc:
                 derivatives.append(loc.array_r.copy())
-            new = {}
-            for k, expr in self._update.items():
-                f = fem.Function(self._dstate[k].function_space)
-                f.interpolate(expr)
-                new[k] = f.x.array.copy()
-            carried.append(new)
+            for k, expr in self._update.items():  # (all read dα_{n−1}: stored after)
+                self._new[k].interpolate(expr)
+            carried.append({k: f.x.array.copy() for k, f in self._new.items()})
         self.state_derivatives = carried
         return derivatives
 
