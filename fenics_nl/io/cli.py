@@ -650,7 +650,7 @@ def _script_run(path: Path) -> None:
             sys.__excepthook__(kind, err, tb)  # a bug: its traceback first
             if MPI.COMM_WORLD.size > 1:  # the other ranks may not have failed: no
                 sys.stderr.flush()       # collective clean-up, end them all
-                MPI.COMM_WORLD.Abort(1)
+                _abort(1)
             run.close_series()
             _forget(run.options)
             return
@@ -658,7 +658,7 @@ def _script_run(path: Path) -> None:
             print(f"error: {_one_line(err)} (on rank {MPI.COMM_WORLD.rank} only: the run "
                   "is stopped)", file=sys.stderr, flush=True)
             sys.stdout.flush()
-            MPI.COMM_WORLD.Abort(2)
+            _abort(2)
         try:
             status = _failed(run, err)
         finally:
@@ -670,6 +670,17 @@ def _script_run(path: Path) -> None:
         os._exit(status)
 
     sys.excepthook = one_line_exit
+
+
+def _abort(status: int) -> None:
+    """MPI_Abort, once what this rank wrote has had time to reach mpiexec.
+
+    Abort kills every rank at once; MPICH's mpiexec relays each rank's stderr through a pipe,
+    and a line still in that pipe is lost with it (seen under load: the one-line error of a
+    rank failing alone never printed).
+    """
+    time.sleep(0.5)
+    MPI.COMM_WORLD.Abort(status)
 
 
 # how long a failing rank waits for the others (a collective error is raised after a
