@@ -228,9 +228,11 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         return rest + 0.5 * k * lnJ**2
 
     def modified_newton_tangent(self, u, model: str, dx):
-        """"initial": at finite strain the elastic tangent of the configuration the step
-        starts from (the committed points sit on the yield surface, within the tolerance
-        that makes them start elastic), refactorized each step. Hooke's reference tangent
+        """The tangent at the start of each step ("initial"): an elastic tangent.
+
+        At finite strain the elastic tangent of the configuration the step starts from (the
+        committed points sit on the yield surface, within the tolerance that makes them
+        start elastic), refactorized each step. Hooke's reference tangent
         would ignore the rotations and stretches of a forming operation.
         """
         return "initial"
