@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 
+from fenics_nl.errors import SolveError
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import FiniteStrain, Isotropic, check_range
 from fenics_nl.materials.plasticity import YIELD_TOLERANCE, per_cell
@@ -291,8 +292,9 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         """Store the returned state of the displacement `u` (a converged step).
 
         Cp⁻¹ ← F⁻¹ be Fᵀ⁻¹ with be = J^⅔ b̄_tr^(1 − Δp/ε̄) (the exponential map), p ← p + Δp.
-        Raises ValueError if the step was too large for the logarithm's series, or the
-        Voce return did not converge.
+        Raises SolveError, before storing anything, if the step was too large for the
+        logarithm's series or the Voce return did not converge: the load driver then cuts
+        the step.
         """
         from dolfinx import fem
 
@@ -331,7 +333,7 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         scale = np.maximum(eq_exact, self.sigma0 / (3 * self.mu))
         series = float(np.max(np.abs(eq - eq_exact) / scale, initial=0.0))
         if series > SERIES_TOLERANCE:
-            raise ValueError(f"a load step too large for the logarithmic strain's series "
+            raise SolveError(f"a load step too large for the logarithmic strain's series "
                              f"(|dev ε| off by {series:.1e} relative at a point): take "
                              "smaller steps")
         if self.voce and np.any(dp > 0):
@@ -339,5 +341,5 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
             g = 3 * self.mu * (eq[dp > 0] - dp[dp > 0]) - self.yield_stress(p, exp=np.exp)
             worst = float(np.max(np.abs(g))) / self.sigma0
             if worst > RETURN_TOLERANCE:
-                raise ValueError(f"the Voce return did not converge (residual {worst:.1e} "
+                raise SolveError(f"the Voce return did not converge (residual {worst:.1e} "
                                  "σ0 at a point): take smaller steps")

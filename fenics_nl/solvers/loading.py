@@ -122,6 +122,8 @@ def solve_incrementally(
             x.ghostUpdate()
         try:
             result = solver.solve()
+            if commit:  # may refuse the step (a SolveError) before it stores anything
+                commit()
         except SolveError as err:
             path.failures += 1
             if err.result is not None:
@@ -140,8 +142,6 @@ def solve_incrementally(
                 progress(f"  step to t = {t + 2 * dt:.4g} failed ({err}); cut to dt = {dt:.4g}")
             continue
         t += dt
-        if commit:
-            commit()
         if predictor:
             if previous is None:
                 previous = saved.duplicate()
