@@ -96,8 +96,7 @@ class Upsetting:
                 "max_it": 30, **(newton_options or {})}
         contact = {"normal_axis": 1, "normal_sign": 1, "initial": "penetrating",
                    "newton_options": opts, "prefix": prefix,
-                   "displacement_space": billet.fields.displacement_space
-                   if billet.fields.mixed else None}
+                   "displacement_space": billet.V if billet.fields.mixed else None}
         args = (self.residual, self.u, billet.supports, billet.candidate, self._gap)
         self.reduction = 0.0
         if self.friction > 0:

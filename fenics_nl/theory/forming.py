@@ -1,5 +1,6 @@
-"""Closed forms of the upsetting of a cylinder between flat dies (homogeneous, and the slab
-method's estimate with friction).
+"""Closed forms of the upsetting of a cylinder between flat dies.
+
+The homogeneous compression without friction, and the slab method's estimate with it.
 
 Without friction the compression stays homogeneous: the logarithmic strain ln(h0/h) is the
 plastic strain p plus the elastic σ_y(p)/E (Hencky's law in uniaxial stress), and the force
@@ -17,7 +18,7 @@ from collections.abc import Callable
 
 from scipy.optimize import brentq
 
-__all__ = ["homogeneous_plastic_strain", "frictionless_force", "slab_force"]
+__all__ = ["frictionless_force", "homogeneous_plastic_strain", "slab_force"]
 
 
 def homogeneous_plastic_strain(reduction: float, yield_stress: Callable[[float], float],
