@@ -67,6 +67,8 @@ demo: $(VENV)/.installed
 	$(PY) demos/snap_through.py --plot results/snap_through.png --png results/snap_shapes.png \
 	  --json results/snap_through.json
 	$(PY) demos/crack.py --plot results/crack.png --json results/crack.json
+	$(PY) demos/upsetting.py --friction 0.3 --cells 8 --png results/upsetting.png \
+	  --plot results/upsetting_force.png --json results/upsetting.json
 	$(PY) -m fenics_nl run cases/thick_cylinder.toml --png results/thick_cylinder.png \
 	  --json results/thick_cylinder.json
 	@echo "make demo: pictures (*.png) and results (*.json) in $(CURDIR)/results/"
