@@ -382,6 +382,24 @@ def test_j2_bar_loaded_and_unloaded_keeps_its_permanent_strain(tmp_path, demo):
     assert d["reactions"]["x0"][0] == pytest.approx(0.0, abs=1e-9 * 60)
 
 
+def test_j2_at_finite_strain_bar_pulled_to_a_log_strain_of_0_3(tmp_path, demo):
+    # ln λ = 0.3 = p + σ_y(p)/E (Hencky), τ = σ_y(p); the end's reaction τ A0/λ (the plastic
+    # flow keeps the volume, the elastic J cancels between σ = τ/J and the area), σ_eq = τ/J
+    write(tmp_path, "bar.geo", BAR_GEO)
+    stretch = math.exp(0.3)
+    text = BAR.replace('law = "linear-elastic"\nE = 1000.0\nnu = 0.25',
+                       'law = "j2-finite"\nE = 1000.0\nnu = 0.25\nsigma0 = 40.0\nH = 100.0')
+    text = text.replace("traction = [50.0, 0.0, 0.0]",
+                        f'displacement = [{10 * (stretch - 1)}, "free", "free"]')
+    text = text.replace("steps = 2", "steps = 10")
+    d = demo.case(write(tmp_path, "j2_finite.toml", text))
+    p = (0.3 - 40.0 / 1000.0) / (1 + 100.0 / 1000.0)
+    tau = 40.0 + 100.0 * p
+    assert d["reactions"]["x0"][0] == pytest.approx(-tau * 2.0 / stretch, rel=1e-8)
+    J = math.exp(tau * (1 - 2 * 0.25) / 1000.0)
+    assert d["probes"]["corner"]["von_mises"] == pytest.approx(tau / J, rel=1e-8)
+
+
 def test_arc_length_control_follows_the_arch_through_its_snap(demo):
     # load control stops at the limit point; the arc-length path goes through it, down the
     # unstable branch and up the inverted one, to the target

@@ -271,12 +271,14 @@ class CaseProblem:
         step is good even when ‖R‖ grows (`NewtonSolver._step`). Only where R is the
         gradient of an energy that is minimised: not the mixed form (a saddle point: the
         pressure rows' slope can cancel the displacement's), not a follower pressure (no
-        potential); J2 and the power law keep the test on ‖R‖ (a kink in R).
+        potential); J2 (at small and finite strain) and the power law keep the test on ‖R‖
+        (a kink in R).
         """
         if self.material.is_linear:
             return False
         follower = any(c.kind == "pressure" and c.follower for c in self.case.conditions)
-        minimised = self.material.finite_strain and not self.mixed and not follower
+        minimised = (self.material.finite_strain and not self.material.path_dependent
+                     and not self.mixed and not follower)
         return "slope" if minimised else True
 
     def make_solver(self):

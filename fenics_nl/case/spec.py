@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from fenics_nl.materials import laws
+from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.vocabulary import canonical
@@ -33,11 +34,14 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
-                         # | at1 | at2
+                         # | j2-finite | at1 | at2
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
                          # plane stress: linear-elastic, saint-venant-kirchhoff or j2
+# j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
+# optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
+# (saturation - sigma0)(1 - exp(-delta p))); not plane stress
 # at1, at2 (gradient damage: a damage field 0 <= alpha <= 1 that never decreases, minimized
 # with u at each step by alternate minimization, Anderson-accelerated): also Gc (toughness,
 # energy per unit crack area) and ell (length; the mesh's cells at most ell/2 where a crack
@@ -100,6 +104,7 @@ LAWS: dict[str, type[laws.Material]] = {
     "saint-venant-kirchhoff": laws.StVenantKirchhoff,
     "neo-hookean": laws.NeoHookean,
     "j2": J2Plasticity,
+    "j2-finite": FiniteJ2Plasticity,
     "at1": AT1,
     "at2": AT2,
 }
@@ -108,6 +113,7 @@ DAMAGE = ("at1", "at2")
 # plasticity; a broken cell of a damage law keeps 1e-6 of its stiffness (a body cut in two
 # by a crack would otherwise have a singular tangent)
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0},
+            "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 WORDS = {"split": SPLITS}  # parameters that are words, and their choices
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
@@ -380,13 +386,13 @@ def _material(r: _Reader, data: dict, model: str | None):
                       default=defaults.get(f.name), choices=WORDS.get(f.name))
         if value is not None:
             parameters[f.name] = value
-    if len(parameters) == len(params):
+    if all(f.name in parameters or f.name in defaults for f in params):
         try:
             LAWS[law](**parameters)
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"material.{name}" if name in parameters else "material", rest or name)
-    if law in ("neo-hookean", "power-law") and model == "plane_stress":
+    if law in ("neo-hookean", "power-law", "j2-finite") and model == "plane_stress":
         r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters

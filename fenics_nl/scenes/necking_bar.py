@@ -43,7 +43,7 @@ class NeckingBar:
     """
 
     def __init__(self, cells: int = 4, *, grading: float = 3.0, mixed: bool = True,
-                 nu: float = 0.29, comm: MPI.Comm = MPI.COMM_WORLD):
+                 nu: float = 0.29, gripped: bool = False, comm: MPI.Comm = MPI.COMM_WORLD):
         half = LENGTH / 2
         rows = max(2, round(cells * half / RADIUS))
         self.mesh = msh = mesh.create_rectangle(comm, [[0.0, 0.0], [1.0, 1.0]],
@@ -67,7 +67,9 @@ class NeckingBar:
         self.end = where(lambda p: np.isclose(p[1], half))
         self.pull = boundary.component(self.V, 1, self.end, 0.0)
         self.bcs = [boundary.component(self.V, 0, axis), boundary.component(self.V, 1, self.mid),
-                    boundary.component(self.V, 0, self.end), self.pull]
+                    self.pull]
+        if gripped:  # the end held radially too (else only pulled along z, as VM318)
+            self.bcs.append(boundary.component(self.V, 0, self.end))
         self.material = simo_material(nu)
         self.quadrature_degree = 4
         self.material.bind(msh, self.quadrature_degree)
@@ -76,7 +78,7 @@ class NeckingBar:
         self._residual_form = fem.form(self.residual)
         self.solver = NewtonSolver(self.residual, self.unknown, self.bcs, rtol=1e-10,
                                    atol=1e-10, force_scale=450.0 * RADIUS**2, max_it=25,
-                                   prefix="necking_")
+                                   line_search=True, prefix="necking_")
         self.probes = Probes(msh, [[RADIUS * NARROWING, 0.0]])  # the neck's surface
 
     @property

@@ -1,0 +1,236 @@
+"""Forming at finite strain: the upsetting's Newton variants and size, the necking bar's mesh.
+
+A. The upsetting (`demos/upsetting.py`'s scene, 50 %, 20 steps), frictionless and f = 0.2,
+   with full Newton, modified Newton (the elastic tangent of the configuration each solve
+   starts from: the course's choice at finite strain, refactorized per solve) and BFGS on
+   it: Newton iterations, factorizations, active-set iterations, time, the time per step
+   in linear solves of the same mesh (one MUMPS factorization and solve of the elastic
+   tangent), the force and its difference from full Newton's.
+B. The size: the f = 0.2 upsetting on a fine mesh, 1 rank and 2 ranks (mpiexec of the
+   demo), its wall time and unknowns.
+C. Simo's necking bar (`scenes.necking_bar`, each end pulled 7 mm in 50 steps, radially
+   free as in ANSYS VM318) on meshes of 4, 8, 16 and 32 cells across the radius, and 8
+   gripped: the peak force against Considère's for the neck section, the neck radius r/r0
+   at 4, 5, 6 and 7 mm a end against the published ones (Simo & Hughes 1998 as digitized in
+   syadegari/fe_solver verification/j2_formulation_study/circular_necking_reference.csv,
+   ±0.1 mm; ANSYS VM318: u_r = −3.740 mm at 7 mm), time.
+
+Writes benchmarks/results/forming.json and, with --update-docs, its section of
+docs/benchmarks.md.
+"""
+
+import json
+import math
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+from common import machine, options, publish
+from mpi4py import MPI
+from scipy.optimize import brentq
+
+from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
+from fenics_nl.scenes.necking_bar import NARROWING, RADIUS, NeckingBar, simo_material
+from fenics_nl.scenes.upsetting import Billet, Upsetting
+from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+
+ROOT = Path(__file__).resolve().parents[1]
+VARIANTS = {"full": {"method": "full"},
+            "modified": {"method": "modified", "max_it": 300},
+            "bfgs": {"method": "bfgs", "max_it": 300}}
+
+
+def say(msg):
+    if MPI.COMM_WORLD.rank == 0:
+        print(msg, flush=True)
+
+
+def linear_solve_time(up) -> float:
+    """One assembly, factorization and solve of the elastic tangent at rest (MUMPS)."""
+    import ufl
+    from dolfinx import fem
+    from dolfinx.fem import petsc
+    from petsc4py import PETSc
+
+    b = up.billet
+    K = fem.form(ufl.derivative(up.residual, up.u))
+    t0 = time.perf_counter()
+    A = petsc.assemble_matrix(K, bcs=b.supports)
+    A.assemble()
+    ksp = PETSc.KSP().create(b.mesh.comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    x, rhs = A.createVecs()
+    rhs.set(1.0)
+    ksp.solve(rhs, x)
+    return time.perf_counter() - t0
+
+
+def upset(cells, friction, variant):
+    billet = Billet(10.0, 20.0, cells=cells)
+    law = FiniteJ2Plasticity(200e3, 0.3, sigma0=400.0, H=1000.0)
+    law.bind(billet.mesh, billet.quadrature_degree)
+    up = Upsetting(billet, law, friction=friction, newton_options=VARIANTS[variant])
+    one_solve = linear_solve_time(up)
+    t0 = time.perf_counter()
+    try:
+        path = solve_incrementally(up, lambda t: up.set_reduction(0.5 * t), 20, max_step=0.05,
+                                   easy_iterations=10**9, commit=up.commit, restore=up.restore)
+    except LoadStepError as err:  # a variant that cannot do it: said in the table
+        return {"problem": f"upsetting f = {friction:g}", "variant": variant,
+                "dofs": billet.dofs, "failed": str(err).split(";")[0]}
+    elapsed = time.perf_counter() - t0
+    steps = len(path.results)
+    return {"problem": f"upsetting f = {friction:g}", "variant": variant,
+            "dofs": billet.dofs, "time_s": elapsed, "steps": steps,
+            "step_cuts": path.failures, "newton_iterations": path.iterations,
+            "factorizations": path.work.factorizations,
+            "status_iterations": sum(r.active_set_iterations for r in path.results),
+            "linear_solve_s": one_solve,
+            "step_in_linear_solves": elapsed / steps / one_solve, "force": up.force}
+
+
+def variants(quick):
+    rows = []
+    for friction in (0.0, 0.2):
+        for variant in VARIANTS:
+            r = upset(6 if quick else 12, friction, variant)
+            rows.append(r)
+            if "failed" in r:
+                say(f"{r['problem']:18s} {variant:9s} failed: {r['failed']}")
+                continue
+            say(f"{r['problem']:18s} {variant:9s} {r['dofs']:6d} dofs {r['time_s']:7.2f} s "
+                f"{r['newton_iterations']:5d} Newton {r['factorizations']:4d} LU "
+                f"{r['status_iterations']:4d} statuses, a step = "
+                f"{r['step_in_linear_solves']:.1f} linear solves, F = {r['force']:.8g}")
+    return rows
+
+
+def demo_run(cells, ranks):
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "u.json"
+        cmd = [str(ROOT / ".venv" / "bin" / "mpiexec"), "-n", str(ranks), sys.executable,
+               str(ROOT / "demos" / "upsetting.py"), "--cells", str(cells), "--json", str(out)]
+        subprocess.run(cmd, check=True, capture_output=True, text=True)
+        return json.loads(out.read_text())
+
+
+def size_runs(quick):
+    cells = 12 if quick else 56
+    rows = []
+    for ranks in (1, 2):
+        d = demo_run(cells, ranks)
+        rows.append({"cells": cells, "ranks": ranks, "dofs": d["dofs"],
+                     "wall_time_s": d["wall_time_s"], "solve_time_s": d["solve_time_s"],
+                     "newton_iterations": d["newton_iterations"],
+                     "status_iterations": d["status_iterations"], "force": d["force"]})
+        say(f"upsetting f = 0.2, {d['dofs']} dofs, {ranks} rank(s): {d['wall_time_s']:.1f} s, "
+            f"F = {d['force']:.8g}")
+    return rows
+
+
+# r/r0 at 4, 5, 6 mm a end (Simo & Hughes, digitized to 0.1 mm) and 7 mm (ANSYS VM318)
+PUBLISHED = {4.0: 5.3 / RADIUS, 5.0: 4.6 / RADIUS, 6.0: 3.7 / RADIUS,
+             7.0: (RADIUS * NARROWING - 3.740) / RADIUS}
+
+
+def considere_force() -> float:
+    """The neck section's largest force in uniaxial rigid plasticity: σ_y(p) A e^(−p) at
+    dσ_y/dp = σ_y (Considère)."""
+    law = simo_material()
+    p = brentq(lambda q: (law.H + law.delta * (law.saturation - law.sigma0)
+                          * math.exp(-law.delta * q)) - law.yield_stress(q, exp=np.exp),
+               1e-3, 2.0)
+    return law.yield_stress(p, exp=np.exp) * math.pi * (RADIUS * NARROWING) ** 2 \
+        * math.exp(-p)
+
+
+def necking_runs(quick):
+    rows = []
+    meshes = [(4, False), (8, False)] if quick else [(4, False), (8, False), (16, False),
+                                                     (32, False), (8, True)]
+    for cells, gripped in meshes:
+        bar = NeckingBar(cells, mixed=False, gripped=gripped)
+        forces, ends, radii = [], [0.0], [NARROWING]
+        t0 = time.perf_counter()
+
+        def on_step(t, result, b=bar, f=forces, e=ends, r=radii):
+            f.append(b.force())
+            e.append(7 * t)
+            r.append(b.neck_radius() / RADIUS)
+
+        path = solve_incrementally(bar.solver, lambda t, b=bar: b.set_elongation(14 * t), 50,
+                                   max_step=0.02, commit=bar.commit, on_step=on_step)
+        r = {"cells": cells, "gripped": gripped, "dofs": bar.dofs,
+             "time_s": time.perf_counter() - t0, "steps": len(path.results),
+             "newton_iterations": path.iterations, "peak_force_kN": max(forces) / 1e3,
+             "final_force_kN": forces[-1] / 1e3,
+             "radius_ratio": {str(u): float(np.interp(u, ends, radii)) for u in PUBLISHED}}
+        say(f"necking bar, {cells} cells{' gripped' if gripped else ''} ({r['dofs']} dofs): "
+            f"peak {r['peak_force_kN']:.3f} kN, r/r0 {r['radius_ratio']}, "
+            f"{r['time_s']:.1f} s")
+        rows.append(r)
+    return rows
+
+
+def table(out):
+    lines = ["| problem | variant | unknowns | Newton its | factorizations | status its "
+             "| time (s) | a step, in linear solves | force | vs full |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    full = {}
+    for r in out["variants"]:
+        if r["variant"] == "full":
+            full[r["problem"]] = r
+        f = full[r["problem"]]
+        if "failed" in r:
+            lines.append(f"| {r['problem']} | {r['variant']} | {r['dofs']} | failed: "
+                         f"{r['failed']} | | | | | | |")
+            continue
+        lines.append(f"| {r['problem']} | {r['variant']} | {r['dofs']} | "
+                     f"{r['newton_iterations']} | {r['factorizations']} | "
+                     f"{r['status_iterations']} | {r['time_s']:.2f} (×"
+                     f"{r['time_s'] / f['time_s']:.2f}) | {r['step_in_linear_solves']:.1f} | "
+                     f"{r['force']:.7g} | {abs(r['force'] / f['force'] - 1):.1e} |")
+    lines += ["", "| upsetting f = 0.2 | unknowns | ranks | wall time (s) | solve (s) | "
+              "Newton its | force |", "|---|---|---|---|---|---|---|"]
+    for r in out["size"]:
+        lines.append(f"| {r['cells']} cells | {r['dofs']} | {r['ranks']} | "
+                     f"{r['wall_time_s']:.1f} | {r['solve_time_s']:.1f} | "
+                     f"{r['newton_iterations']} | {r['force']:.7g} |")
+    head = " | ".join(f"r/r0 at {u:g} mm" for u in PUBLISHED)
+    lines += ["", f"| necking bar | unknowns | peak force (kN) | {head} | Newton its | time (s) |",
+              "|---|---|---|" + "---|" * len(PUBLISHED) + "---|---|",
+              f"| published | | {out['considere_force_kN']:.2f} (Considère, neck section) | "
+              + " | ".join(f"{v:.3f}" for v in PUBLISHED.values()) + " | | |"]
+    for r in out["necking"]:
+        ratios = " | ".join("" if v is None else f"{v:.3f}" for v in r["radius_ratio"].values())
+        lines.append(f"| {r['cells']} cells{', gripped' if r['gripped'] else ''} | {r['dofs']} "
+                     f"| {r['peak_force_kN']:.3f} | {ratios} | {r['newton_iterations']} | "
+                     f"{r['time_s']:.1f} |")
+    lines.append("")
+    lines.append("Upsetting: R0 = 10, h0 = 20 to 50 % in 20 steps (cut when a step fails), "
+                 "P2. Modified Newton keeps the elastic tangent of the configuration each "
+                 "inner solve starts from. Necking bar: P2 displacement formulation, graded "
+                 "mesh, 50 steps; the Taylor–Hood form does not pass the force peak yet "
+                 f"(Newton stalls there). {out['machine']['cores']} cores.")
+    return "\n".join(lines)
+
+
+def main():
+    args = options(__doc__, "small meshes, nothing written")
+    out = {"machine": machine(), "considere_force_kN": considere_force() / 1e3,
+           "variants": variants(args.quick),
+           "size": size_runs(args.quick), "necking": necking_runs(args.quick)}
+    publish("forming", out, table, args, say)
+
+
+main()
