@@ -71,6 +71,7 @@ class UpsettingParameters(Parameters):
                                 "strain, the die and the contact statuses",
                          "plot": "the force against the reduction, with the frictionless "
                                  "closed form and the slab estimate"}
+    CHECKPOINTS = True
 
     friction: float = number(0.2, "Coulomb friction coefficient f on the die faces (0: "
                              "frictionless, the homogeneous compression)", at_least=0)
@@ -148,11 +149,17 @@ def record(t, result):
         f"{result.iterations} Newton / {result.active_set_iterations} status iterations")
 
 
+# --checkpoint saves, after each converged step, the displacement, the plastic state, the
+# contact's statuses and slip history and the steps so far; --restart puts them back
+checkpoints = cli.checkpointing({"unknown": billet.unknown, **material.state_functions()},
+                                newton=up.contact.newton, contact=up.contact)
+history += checkpoints.steps
 t0 = time.perf_counter()
 run = solve_incrementally(up, lambda t: up.set_reduction(t * args.reduction), args.steps,
                           adaptive=True, max_step=1.0 / args.steps,
                           easy_iterations=10**9, progress=say, progress_every=10**9,
-                          commit=up.commit, restore=up.restore, on_step=record)
+                          commit=up.commit, restore=up.restore, on_step=record,
+                          **checkpoints.options)
 solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 # -
 
@@ -190,7 +197,7 @@ out = {"force": last["force"], "reduction": last["reduction"], "friction": args.
        "folded_nodes": last["folded_nodes"], "max_plastic_strain": up.max_plastic_strain(),
        "volume_change": up.volume() / up.initial_volume(R0, h0) - 1,
        "newton_iterations": run.iterations,
-       "status_iterations": sum(r.active_set_iterations for r in run.results),
+       "status_iterations": sum(h["status_iterations"] for h in history),
        "step_cuts": run.failures, "factorizations": run.work.factorizations,
        "dofs": billet.dofs, "ranks": comm.size, "solve_time_s": solve_time,
        "warnings": [] if args.friction == 0 else [

@@ -72,3 +72,22 @@ def test_bad_input_one_clear_line(args, message, demo):
     proc = demo.run(["upsetting.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_a_killed_upsetting_restarts_to_the_uninterrupted_answer(tmp_path, demo):
+    # the displacement, the plastic state, the statuses and the slip history come back
+    import json
+    import sys
+
+    from conftest import DEMOS, run_and_kill
+
+    args = ("--steps", "8", "--cells", "4")
+    whole = demo.json("upsetting.py", *args)
+    run_and_kill([sys.executable, DEMOS / "upsetting.py", *args, "--checkpoint", "ck"],
+                 tmp_path, "  reduction 0.25")
+    saved = json.loads((tmp_path / "ck" / "latest.json").read_text())["step"]
+    assert saved != "step-000010", saved  # killed on the way (10 steps: 2 cut)
+    again = demo.json("upsetting.py", *args, "--restart", tmp_path / "ck")
+    assert again["force_history"] == pytest.approx(whole["force_history"], rel=1e-10)
+    for k in ("stick_radius", "contact_radius", "max_plastic_strain"):
+        assert again[k] == pytest.approx(whole[k], rel=1e-10), k
