@@ -229,14 +229,16 @@ def test_small_strain_limit_is_the_project_j2():
     assert differences[0] < 3 * 4e-3 * 3, differences  # 3 δ at the largest strain
 
 
-def inflate_sphere(steps=10):
-    """A thick incompressible, perfectly plastic sphere (a0 = 1, b0 = 2) inflated by its
-    inner displacement to a = 2 a0; (a, p, 2σ0 ln(b/a)) at each step, b from b³ − a³ = b0³ −
-    a0³ (mixed form, ν = 1/2)."""
+def inflate(shape="sphere", steps=10):
+    """A thick incompressible, perfectly plastic sphere or cylinder (plane strain; a0 = 1,
+    b0 = 2) inflated by its inner displacement to a = 2 a0; (a, p, the closed form) at each
+    step: 2σ0 ln(b/a) for the sphere, b³ − a³ = b0³ − a0³; (2/√3) σ0 ln(b/a) for the
+    cylinder, b² − a² = b0² − a0² (mixed form, ν = 1/2)."""
     from fenics_nl.scenes.vessel import VesselBody
 
     a0, b0 = 1.0, 2.0
-    body = VesselBody("sphere", a0, b0, size=(b0 - a0) / 6, mixed=True)
+    n, factor = (3, 2.0) if shape == "sphere" else (2, 2 / math.sqrt(3))
+    body = VesselBody(shape, a0, b0, size=(b0 - a0) / 6, mixed=True)
     material = FiniteJ2Plasticity(E, 0.5, sigma0=S0)
     material.bind(body.mesh, body.quadrature_degree)
     residual = body.fields.internal_work(material, body.model) * body.dx
@@ -246,23 +248,27 @@ def inflate_sphere(steps=10):
 
     def on_step(t, result):
         a = a0 + t * a0
-        b = (b0**3 - a0**3 + a**3) ** (1 / 3)
-        out.append((a, body.pressure_from(compiled, a), 2 * S0 * math.log(b / a)))
+        b = (b0**n - a0**n + a**n) ** (1 / n)
+        out.append((a, body.pressure_from(compiled, a), factor * S0 * math.log(b / a)))
 
     solve_incrementally(solver, lambda t: body.move_inner(t * a0), steps, adaptive=False,
                         commit=lambda: material.commit(body.u, body.model), on_step=on_step)
     return np.array(out)
 
 
-@pytest.mark.parametrize("ranks", [pytest.param(1), pytest.param(2, marks=pytest.mark.mpi)])
-def test_inflated_sphere_pressure_falls_as_two_sigma0_ln_b_over_a(ranks):
-    # once the wall is fully plastic, p = 2σ0 ln(b/a) in the current radii: the pressure
-    # falls as the sphere inflates. Asked within 0.5 %; measured 2e-5 at h = (b − a)/6 (P2),
-    # asserted within 1e-3
+@pytest.mark.parametrize("shape,ranks", [("sphere", 1), ("cylinder", 1),
+                                         pytest.param("sphere", 2, marks=pytest.mark.mpi)])
+def test_inflated_vessel_pressure_falls_with_the_current_radii(shape, ranks):
+    # once the wall is fully plastic, p = 2σ0 ln(b/a) (sphere; plane-strain cylinder:
+    # (2/√3) σ0 ln(b/a)) in the current radii: the pressure falls as it inflates. Asked
+    # within 0.5 %. Sphere: measured 2e-5 at h = (b − a)/6 (P2) in 10 steps, asserted
+    # within 1e-3. Cylinder: 3e-5 at a = 1.5 a0, −0.40 % at 2 a0 (the error grows past
+    # 1.6 a0, where the inner cells are stretched 1.6 times round and squeezed across; it
+    # needs 40 steps: from 20, Newton blows up at a = 1.5 a0), asserted within the 0.5 %
     assert MPI.COMM_WORLD.size == ranks, "the mpi case runs under mpiexec -n 2"
-    result = inflate_sphere()
+    result = inflate(shape, 10 if shape == "sphere" else 40)
     at = {round(a, 6): (p, exact) for a, p, exact in result}
     for a in (1.5, 2.0):
         p, exact = at[a]
-        assert p == pytest.approx(exact, rel=1e-3)
+        assert p == pytest.approx(exact, rel=1e-3 if shape == "sphere" else 5e-3)
     assert np.all(np.diff(result[:, 1]) < 0)  # falling
