@@ -148,9 +148,9 @@ def considere_force() -> float:
     dσ_y/dp = σ_y (Considère)."""
     law = simo_material()
     p = brentq(lambda q: (law.H + law.delta * (law.saturation - law.sigma0)
-                          * math.exp(-law.delta * q)) - law.yield_stress(q, exp=np.exp),
+                          * math.exp(-law.delta * q)) - law.yield_stress(q),
                1e-3, 2.0)
-    return law.yield_stress(p, exp=np.exp) * math.pi * (RADIUS * NARROWING) ** 2 \
+    return law.yield_stress(p) * math.pi * (RADIUS * NARROWING) ** 2 \
         * math.exp(-p)
 
 

@@ -335,6 +335,10 @@ def read_case(path: str | Path) -> Case:
             if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
                 r.fail(f"{c.key}", "arc-length control scales loads only: a contact or a "
                                    "prescribed non-zero displacement cannot take part")
+        if law == "j2-finite":  # its commit may refuse a step, which only load steps cut
+            r.fail("loading.control", 'j2-finite is driven by load steps (its commit may '
+                                      'refuse a step too large, and a step is cut): remove '
+                                      'control = "arc-length"')
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions, arc)
     probes = _probes(r, data, dim)

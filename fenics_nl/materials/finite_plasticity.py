@@ -27,7 +27,7 @@ where two stretches coincide (uniaxial tension, axisymmetry), and short enough f
 tangent kernel. Over a load step the trial deviatoric elastic strain is the elastic strain
 (σ_y/E) plus the step's increment, a few per cent, where the series is exact to round-off;
 `commit` measures its truncation against an eigen-decomposition and refuses a step that made
-it exceed 1e-9 (an equivalent strain increment of about 0.3).
+it exceed 1e-9 (a trial deviatoric strain ε̄ of about 0.35).
 
 Voce hardening solves the scalar return equation by Newton iterations unrolled in UFL
 (the equation is convex, so Newton rises monotonically to the root; `commit` checks the
@@ -46,13 +46,17 @@ import ufl
 from fenics_nl.errors import SolveError
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import FiniteStrain, Isotropic, check_range
-from fenics_nl.materials.plasticity import YIELD_TOLERANCE, per_cell
+from fenics_nl.materials.plasticity import QuadratureStateOutputs, quadrature_spaces
 
 __all__ = ["FiniteJ2Plasticity", "FiniteStrainState", "deviatoric_log_strain_squared"]
 
 SERIES_TOLERANCE = 1e-9  # relative truncation of |dev ε_tr| a commit accepts
 RETURN_ITERATIONS = 4  # Voce: Newton iterations of the scalar return (unrolled)
 RETURN_TOLERANCE = 1e-10  # its residual, relative to σ0, that a commit accepts
+# f > 1e-8 σ0 is plastic: a committed point starts the next step on its yield surface to the
+# round-off of the invariants of C Cp⁻¹ (about 1e-16 λ⁴ of |dev ε|², 1e-10 σ0 at λ = 3),
+# and must start it elastic (an unloading step with the plastic tangent overshoots)
+YIELD_TOLERANCE = 1e-8
 
 # Σ x_i² for x_i = ln λ̄_i (Σ x_i = 0) as Σ k s^i c^j, s = tr Ā + tr Ā⁻¹ − 6 and
 # c = (tr Ā − tr Ā⁻¹)², every term with 2i + 6j <= 14: (i, j, k). Obtained by inverting
@@ -102,14 +106,9 @@ class FiniteStrainState:
 
     def bind(self, mesh, degree: int) -> None:
         """Virgin state (Cp⁻¹ = I, p = 0) at the quadrature points of `degree` on `mesh`."""
-        import basix.ufl
         from dolfinx import fem
 
-        cell = mesh.basix_cell()
-        T = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(3, 3), scheme="default", degree=degree))
-        S = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(), scheme="default", degree=degree))
+        T, S = quadrature_spaces(mesh, degree)
         self.metric = fem.Function(T, name="plastic_metric")
         self.p = fem.Function(S, name="cumulated_plastic_strain")
         self.points, self.update = T.element.interpolation_points, None
@@ -122,11 +121,14 @@ class FiniteStrainState:
 
 
 @dataclass(frozen=True, eq=False)
-class FiniteJ2Plasticity(Isotropic, FiniteStrain):
+class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
     """J2 at finite strain: σ0 > 0, linear hardening H ≥ 0, Voce saturation σ∞ ≥ σ0, δ ≥ 0.
 
     σ_y(p) = σ0 + H p + (σ∞ − σ0)(1 − exp(−δ p)); `saturation=None` (the default) is σ∞ = σ0,
     linear hardening (H = 0: perfect plasticity). Models: 3D, plane strain, axisymmetric.
+    Modified Newton keeps the tangent each solve starts from ("initial"): at finite strain
+    the elastic tangent of that configuration (its points start elastic), not Hooke's
+    reference tangent, which would ignore the rotations and stretches of a forming step.
     """
 
     sigma0: float = 1.0
@@ -149,6 +151,11 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
                 math.isfinite(float(self.saturation)) and self.saturation >= self.sigma0):
             raise ValueError(f"saturation must be >= sigma0 ({self.sigma0:g}) and finite, got "
                              f"{self.saturation!r}")
+        saturating = self.saturation is not None and self.saturation > self.sigma0
+        if saturating != (self.delta > 0):  # half a Voce law would be silently linear
+            raise ValueError("saturation (> sigma0) and delta (> 0) go together: Voce's "
+                             f"hardening needs both, got saturation={self.saturation!r}, "
+                             f"delta={self.delta!r}")
 
     # the hardening law
 
@@ -157,8 +164,9 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         """A saturating (non-linear) part: the return needs iterations."""
         return self.saturation is not None and self.saturation > self.sigma0 and self.delta > 0
 
-    def yield_stress(self, p, exp=ufl.exp):
-        """σ_y(p) (UFL, or numpy with `exp=np.exp`)."""
+    def yield_stress(self, p):
+        """σ_y(p): UFL for a UFL p, numpy for a number or an array."""
+        exp = np.exp if isinstance(p, int | float | np.floating | np.ndarray) else ufl.exp
         s = self.sigma0 + self.H * p
         if self.voce:
             s = s + (self.saturation - self.sigma0) * (1 - exp(-self.delta * p))
@@ -228,16 +236,6 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         rest, lnJ, k = self.volumetric_split(e)
         return rest + 0.5 * k * lnJ**2
 
-    def modified_newton_tangent(self, u, model: str, dx):
-        """The tangent at the start of each step ("initial"): an elastic tangent.
-
-        At finite strain the elastic tangent of the configuration the step starts from (the
-        committed points sit on the yield surface, within the tolerance that makes them
-        start elastic), refactorized each step. Hooke's reference tangent
-        would ignore the rotations and stretches of a forming operation.
-        """
-        return "initial"
-
     # the state
 
     def reset(self) -> None:
@@ -259,34 +257,9 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         st = self._bound()
         return {"plastic_metric": st.metric, "cumulated_plastic_strain": st.p}
 
-    def cumulated_plastic_strain_per_cell(self):
-        """The largest committed p of each cell's quadrature points (DG0 Function)."""
-        from dolfinx import fem
-
-        p = self.cumulated_plastic_strain
-        cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
-                             name="cumulated_plastic_strain")
-        per_cell(p, cells, np.max)
-        return cells
-
     def output_fields(self) -> list:
         """What a time series writes of the state: p (cell max), DG0."""
         return [self.cumulated_plastic_strain_per_cell()]
-
-    def cell_mean(self, expression, name: str):
-        """The mean of a scalar UFL expression over each cell's quadrature points (DG0)."""
-        from dolfinx import fem
-
-        st = self._bound()
-        at_points = fem.Function(st.p.function_space)
-        at_points.interpolate(fem.Expression(expression, st.points))
-        f = fem.Function(fem.functionspace(st.p.function_space.mesh, ("DG", 0)), name=name)
-        per_cell(at_points, f, np.mean)
-        return f
-
-    def von_mises(self, u, model: str = "3d"):
-        """σ_eq per cell (DG0): the mean of its quadrature points' values."""
-        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
 
     def commit(self, u, model: str = "3d") -> None:
         """Store the returned state of the displacement `u` (a converged step).
@@ -317,38 +290,51 @@ class FiniteJ2Plasticity(Isotropic, FiniteStrain):
         volume = np.cbrt(np.prod(lam, axis=1))[:, None]  # J^⅔ (det Cp⁻¹ = 1)
         log_dev = 0.5 * np.log(lam / volume)  # dev ε_tr, eigenvalues
         eq_exact = np.sqrt(2.0 / 3.0 * np.sum(log_dev**2, axis=1))
-        self._check_commit(eq, 2 * log_dev, dp)
-        keep = 1.0 - np.divide(dp, eq_exact, out=np.zeros_like(dp), where=dp > 0)
-        new = volume * np.exp(2 * keep[:, None] * log_dev)
-        be = np.einsum("pij,pj,pkj->pik", vec, new, vec)
-        F_inv = np.linalg.inv(F)
+        self._check_commit(st.p.function_space.mesh.comm, eq, 2 * log_dev, dp)
+        flowed = dp > 0  # elastic points keep their Cp⁻¹ (no round trip through F⁻¹)
+        # |dev ε_e| = (ε̄ − Δp) with the ε̄ of the series, the one the next step's trial
+        # reads: the point then starts that step on its yield surface, to round-off
+        keep = (eq[flowed] - dp[flowed]) / eq_exact[flowed]
+        new = volume[flowed] * np.exp(2 * keep[:, None] * log_dev[flowed])
+        be = np.einsum("pij,pj,pkj->pik", vec[flowed], new, vec[flowed])
+        F_inv = np.linalg.inv(F[flowed])
         cp = F_inv @ be @ F_inv.transpose(0, 2, 1)
-        metric[:] = 0.5 * (cp + cp.transpose(0, 2, 1))
+        cp = 0.5 * (cp + cp.transpose(0, 2, 1))
+        metric[flowed] = cp / np.cbrt(np.linalg.det(cp))[:, None, None]  # det Cp⁻¹ = 1
         st.p.x.array[:] += dp
 
-    def _check_commit(self, eq, x, dp) -> None:
-        """The series' truncation and (Voce) the return's residual, at every point.
+    def _check_commit(self, comm, eq, x, dp) -> None:
+        """The series' truncation and (Voce) the return's residual, on every rank.
+
+        A refusal is every rank's: the driver's cut is collective.
 
         `x`: the eigenvalues of ln b̄_tr. The truncation is measured on them, the series
         evaluated at s and c computed from them without cancellation (the invariants of
         C Cp⁻¹ carry a round-off that grows with the stretch, about 1e-16 λ⁴, which is not
-        the step's doing); relative where the strain is at least the yield strain.
+        the step's doing); relative where the strain is at least the yield strain. A NaN
+        fails both checks.
         """
+        from mpi4py import MPI
+
         s = np.sum(4 * np.sinh(0.5 * x) ** 2, axis=1)  # Σ 2 (cosh x − 1)
         c = np.sum(2 * np.sinh(x), axis=1) ** 2
         series = sum(k * s**i * c**j for i, j, k in LOG_SERIES)
         exact = np.sum(x**2, axis=1)
         floor = 6 * (self.sigma0 / (3 * self.mu)) ** 2  # Σ x² at the yield strain
-        worst = 0.5 * float(np.max(np.abs(series - exact) / np.maximum(exact, floor),
-                                   initial=0.0))  # |dev ε| relative: half of Σ x²'s
-        if worst > SERIES_TOLERANCE:
+        # |dev ε| relative: half of Σ x²'s (NaN kept: np.max propagates it)
+        worst = comm.allreduce(0.5 * float(np.max(np.abs(series - exact)
+                                                   / np.maximum(exact, floor), initial=0.0)),
+                               op=MPI.MAX)
+        if not worst <= SERIES_TOLERANCE:
             raise SolveError(f"a load step too large for the logarithmic strain's series "
                              f"(|dev ε| off by {worst:.1e} relative at a point): take "
                              "smaller steps")
+        residual = 0.0
         if self.voce and np.any(dp > 0):
             p = self._bound().p.x.array[dp > 0] + dp[dp > 0]
-            g = 3 * self.mu * (eq[dp > 0] - dp[dp > 0]) - self.yield_stress(p, exp=np.exp)
-            worst = float(np.max(np.abs(g))) / self.sigma0
-            if worst > RETURN_TOLERANCE:
-                raise SolveError(f"the Voce return did not converge (residual {worst:.1e} "
-                                 "σ0 at a point): take smaller steps")
+            g = 3 * self.mu * (eq[dp > 0] - dp[dp > 0]) - self.yield_stress(p)
+            residual = float(np.max(np.abs(g))) / self.sigma0
+        residual = comm.allreduce(residual, op=MPI.MAX)
+        if not residual <= RETURN_TOLERANCE:
+            raise SolveError(f"the Voce return did not converge (residual {residual:.1e} "
+                             "σ0 at a point): take smaller steps")

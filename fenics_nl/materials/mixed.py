@@ -129,9 +129,11 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
 def modified_newton_tangent(material, unknown: MixedUnknown, model: str, dx):
     """The mixed counterpart of `Material.modified_newton_tangent`.
 
-    For a path-dependent law: the tangent of the same mixed form with Hooke's law (E, ν).
+    For a path-dependent law at small strain: the tangent of the same mixed form with
+    Hooke's law (E, ν); at finite strain, the tangent each solve starts from, as in the
+    displacement formulation.
     """
-    if not material.path_dependent:
+    if not material.path_dependent or material.finite_strain:
         return "initial"
     from fenics_nl.materials.laws import LinearElastic
 

@@ -32,7 +32,8 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["J2Plasticity", "PlasticState", "per_cell"]
+__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "per_cell",
+           "quadrature_spaces"]
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
 
@@ -51,21 +52,63 @@ class PlasticState:
 
     def bind(self, mesh, degree: int) -> None:
         """Zero ε_p and p at the quadrature points of `degree` on `mesh`."""
-        import basix.ufl
         from dolfinx import fem
 
-        cell = mesh.basix_cell()
-        T = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(3, 3), scheme="default", degree=degree))
-        S = fem.functionspace(mesh, basix.ufl.quadrature_element(
-            cell, value_shape=(), scheme="default", degree=degree))
+        T, S = quadrature_spaces(mesh, degree)
         self.eps_p = fem.Function(T, name="plastic_strain")
         self.p = fem.Function(S, name="cumulated_plastic_strain")
         self.points, self.commit = T.element.interpolation_points, None
 
 
+def quadrature_spaces(mesh, degree: int):
+    """(3x3 tensor, scalar) spaces at the quadrature points of `degree` on `mesh`."""
+    import basix.ufl
+    from dolfinx import fem
+
+    cell = mesh.basix_cell()
+    return tuple(fem.functionspace(mesh, basix.ufl.quadrature_element(
+        cell, value_shape=shape, scheme="default", degree=degree)) for shape in ((3, 3), ()))
+
+
+class QuadratureStateOutputs:
+    """Per-cell outputs of a law whose state lives at the quadrature points.
+
+    J2 at small and finite strain: the law has `cumulated_plastic_strain`, a quadrature
+    Function.
+    """
+
+    def cumulated_plastic_strain_per_cell(self):
+        """The largest committed p of each cell's quadrature points (DG0 Function)."""
+        from dolfinx import fem
+
+        p = self.cumulated_plastic_strain
+        cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
+                             name="cumulated_plastic_strain")
+        per_cell(p, cells, np.max)
+        return cells
+
+    def cell_mean(self, expression, name: str):
+        """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
+
+        The state exists at the quadrature points only, so anything that reads it (σ_eq,
+        the mixed formulation's stress) is evaluated there.
+        """
+        from dolfinx import fem
+
+        Q = self.cumulated_plastic_strain.function_space
+        at_points = fem.Function(Q)
+        at_points.interpolate(fem.Expression(expression, Q.element.interpolation_points))
+        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
+        per_cell(at_points, f, np.mean)
+        return f
+
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq per cell (DG0): the mean of its quadrature points' values."""
+        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
+
+
 @dataclass(frozen=True, eq=False)
-class J2Plasticity(Isotropic, SmallStrain):
+class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
     """J2 plasticity: yield stress σ0 > 0, isotropic hardening H ≥ 0, kinematic C ≥ 0.
 
     H = C = 0 is perfect plasticity (the defaults of H and C). Models: 3D, plane strain,
@@ -118,16 +161,6 @@ class J2Plasticity(Isotropic, SmallStrain):
     def cumulated_plastic_strain(self):
         """The committed cumulated plastic strain p (quadrature Function)."""
         return self._bound().p
-
-    def cumulated_plastic_strain_per_cell(self):
-        """The largest committed p of each cell's quadrature points (DG0 Function)."""
-        from dolfinx import fem
-
-        p = self.cumulated_plastic_strain
-        cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
-                             name="cumulated_plastic_strain")
-        per_cell(p, cells, np.max)
-        return cells
 
     def state_functions(self) -> dict:
         """The committed state's quadrature Functions by name (to checkpoint and restore)."""
@@ -205,26 +238,6 @@ class J2Plasticity(Isotropic, SmallStrain):
         rest = (self.mu * ufl.inner(d, d) + 0.5 * self.H * p**2
                 + self.C / 3.0 * ufl.inner(eps_p, eps_p) + self.sigma0 * dp)
         return rest, ufl.tr(eps), self.kappa
-
-    def von_mises(self, u, model: str = "3d"):
-        """σ_eq per cell (DG0): the mean of its quadrature points' values."""
-        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
-
-    def cell_mean(self, expression, name: str):
-        """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
-
-        The state exists at the quadrature points only, so anything that reads it (σ_eq,
-        the mixed formulation's stress) is evaluated there.
-        """
-        from dolfinx import fem
-
-        st = self._bound()
-        Q = st.p.function_space
-        at_points = fem.Function(Q)
-        at_points.interpolate(fem.Expression(expression, st.points))
-        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
-        per_cell(at_points, f, np.mean)
-        return f
 
     def commit(self, u, model: str = "3d") -> None:
         """Store the return-mapped state of the displacement `u` (a converged step).

@@ -4,9 +4,9 @@ A bar of radius r0 = 6.413 mm and length L0 = 53.334 mm, the radius narrowed lin
 0.982 r0 at mid-length (the imperfection that fixes where the neck forms), is pulled at
 both ends by `elongation`/2 each. By symmetry the quarter 0 < r < R(z), 0 < z < L0/2 of the
 (r, z) plane is computed: the axis (u_r = 0), the mid-plane (u_z = 0), the end z = L0/2
-moved along z and held radially (gripped). Steel-like, Voce hardening with a linear part:
-E = 206.9 GPa, ν = 0.29, σ_y = 450 + 129.24 p + (715 − 450)(1 − exp(−16.93 p)) MPa. Units:
-N, mm, MPa.
+moved along z, radially free as in ANSYS VM318 (`gripped`: held radially too).
+Steel-like, Voce hardening with a linear part: E = 206.9 GPa, ν = 0.29,
+σ_y = 450 + 129.24 p + (715 − 450)(1 − exp(−16.93 p)) MPa. Units: N, mm, MPa.
 """
 
 from __future__ import annotations
@@ -38,8 +38,9 @@ def simo_material(nu: float = 0.29) -> FiniteJ2Plasticity:
 class NeckingBar:
     """Mesh, unknown, material, supports, the end's motion and its solver.
 
-    `cells` across the radius, square cells graded towards the neck (`grading` > 1: the
-    cells at mid-length `grading` times shorter than at the end).
+    `cells` across the radius and about 4.2 times as many along the half length, graded
+    towards the neck: z = (L0/2) s^a, a = 1 + ln(grading)/ln(rows), so that the cells at
+    mid-length are about `grading` times shorter than the mean (1: uniform).
     """
 
     def __init__(self, cells: int = 4, *, grading: float = 3.0, mixed: bool = True,

@@ -9,7 +9,9 @@ Any solver fits that has `u` (the unknown Function) and `solve()` returning a
 `SolveResult` or raising a `SolveError`: NewtonSolver, SnesSolver, ActiveSetContact.
 Path-dependent state that the solver itself does not hold (internal variables at
 quadrature points, slip at contact nodes) is kept right by two hooks: `commit()` after each
-converged step, `restore()` when a step is cut (the displacement is restored here).
+converged step, `restore()` when a step is cut (the displacement is restored here). A
+commit may refuse its step by raising SolveError before it stores anything (a step too
+large for the law's integration, on every rank): the step is then cut like a failed solve.
 
 The predictor matters past a bifurcation: from the last state alone Newton can settle on a
 nearby unstable branch (a column that stays straight above its Euler load); extrapolation
@@ -120,14 +122,16 @@ def solve_incrementally(
             x.axpy(dt / dt_previous, saved)
             x.axpy(-dt / dt_previous, previous)
             x.ghostUpdate()
+        result = None
         try:
             result = solver.solve()
             if commit:  # may refuse the step (a SolveError) before it stores anything
                 commit()
         except SolveError as err:
             path.failures += 1
-            if err.result is not None:
-                path.work.add(err.result.work)
+            spent = err.result if err.result is not None else result  # a refused commit's
+            if spent is not None:
+                path.work.add(spent.work)
             saved.copy(x)
             x.ghostUpdate()
             if restore:
