@@ -398,15 +398,18 @@ def forming(x: dict) -> str:
                      f"({full['step_in_linear_solves']:.0f} linear solves a step), "
                      + ", ".join(parts))
     one, two = (next(r for r in x["size"] if r["ranks"] == k) for k in (1, 2))
-    free = sorted((r for r in x["necking"] if not r.get("gripped")), key=lambda r: r["dofs"])
+    free = sorted((r for r in x["necking"] if not r.get("gripped") and "failed" not in r),
+                  key=lambda r: r["dofs"])
     n, coarser = free[-1], free[-2]
     change = max(abs(v - coarser["radius_ratio"][u]) for u, v in n["radius_ratio"].items())
     ratios = ", ".join(f"{float(u):g} mm {v:.3f}" for u, v in n["radius_ratio"].items())
+    best = {problem: min((r for r in x["variants"]
+                          if r["problem"] == problem and "failed" not in r),
+                         key=lambda r: r["time_s"])["variant"]
+            for problem in dict.fromkeys(r["problem"] for r in x["variants"])}
+    fastest = "; ".join(f"{p}: {v} is the fastest" for p, v in best.items())
     return ("* **Forming at finite strain** (J2 with the die's active set): "
-            + "; ".join(lines) + ". At finite strain with friction a constant tangent buys "
-            "nothing: the status loop already refactorizes per solve, and BFGS's savings go "
-            "to its extra iterations; without friction modified Newton (the elastic tangent "
-            "of each step's start) is the cheapest. The 50 % upsetting with friction at "
+            + "; ".join(lines) + f". {fastest}. The 50 % upsetting with friction at "
             f"{one['dofs']} unknowns takes {one['wall_time_s'] / 60:.1f} min on 1 rank, "
             f"{two['wall_time_s'] / 60:.1f} min on 2 "
             f"({one['wall_time_s'] / two['wall_time_s']:.2f}x). The necking bar's neck radius "
