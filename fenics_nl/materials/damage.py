@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import numpy as np
 import ufl
 
 from fenics_nl.materials import kinematics
@@ -154,15 +153,9 @@ class CourseDamage(Isotropic, SmallStrain):
 
     def damage_per_cell(self):
         """The largest committed α of each cell's quadrature points (DG0 Function)."""
-        from dolfinx import fem
+        from fenics_nl.materials.plasticity import cell_max
 
-        from fenics_nl.materials.plasticity import per_cell
-
-        a = self.alpha
-        cells = fem.Function(fem.functionspace(a.function_space.mesh, ("DG", 0)),
-                             name="damage")
-        per_cell(a, cells, np.max)
-        return cells
+        return cell_max(self.alpha, "damage")
 
     def state_functions(self) -> dict:
         """The committed state's quadrature Functions by name (to checkpoint and restore)."""

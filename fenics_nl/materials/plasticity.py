@@ -32,7 +32,7 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "per_cell",
+__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "cell_max", "per_cell",
            "quadrature_spaces"]
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
@@ -79,13 +79,7 @@ class QuadratureStateOutputs:
 
     def cumulated_plastic_strain_per_cell(self):
         """The largest committed p of each cell's quadrature points (DG0 Function)."""
-        from dolfinx import fem
-
-        p = self.cumulated_plastic_strain
-        cells = fem.Function(fem.functionspace(p.function_space.mesh, ("DG", 0)),
-                             name="cumulated_plastic_strain")
-        per_cell(p, cells, np.max)
-        return cells
+        return cell_max(self.cumulated_plastic_strain, "cumulated_plastic_strain")
 
     def cell_mean(self, expression, name: str):
         """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
@@ -262,6 +256,16 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         b.interpolate(new_p)
         st.eps_p.x.array[:] = a.x.array
         st.p.x.array[:] = b.x.array
+
+
+def cell_max(at_points, name: str):
+    """The largest value of each cell's quadrature points of `at_points` (DG0, `name`)."""
+    from dolfinx import fem
+
+    cells = fem.Function(fem.functionspace(at_points.function_space.mesh, ("DG", 0)),
+                         name=name)
+    per_cell(at_points, cells, np.max)
+    return cells
 
 
 def per_cell(at_points, cells, reduce) -> None:
