@@ -70,7 +70,9 @@ class UpsettingParameters(Parameters):
     OUTPUTS: ClassVar = {"png": "the barrelled billet coloured by the cumulated plastic "
                                 "strain, the die and the contact statuses",
                          "plot": "the force against the reduction, with the frictionless "
-                                 "closed form and the slab estimate"}
+                                 "closed form and the slab estimate",
+                         "output": "the displacement, the cumulated plastic strain, the "
+                                   "contact pressure and active set at every converged step"}
     CHECKPOINTS = True
 
     friction: float = number(0.2, "Coulomb friction coefficient f on the die faces (0: "
@@ -142,7 +144,8 @@ def record(t, result):
             "folded_nodes": up.folded_nodes(), "newton_iterations": result.iterations,
             "status_iterations": result.active_set_iterations}
     history.append(step)
-    cli.converged_step(step, lambda: [billet.displacement(), *material.output_fields()])
+    cli.converged_step(step, lambda: [billet.displacement(), *material.output_fields(),
+                                      *up.contact.fields(billet.weight)])
     say(f"  reduction {r:.3f}: F = {up.force:.6g} (frictionless "
         f"{step['force_frictionless_exact']:.6g}), contact radius "
         f"{step['contact_radius']:.4g}, stick {step['stick_radius']:.4g}; "

@@ -91,3 +91,15 @@ def test_a_killed_upsetting_restarts_to_the_uninterrupted_answer(tmp_path, demo)
     assert again["force_history"] == pytest.approx(whole["force_history"], rel=1e-10)
     for k in ("stick_radius", "contact_radius", "max_plastic_strain"):
         assert again[k] == pytest.approx(whole[k], rel=1e-10), k
+
+
+def test_output_holds_every_converged_step(tmp_path, demo):
+    from conftest import read_series
+
+    d = demo.json("upsetting.py", "--steps", "5", "--cells", "4", "--output", tmp_path / "f")
+    times, p = read_series(tmp_path / "f" / "cumulated_plastic_strain.bp",
+                           "cumulated_plastic_strain")
+    assert times == pytest.approx([s["load_factor"] for s in d["steps"]], rel=1e-12)
+    assert p[0].max() < p[-1].max()
+    times, active = read_series(tmp_path / "f" / "active_set.bp", "active_set")
+    assert len(times) == len(d["steps"]) and active[-1].max() == 1.0

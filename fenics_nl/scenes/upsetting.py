@@ -65,6 +65,7 @@ class Billet:
         self.candidate = np.unique(np.concatenate([self.top, self.side]))
         self.supports = [boundary.component(self.V, 0, self.axis),
                          boundary.component(self.V, 1, self.mid)]
+        self.weight = kinematics.measure_weight(msh, MODEL)  # 2πr: totals per turn
         self.quadrature_degree = 2 * degree
         self.dx = kinematics.quadrature_measure("dx", msh, self.quadrature_degree)
 
@@ -172,8 +173,7 @@ class Upsetting:
         b = self.billet
         if self._volume is None:
             F = kinematics.deformation_gradient(b.u, MODEL)
-            weight = kinematics.measure_weight(b.mesh, MODEL)
-            self._volume = fem.form(ufl.det(F) * weight * b.dx)
+            self._volume = fem.form(ufl.det(F) * b.weight * b.dx)
         return 2 * b.mesh.comm.allreduce(fem.assemble_scalar(self._volume))
 
     @staticmethod
