@@ -98,6 +98,12 @@ def _round_off_hint(norms: list[float]) -> str:
     return ""
 
 
+def _constrained_rows(bcs: Sequence[fem.DirichletBC]) -> np.ndarray:
+    """The sorted local dofs that `bcs` constrain (owned and ghost)."""
+    rows = [bc.dof_indices()[0] for bc in bcs]
+    return np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
+
+
 class _Timer:
     def __init__(self, work: WorkCounts, phase: str):
         self.work, self.phase = work, phase
@@ -129,8 +135,12 @@ class TangentPolicy:
         self.factorization_current = False  # the factorization is of the current tangent
 
     def start_solve(self) -> None:
-        """A new solve: the state moved, so every tangent but a life-long one is stale."""
-        if not self.for_life:
+        """A new solve: the state moved, so every tangent is stale but two.
+
+        A life-long one, and a linear material's (it changes with the Dirichlet rows and
+        the springs only, which say so themselves).
+        """
+        if not (self.for_life or self.fixed):
             self.ready = False
 
     def bcs_changed(self, small: bool) -> None:
@@ -410,7 +420,15 @@ class NewtonSolver:
         `small_change`: only a few rows differ from the last factorized tangent, so with
         `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
         """
+        # a small change of no row at all (an active set that settled, new values on the
+        # same rows): the same matrix, nothing to rebuild. (A change of unknown size, as
+        # at a load step's start, refactorizes as before: a restart, which has no
+        # factorization, then takes the uninterrupted run's path, work counts included.)
+        same = small_change and self.A.comm.tompi4py().allreduce(  # the same on every rank
+            np.array_equal(_constrained_rows(bcs), _constrained_rows(self.bcs)), op=MPI.LAND)
         self.bcs = list(bcs)
+        if same:
+            return
         self.policy.bcs_changed(small_change)
         self._supports_checked = False
 
@@ -506,7 +524,7 @@ class NewtonSolver:
         """
         if self.nodal.version != self._nodal_version:  # new springs: the tangent is stale
             self._nodal_version = self.nodal.version
-            self.policy.bcs_changed(small=False)
+            self.policy.bcs_changed(small=True)
             self._supports_checked = False
         if not self.policy.needs_tangent(k):
             return False
