@@ -9,7 +9,9 @@ reference cycle) on rank 0 while rank 1 waits in another collective: the mpi sui
 """
 
 import copy
+import fcntl
 import gc
+import hashlib
 
 import fenics_nl  # noqa: F401
 
@@ -143,19 +145,26 @@ class Demos:
         shared = ranks == 1 and not any(
             str(a).startswith(("--png", "--plot", "--output", "--checkpoint", "--restart"))
             for a in args)
-        if shared:
-            if key in _serial_references:
-                return copy.deepcopy(_serial_references[key])
-            kept = self.cache.get(cache_key, None)
-            if kept is not None:
-                return kept
+        if not shared:
+            return self._run_json(name, args, ranks)
+        if key in _serial_references:
+            return copy.deepcopy(_serial_references[key])
+        # the other xdist worker may be making this very run: wait for it rather than
+        # make it twice (a lock per run, held while it is made)
+        lock = self.cache.mkdir("fenics_nl_locks") / hashlib.sha1(cache_key.encode()).hexdigest()
+        with open(lock, "w") as held:
+            fcntl.flock(held, fcntl.LOCK_EX)
+            result = self.cache.get(cache_key, None)
+            if result is None:
+                result = self._run_json(name, args, ranks)
+                self.cache.set(cache_key, result)
+        _serial_references[key] = copy.deepcopy(result)
+        return result
+
+    def _run_json(self, name, args, ranks) -> dict:
         out = self.tmp_path / f"{Path(name).stem}{next(_runs)}.json"
         self.run([name, *args, "--json", out], ranks=ranks)
-        result = json.loads(out.read_text())
-        if shared:
-            _serial_references[key] = copy.deepcopy(result)
-            self.cache.set(cache_key, result)
-        return result
+        return json.loads(out.read_text())
 
     def punch(self, *args, ranks=1) -> dict:
         return self.json("punch.py", *args, ranks=ranks)
