@@ -7,10 +7,14 @@ import pytest
 from conftest import DEMOS
 from demo_snapshot import differences
 from notebooks import SMALL, execute, page_args, save_page
+from test_demos import identification_recovers_sigma0_and_hardening_within_their_spread
 from test_friction import cattaneo_mindlin_partial_slip_of_a_cylinder
 
-# what a page's run must show, beyond running: its checks against theory
-CHECKS = {"punch_friction.py": cattaneo_mindlin_partial_slip_of_a_cylinder}
+# what a page's run must show, beyond running: its checks against theory (on the run the
+# page makes: the same flags again elsewhere would make it a second time)
+CHECKS = {"punch_friction.py": cattaneo_mindlin_partial_slip_of_a_cylinder,
+          "indentation_identification.py":
+              identification_recovers_sigma0_and_hardening_within_their_spread}
 
 
 def test_every_demo_is_run_as_a_notebook():

@@ -215,12 +215,13 @@ def test_beam_large_increments_land_on_the_elastica(args, demo, on_elastica):
 
 def test_punch_tenfold_increment_power_law(demo):
     # ×10 the default indentation (0.01 R, one step) in one step, non-linear material:
-    # frictionless contact on a convex energy has one solution, whatever the path
+    # frictionless contact on a convex energy has one solution, whatever the path (four
+    # steps reach the same one)
 
     common = ["--material", "power-law", "--indentation", "0.1", "--refine", "0"]
-    one, ten = demo.punch(*common, "--steps", "1"), demo.punch(*common, "--steps", "10")
-    assert one["force"] == pytest.approx(ten["force"], rel=1e-8)
-    assert one["contact_radius"] == ten["contact_radius"]
+    one, four = demo.punch(*common, "--steps", "1"), demo.punch(*common, "--steps", "4")
+    assert one["force"] == pytest.approx(four["force"], rel=1e-8)
+    assert one["contact_radius"] == four["contact_radius"]
 
 
 def test_punch_hundredfold_increment_stays_on_hertz(demo):
@@ -240,12 +241,12 @@ def test_punch_hundredfold_increment_stays_on_hertz(demo):
 
 
 def test_bracket_tenfold_increment_gives_the_same_answer(demo):
-    # ×10: 20 kN (ε_eq ~ 800 ε0) in one step against ten steps of the default 2 kN
+    # ×10: 20 kN (ε_eq ~ 800 ε0) in one step, ten times the default 2 kN step, against
+    # four steps (the path does not matter to this elastic law: the end state is the same)
 
     common = ["--size", "20", "--force", "20000"]  # 11.6k unknowns: the same on any mesh
-    one, ten = demo.bracket(*common, "--steps", "1"), demo.bracket(*common,
-                                                                   "--steps", "10")
-    assert one["load_point_displacement"] == pytest.approx(ten["load_point_displacement"],
+    one, four = demo.bracket(*common, "--steps", "1"), demo.bracket(*common, "--steps", "4")
+    assert one["load_point_displacement"] == pytest.approx(four["load_point_displacement"],
                                                            rel=1e-8)
 
 
