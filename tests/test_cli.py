@@ -135,3 +135,17 @@ def test_an_error_on_one_rank_stops_the_run_instead_of_hanging(tmp_path):
 def test_help_is_printed_once_on_two_ranks(demo):
     proc = demo.run(["newton_scalar.py", "--help"], ranks=2)
     assert proc.stdout.count("usage:") == 1, proc.stdout
+
+
+def test_several_ranks_get_one_blas_thread_each_unless_the_user_set_it():
+    # the spinning BLAS threads of two ranks on two cores had made the J2 sphere's 2-rank
+    # run 1.24x rather than 1.54x (fenics_nl.threads)
+    from fenics_nl.threads import one_thread_per_rank
+
+    serial = {}
+    assert not one_thread_per_rank(serial) and serial == {}
+    two = {"PMI_SIZE": "2"}
+    assert one_thread_per_rank(two)
+    assert two["OPENBLAS_NUM_THREADS"] == two["OMP_NUM_THREADS"] == "1"
+    mine = {"OMPI_COMM_WORLD_SIZE": "4", "OMP_NUM_THREADS": "2"}
+    assert one_thread_per_rank(mine) and mine["OMP_NUM_THREADS"] == "2"
