@@ -13,8 +13,6 @@ import numpy as np
 from dolfinx import fem, geometry
 from mpi4py import MPI
 
-from fenics_nl.materials.expressions import point_expression
-
 __all__ = ["Probes"]
 
 
@@ -60,7 +58,7 @@ class Probes:
                                    lagrange_variant=basix.LagrangeVariant.legendre)
             Q = fem.functionspace(self.mesh, el)
             self._fields[name] = (fem.Function(Q),
-                                  point_expression(expr, Q.element.interpolation_points))
+                                  fem.Expression(expr, Q.element.interpolation_points))
         f, compiled = self._fields[name]
         f.interpolate(compiled)
         comm, out = self.mesh.comm, []

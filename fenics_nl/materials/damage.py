@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 import ufl
 
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.expressions import point_expression
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
 __all__ = ["CourseDamage", "DamageState"]
@@ -172,7 +171,7 @@ class CourseDamage(Isotropic, SmallStrain):
 
         st = self._bound()
         if st.update is None:  # compiled once, for the first u given
-            st.update = point_expression(self.damage(kinematics.small_strain(u, model)),
+            st.update = fem.Expression(self.damage(kinematics.small_strain(u, model)),
                                        st.points)
         new = fem.Function(st.alpha.function_space)
         new.interpolate(st.update)

@@ -45,7 +45,6 @@ import ufl
 
 from fenics_nl.errors import SolveError
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.expressions import point_expression
 from fenics_nl.materials.laws import FiniteStrain, Isotropic, check_range
 from fenics_nl.materials.plasticity import QuadratureStateOutputs, quadrature_spaces
 
@@ -276,8 +275,8 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         if st.update is None:  # compiled once
             _, Q = self.trial(kinematics.green_lagrange(u, model))
             _, eq, dp = self.return_map(Q)
-            st.update = (point_expression(kinematics.deformation_gradient(u, model), st.points),
-                         point_expression(dp, st.points), point_expression(eq, st.points))
+            st.update = (fem.Expression(kinematics.deformation_gradient(u, model), st.points),
+                         fem.Expression(dp, st.points), fem.Expression(eq, st.points))
         values = []
         for expr, like in zip(st.update, (st.metric, st.p, st.p), strict=True):
             f = fem.Function(like.function_space)

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import ufl
 
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.expressions import point_expression
 
 __all__ = [
     "FiniteStrain",
@@ -162,7 +161,7 @@ class Material(ABC):
 
         Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
         f = fem.Function(Q, name="von_mises")
-        f.interpolate(point_expression(self.von_mises_expression(u, model),
+        f.interpolate(fem.Expression(self.von_mises_expression(u, model),
                                      Q.element.interpolation_points))
         return f
 

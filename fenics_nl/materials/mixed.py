@@ -30,7 +30,6 @@ import ufl
 from dolfinx import fem
 
 from fenics_nl.materials import kinematics
-from fenics_nl.materials.expressions import point_expression
 from fenics_nl.materials.laws import von_mises_of
 
 __all__ = [
@@ -122,7 +121,7 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
         return material.cell_mean(von_mises_expression(material, u, p, model), "von_mises")
     Q = fem.functionspace(mesh, ("DG", 0))
     f = fem.Function(Q, name="von_mises")
-    f.interpolate(point_expression(von_mises_expression(material, u, p, model),
+    f.interpolate(fem.Expression(von_mises_expression(material, u, p, model),
                                  Q.element.interpolation_points))
     return f
 

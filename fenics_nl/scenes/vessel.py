@@ -23,7 +23,6 @@ from fenics_nl.domain.meshes import quarter_annulus
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, mixed
-from fenics_nl.materials.expressions import point_expression
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
 
@@ -147,7 +146,7 @@ class VesselBody:
         Q = p.function_space
         x = ufl.SpatialCoordinate(self.mesh)
         r = fem.Function(Q)
-        r.interpolate(point_expression(ufl.sqrt(ufl.inner(x, x)),
+        r.interpolate(fem.Expression(ufl.sqrt(ufl.inner(x, x)),
                                      Q.element.interpolation_points))
         n = Q.dofmap.index_map.size_local
         plastic = p.x.array[:n] > 0
