@@ -99,8 +99,8 @@ def _round_off_hint(norms: list[float]) -> str:
 
 
 def _constrained_rows(bcs: Sequence[fem.DirichletBC]) -> np.ndarray:
-    """The sorted local dofs that `bcs` constrain (owned and ghost)."""
-    rows = [bc.dof_indices()[0] for bc in bcs]
+    """The sorted local indices of the owned dofs that `bcs` constrain."""
+    rows = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in bcs]
     return np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
 
 
@@ -424,7 +424,7 @@ class NewtonSolver:
         # same rows): the same matrix, nothing to rebuild. (A change of unknown size, as
         # at a load step's start, refactorizes as before: a restart, which has no
         # factorization, then takes the uninterrupted run's path, work counts included.)
-        same = small_change and self.A.comm.tompi4py().allreduce(  # the same on every rank
+        same = small_change and self.A.comm.tompi4py().allreduce(  # on every rank's rows
             np.array_equal(_constrained_rows(bcs), _constrained_rows(self.bcs)), op=MPI.LAND)
         self.bcs = list(bcs)
         if same:
@@ -523,6 +523,8 @@ class NewtonSolver:
         solver's life); periodic: every `period` iterations. Returns whether it did.
         """
         if self.nodal.version != self._nodal_version:  # new springs: the tangent is stale
+            # but near the last one (friction's springs follow the slip directions as they
+            # converge): with reuse, the last factorization preconditions CG first
             self._nodal_version = self.nodal.version
             self.policy.bcs_changed(small=True)
             self._supports_checked = False
@@ -648,8 +650,7 @@ class NewtonSolver:
             self._K_fixed = self.A.copy()
         else:
             self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        rows = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in self.bcs]
-        rows = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
+        rows = _constrained_rows(self.bcs)
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
 
     def _factorize(self, work: WorkCounts) -> None:
