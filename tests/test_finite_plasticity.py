@@ -13,6 +13,7 @@ from mpi4py import MPI
 from scipy.optimize import brentq
 
 from fenics_nl.domain import boundary
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.finite_plasticity import (
     FiniteJ2Plasticity,
@@ -228,7 +229,7 @@ def test_small_strain_limit_is_the_project_j2():
         finite.bind(m, 2)
         small.bind(m, 2)
         points = finite.state.points  # the state's (both laws': the same rule)
-        stresses = [fem.Expression(law.cauchy_stress(u), points) for law in (finite, small)]
+        stresses = [Expression(law.cauchy_stress(u), points) for law in (finite, small)]
         worst = 0.0
         for t in (0.5, 1.0, 2.0, 3.0):  # δ|G| ≈ 1.5 ε_y at t = 1
             u.interpolate(lambda x, s=t * delta: s * (G @ x))

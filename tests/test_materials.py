@@ -132,3 +132,26 @@ def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
         for cls in (LinearElastic, StVenantKirchhoff, NeoHookean):
             with pytest.raises(ValueError, match=rf"^{name} must be in"):
                 cls(**kwargs)
+
+
+def test_a_stress_kernel_is_named_after_the_law_not_after_the_labels_made_before_it():
+    # the kernel cache is keyed by this name: before renumbering, a law built after other
+    # `ufl.variable`s (another test, another order) was compiled again under a new name
+    import ffcx.naming
+
+    from fenics_nl.expression import renumber_labels
+
+    V = _space("3d")
+    points = fem.functionspace(V.mesh, ("DG", 0)).element.interpolation_points
+
+    def name(expr):
+        return ffcx.naming.compute_signature([(expr, points)], "")
+
+    def stress():
+        return NeoHookean(E, NU).von_mises_expression(fem.Function(V))
+
+    first = stress()
+    ufl.variable(ufl.as_ufl(1.0))  # moves the process-wide label counter
+    second = stress()
+    assert name(first) != name(second)  # what FFCx would see without renumbering
+    assert name(renumber_labels(first)) == name(renumber_labels(second))

@@ -17,6 +17,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics, plane_stress
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.solvers.loading import solve_incrementally
@@ -68,7 +69,7 @@ class Sheet:
         import basix
 
         points, _ = basix.make_quadrature(self.mesh.basix_cell(), self.q)
-        expr = fem.Expression(plane_stress.stress(self.law, self.w)[2, 2], points)
+        expr = Expression(plane_stress.stress(self.law, self.w)[2, 2], points)
         cells = np.arange(self.mesh.topology.index_map(2).size_local, dtype=np.int32)
         values = expr.eval(self.mesh, cells)
         return self.mesh.comm.allreduce(float(np.abs(values).max(initial=0.0)), op=MPI.MAX)

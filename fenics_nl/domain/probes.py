@@ -13,6 +13,8 @@ import numpy as np
 from dolfinx import fem, geometry
 from mpi4py import MPI
 
+from fenics_nl.expression import Expression
+
 __all__ = ["Probes"]
 
 
@@ -58,7 +60,7 @@ class Probes:
                                    lagrange_variant=basix.LagrangeVariant.legendre)
             Q = fem.functionspace(self.mesh, el)
             self._fields[name] = (fem.Function(Q),
-                                  fem.Expression(expr, Q.element.interpolation_points))
+                                  Expression(expr, Q.element.interpolation_points))
         f, compiled = self._fields[name]
         f.interpolate(compiled)
         comm, out = self.mesh.comm, []

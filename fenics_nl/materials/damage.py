@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import ufl
 
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
@@ -171,8 +172,8 @@ class CourseDamage(Isotropic, SmallStrain):
 
         st = self._bound()
         if st.update is None:  # compiled once, for the first u given
-            st.update = fem.Expression(self.damage(kinematics.small_strain(u, model)),
-                                       st.points)
+            st.update = Expression(self.damage(kinematics.small_strain(u, model)),
+                                   st.points)
         new = fem.Function(st.alpha.function_space)
         new.interpolate(st.update)
         st.alpha.x.array[:] = new.x.array

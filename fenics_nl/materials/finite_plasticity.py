@@ -44,6 +44,7 @@ import numpy as np
 import ufl
 
 from fenics_nl.errors import SolveError
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import FiniteStrain, Isotropic, check_range
 from fenics_nl.materials.plasticity import QuadratureStateOutputs, quadrature_spaces
@@ -275,8 +276,8 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         if st.update is None:  # compiled once
             _, Q = self.trial(kinematics.green_lagrange(u, model))
             _, eq, dp = self.return_map(Q)
-            st.update = (fem.Expression(kinematics.deformation_gradient(u, model), st.points),
-                         fem.Expression(dp, st.points), fem.Expression(eq, st.points))
+            st.update = (Expression(kinematics.deformation_gradient(u, model), st.points),
+                         Expression(dp, st.points), Expression(eq, st.points))
         values = []
         for expr, like in zip(st.update, (st.metric, st.p, st.p), strict=True):
             f = fem.Function(like.function_space)

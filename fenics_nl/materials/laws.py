@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import ufl
 
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 
 __all__ = [
@@ -161,8 +162,8 @@ class Material(ABC):
 
         Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
         f = fem.Function(Q, name="von_mises")
-        f.interpolate(fem.Expression(self.von_mises_expression(u, model),
-                                     Q.element.interpolation_points))
+        f.interpolate(Expression(self.von_mises_expression(u, model),
+                                 Q.element.interpolation_points))
         return f
 
 

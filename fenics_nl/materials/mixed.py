@@ -29,6 +29,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import von_mises_of
 
@@ -121,8 +122,8 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
         return material.cell_mean(von_mises_expression(material, u, p, model), "von_mises")
     Q = fem.functionspace(mesh, ("DG", 0))
     f = fem.Function(Q, name="von_mises")
-    f.interpolate(fem.Expression(von_mises_expression(material, u, p, model),
-                                 Q.element.interpolation_points))
+    f.interpolate(Expression(von_mises_expression(material, u, p, model),
+                             Q.element.interpolation_points))
     return f
 
 

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import ufl
 
+from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
@@ -91,7 +92,7 @@ class QuadratureStateOutputs:
 
         Q = self.cumulated_plastic_strain.function_space
         at_points = fem.Function(Q)
-        at_points.interpolate(fem.Expression(expression, Q.element.interpolation_points))
+        at_points.interpolate(Expression(expression, Q.element.interpolation_points))
         f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
         per_cell(at_points, f, np.mean)
         return f
@@ -247,7 +248,7 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         st = self._bound()
         if st.commit is None:  # compiled once
             eps_p, p, _ = self.return_map(strain)
-            st.commit = (fem.Expression(eps_p, st.points), fem.Expression(p, st.points))
+            st.commit = (Expression(eps_p, st.points), Expression(p, st.points))
         new_eps_p, new_p = st.commit
         # evaluate both before storing: each reads the committed state
         a = fem.Function(st.eps_p.function_space)

@@ -21,6 +21,7 @@ from mpi4py import MPI
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import quarter_annulus
 from fenics_nl.domain.probes import Probes
+from fenics_nl.expression import Expression
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.mixed import unknowns
@@ -146,8 +147,8 @@ class VesselBody:
         Q = p.function_space
         x = ufl.SpatialCoordinate(self.mesh)
         r = fem.Function(Q)
-        r.interpolate(fem.Expression(ufl.sqrt(ufl.inner(x, x)),
-                                     Q.element.interpolation_points))
+        r.interpolate(Expression(ufl.sqrt(ufl.inner(x, x)),
+                                 Q.element.interpolation_points))
         n = Q.dofmap.index_map.size_local
         plastic = p.x.array[:n] > 0
         return max(self.a, global_max(self.mesh.comm, r.x.array[:n][plastic]))

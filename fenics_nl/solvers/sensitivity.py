@@ -32,6 +32,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.expression import Expression
 from fenics_nl.solvers.newton import ConvergenceError, LinearSolveError
 from fenics_nl.solvers.result import WorkCounts
 
@@ -94,7 +95,7 @@ class PathSensitivity:
                 d = d + parameter_derivative(new, c, self._which[i])
             for j in state:
                 d = d + ufl.derivative(new, state[j], self._dstate[j])
-            self._update[k] = fem.Expression(d, points)
+            self._update[k] = Expression(d, points)
         self._b = petsc.create_vector(V)
         self.work = WorkCounts()
         self.state_derivatives = [{k: np.zeros_like(f.x.array) for k, f in state.items()}
