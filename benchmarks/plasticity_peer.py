@@ -96,7 +96,7 @@ def linear_solve_time(vb: VesselBody) -> float:
     return plasticity.linear_solve_time(vb, E, NU, LOADS[0], dx=dx, prefix="peer_linear_")
 
 
-def ours(vb: VesselBody) -> dict:
+def ours(vb: VesselBody, linear_solver: str = "lu") -> dict:
     """fenics_nl: the condensed energy in UFL, its UFL tangent, full Newton."""
     material = J2Plasticity(E, NU, sigma0=SIGMA0, H=H)
     material.bind(vb.mesh, QUADRATURE)
@@ -106,7 +106,7 @@ def ours(vb: VesselBody) -> dict:
     residual = (material.internal_work(u, v, vb.model) * dx
                 + vb.pressure * ufl.dot(vb.normal, v) * vb.ds_inner)
     solver = NewtonSolver(residual, u, vb.supports, rtol=TOL, atol=TOL, force_scale=1.0,
-                          prefix="peer_ours_")
+                          prefix="peer_ours_", linear_solver=linear_solver)
     iterations, path, phases = [], [], {}
     t0 = time.perf_counter()
     for q in LOADS:
@@ -158,7 +158,7 @@ def radial_return(deps, sigma_n, p_n, lmbda, mu, sigma0, hardening):
     return sigma, tangent, dp
 
 
-def peer(vb: VesselBody, snes_type: str = "vinewtonrsls") -> dict:
+def peer(vb: VesselBody, snes_type: str = "vinewtonrsls", factorization: str = "lu") -> dict:
     """dolfinx-external-operator: the return map in Numba behind a FEMExternalOperator."""
     import basix.ufl
     from dolfinx import fem
@@ -209,10 +209,14 @@ def peer(vb: VesselBody, snes_type: str = "vinewtonrsls") -> dict:
 
     options = {"snes_type": snes_type, "snes_linesearch_type": "basic",
                "snes_rtol": TOL, "snes_atol": TOL, "snes_stol": 0.0, "snes_max_it": 50,
-               "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+               "ksp_type": "preonly", "pc_type": factorization,
+               "pc_factor_mat_solver_type": "mumps"}
     with solver_options("peer_eo_", options) as passed:  # none left behind (see snes.py)
         problem = NonlinearProblem(F_hat, du, J=J_hat, bcs=vb.supports,
                                    petsc_options_prefix="peer_eo_", petsc_options=passed)
+    if factorization == "cholesky":  # its tangent is symmetric too: MUMPS LDLᵀ (SYM=2)
+        problem.A.setOption(problem.A.Option.SYMMETRIC, True)
+        problem.A.setOption(problem.A.Option.SYMMETRY_ETERNAL, True)
     problem.solver.setFunction(partial(assemble_residual_with_callback, problem.u, problem.F,
                                        problem.J, vb.supports, update, []), problem.b)
     iterations, path = [], []
@@ -239,8 +243,10 @@ def peer(vb: VesselBody, snes_type: str = "vinewtonrsls") -> dict:
 def compare(h: float) -> dict:
     vb = body(h)
     row = {"h": h, "dofs": vb.dofs, "linear_solve_s": linear_solve_time(vb)}
-    for name, run in (("ours", ours), ("peer", peer),
-                      ("peer, newtonls", partial(peer, snes_type="newtonls"))):
+    for name, run in (("ours", ours), ("ours, LDLᵀ", partial(ours, linear_solver="cholesky")),
+                      ("peer", peer), ("peer, newtonls", partial(peer, snes_type="newtonls")),
+                      ("peer, newtonls, LDLᵀ",
+                       partial(peer, snes_type="newtonls", factorization="cholesky"))):
         r = run(vb)
         row[name] = {"time_s": r["time_s"], "newton_iterations": sum(r["iterations"]),
                      "iterations_per_increment": r["iterations"],
@@ -250,7 +256,7 @@ def compare(h: float) -> dict:
     return row
 
 
-CODES = ("ours", "peer", "peer, newtonls")
+CODES = ("ours", "ours, LDLᵀ", "peer", "peer, newtonls", "peer, newtonls, LDLᵀ")
 
 
 def phases(c: dict) -> str:
@@ -265,7 +271,8 @@ def phases(c: dict) -> str:
 
 def table(rows: list[dict], reference: dict) -> str:
     lines = [f"Thick cylinder a = 1, b = 1.3, plane strain, E_t = E/100, 19 increments to "
-             f"1.1 q_lim, P2, 3 quadrature points per triangle, MUMPS LU; the reference "
+             f"1.1 q_lim, P2, 3 quadrature points per triangle, MUMPS LU (LDLᵀ where named: "
+             f"the tangent is symmetric, MUMPS's symmetric factorization); the reference "
              f"u_ref(a) = {reference['inner_displacement']:.7g} is ours on h = "
              f"{reference['h']:g} ({reference['dofs']} unknowns). "
              "`python benchmarks/plasticity_peer.py`.", "",

@@ -178,9 +178,9 @@ class SmallStrain(Material):
         return ufl.diff(self.energy(eps), eps)
 
     def tangent(self, eps):
-        """Tangent moduli A = ∂²φ/∂ε∂ε (fourth-order tensor)."""
+        """Tangent moduli A = ∂²φ/∂ε∂ε = ∂σ/∂ε (fourth-order tensor)."""
         eps = ufl.variable(eps)
-        return ufl.diff(ufl.diff(self.energy(eps), eps), eps)
+        return ufl.diff(self.stress(eps), eps)
 
     def internal_work(self, u, v, model: str = "3d"):
         """Integrand of the internal virtual work σ(ε(u)) : ε(v) (times 2πr if axisymmetric)."""
