@@ -107,6 +107,18 @@ def test_uniaxial_load_unload_reverse_is_the_closed_form(H, C):
                                          rel=1e-9)
 
 
+def test_elastic_increments_factorize_the_elastic_tangent_once():
+    # full Newton assembles the tangent at every iteration; below yield it is Hooke's each
+    # time, the same matrix to the bit, and is factorized once; a plastic step's is new
+    bar = Bar(J2Plasticity(E, NU, sigma0=S0, H=100.0))
+    elastic = EPS_Y * np.array([0.25, 0.5, 0.75])
+    assert bar.go(elastic) == pytest.approx(E * elastic, rel=1e-12)
+    work = bar.solver.total
+    assert work.tangent_assemblies >= 3 and work.factorizations == 1
+    bar.go(EPS_Y * np.array([1.5]))
+    assert bar.solver.total.factorizations >= 2
+
+
 @pytest.mark.mpi
 def test_uniaxial_closed_form_on_two_ranks():
     # the state lives at each rank's quadrature points; commit and assembly are collective

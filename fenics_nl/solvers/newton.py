@@ -29,6 +29,7 @@ numeric factorization only and reuse the symbolic analysis.
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import math
 import time
@@ -174,6 +175,34 @@ class TangentPolicy:
     def krylov_iterations(self, its: int) -> None:
         """CG on a reused factorization took `its`: beyond a few, refactorize next time."""
         self.factorization_current = its <= self.REUSE_ITERATIONS
+
+
+class FactorizedTangent:
+    """Whether the tangent is the one last factorized, bit for bit, on every rank.
+
+    Full Newton on a path-dependent law assembles the elastic tangent again wherever no
+    point yields (a J2 material's elastic increments, each one Newton iteration): the same
+    matrix, which is not factorized again. Compared through its product with a fixed random
+    vector, so that no copy of the matrix is kept: a change it hides (rows whose change sums
+    to zero against it, to the last bit) would leave a factorization off by round-off, which
+    a Newton iteration tolerates (its residual is exact). A restarted run has no
+    factorization in memory: where the uninterrupted one kept its factorization across the
+    restart point, the restart makes one more, on the same path.
+    """
+
+    def __init__(self, A: PETSc.Mat):
+        self._probe, self._product = A.createVecs()
+        rng = np.random.default_rng(A.comm.rank)
+        self._probe.array[:] = rng.uniform(0.5, 1.5, self._probe.getLocalSize())
+        self._digest = None
+
+    def unchanged(self, A: PETSc.Mat) -> bool:
+        """Whether A is the matrix of the last call (collective); A is then the last one."""
+        A.mult(self._probe, self._product)
+        digest = hashlib.blake2b(self._product.array_r, digest_size=16).digest()
+        same = A.comm.tompi4py().allreduce(digest == self._digest, op=MPI.LAND)
+        self._digest = digest
+        return same
 
 
 class InverseBFGS:
@@ -383,6 +412,8 @@ class NewtonSolver:
             nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
             self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                                   P=self.A if reuse else None, rtol=1e-12)
+        # the block preconditioner is built from its own matrix: always set up again
+        self._factorized = FactorizedTangent(self.A) if self._M is None else None
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
@@ -654,8 +685,17 @@ class NewtonSolver:
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
 
     def _factorize(self, work: WorkCounts) -> None:
-        """Numeric factorization of the current tangent (the symbolic one is reused)."""
+        """Numeric factorization of the current tangent (the symbolic one is reused).
+
+        None if the tangent is the one factorized last (`FactorizedTangent`): PETSc is told
+        to keep its preconditioner, though the matrix was assembled again.
+        """
         with _Timer(work, "factorization"):
+            if self._factorized is not None and self._factorized.unchanged(self.A):
+                self.ksp.getPC().setReusePreconditioner(True)
+                self.policy.factorized()
+                return
+            self.ksp.getPC().setReusePreconditioner(False)
             if self.policy.reuse and self.P is None:
                 self.P = self.A.copy()
                 self.ksp.setOperators(self.A, self.P)
