@@ -177,32 +177,79 @@ class TangentPolicy:
         self.factorization_current = its <= self.REUSE_ITERATIONS
 
 
-class FactorizedTangent:
-    """Whether the tangent is the one last factorized, bit for bit, on every rank.
+class Factorizations:
+    """Which factorization solves with the tangent just assembled (none new if it has one).
 
-    Full Newton on a path-dependent law assembles the elastic tangent again wherever no
-    point yields (a J2 material's elastic increments, each one Newton iteration): the same
-    matrix, which is not factorized again. Compared through its product with a fixed random
-    vector, so that no copy of the matrix is kept: a change it hides (rows whose change sums
-    to zero against it, to the last bit) would leave a factorization off by round-off, which
-    a Newton iteration tolerates (its residual is exact). A restarted run has no
-    factorization in memory: where the uninterrupted one kept its factorization across the
-    restart point, the restart makes one more, on the same path.
+    A tangent equal, bit for bit and on every rank, to one already factorized is not
+    factorized again. Full Newton on a path-dependent law assembles Hooke's tangent again
+    and again: at every elastic increment, and at the first iteration of every plastic one
+    (the trial state is the committed one, on the yield surface, hence elastic). The
+    factorization last made is reused when the tangent equals it; and once one has been
+    reused it is worth keeping: a copy of it is factorized aside (MUMPS, while both fit in
+    a quarter of the memory) and solves whenever the tangent comes back to it, while the
+    other tangents are factorized in the solver's own matrix. Tangents are compared through
+    their product with a fixed random vector, so that no copy is kept to compare with: a
+    change it hides (rows whose change sums to zero against it, to the last bit) would
+    leave a factorization off by round-off, which a Newton iteration tolerates (its
+    residual is exact). A restarted run has no factorization in memory: where the
+    uninterrupted one kept one across the restart point, the restart makes one more, on
+    the same path.
     """
 
-    def __init__(self, A: PETSc.Mat):
+    def __init__(self, A: PETSc.Mat, ksp: PETSc.KSP, make_ksp):
         self._probe, self._product = A.createVecs()
         rng = np.random.default_rng(A.comm.rank)
         self._probe.array[:] = rng.uniform(0.5, 1.5, self._probe.getLocalSize())
-        self._digest = None
+        self.ksp, self._own, self._make_ksp = ksp, ksp, make_ksp
+        self._digest = None  # of the matrix `ksp`'s factorization is of
+        self._kept = None  # (digest, its matrix, its KSP): a reused factorization, aside
+        self._may_keep = make_ksp is not None and ksp.getType() == "preonly"
 
-    def unchanged(self, A: PETSc.Mat) -> bool:
-        """Whether A is the matrix of the last call (collective); A is then the last one."""
+    def _same(self, a: bytes | None, b: bytes | None, comm) -> bool:
+        return comm.allreduce(a is not None and a == b, op=MPI.LAND)
+
+    def factorize(self, A: PETSc.Mat, setup) -> bool:
+        """Point `ksp` at a factorization of A; whether one was made (collective).
+
+        `setup()` factorizes the solver's own KSP on A when no factorization is of A.
+        """
+        comm = A.comm.tompi4py()
         A.mult(self._probe, self._product)
         digest = hashlib.blake2b(self._product.array_r, digest_size=16).digest()
-        same = A.comm.tompi4py().allreduce(digest == self._digest, op=MPI.LAND)
+        if self._kept and self._same(digest, self._kept[0], comm):
+            self.ksp = self._kept[2]
+            return False
+        self.ksp = self._own
+        pc = self._own.getPC()
+        if self._same(digest, self._digest, comm):
+            pc.setReusePreconditioner(True)  # A was assembled again: PETSc would refactor
+            if self._kept is None and self._may_keep and _room_for_another(pc, comm):
+                self._keep_aside(A, digest)
+                return True
+            return False
+        pc.setReusePreconditioner(False)
+        setup()
         self._digest = digest
-        return same
+        return True
+
+    def _keep_aside(self, A: PETSc.Mat, digest: bytes) -> None:
+        copy = A.copy()
+        ksp = self._make_ksp(copy)
+        ksp.getPC().setUp()
+        self._kept = (digest, copy, ksp)
+        self.ksp = ksp
+
+
+def _room_for_another(pc: PETSc.PC, comm) -> bool:
+    """Whether a second MUMPS factorization as large as `pc`'s fits in a quarter of RAM."""
+    import os
+
+    try:
+        megabytes = pc.getFactorMatrix().getMumpsInfog(21)  # all ranks' factorization memory
+    except PETSc.Error:
+        return False
+    ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    return comm.allreduce(2 * megabytes * 2**20 < ram / 4, op=MPI.LAND)
 
 
 class InverseBFGS:
@@ -413,7 +460,8 @@ class NewtonSolver:
             self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                                   P=self.A if reuse else None, rtol=1e-12)
         # the block preconditioner is built from its own matrix: always set up again
-        self._factorized = FactorizedTangent(self.A) if self._M is None else None
+        self._factorizations = None if self._M is not None or reuse else Factorizations(
+            self.A, self.ksp, lambda A: create_ksp(A, linear_solver, prefix, rtol=1e-12))
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
@@ -687,15 +735,14 @@ class NewtonSolver:
     def _factorize(self, work: WorkCounts) -> None:
         """Numeric factorization of the current tangent (the symbolic one is reused).
 
-        None if the tangent is the one factorized last (`FactorizedTangent`): PETSc is told
-        to keep its preconditioner, though the matrix was assembled again.
+        None if the tangent is one already factorized (`Factorizations`).
         """
         with _Timer(work, "factorization"):
-            if self._factorized is not None and self._factorized.unchanged(self.A):
-                self.ksp.getPC().setReusePreconditioner(True)
+            if self._factorizations is not None:
+                made = self._factorizations.factorize(self.A, self.ksp.getPC().setUp)
+                work.factorizations += made
                 self.policy.factorized()
                 return
-            self.ksp.getPC().setReusePreconditioner(False)
             if self.policy.reuse and self.P is None:
                 self.P = self.A.copy()
                 self.ksp.setOperators(self.A, self.P)
@@ -707,12 +754,13 @@ class NewtonSolver:
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
         """du = K⁻¹ rhs (the Newton correction is −du)."""
+        ksp = self._factorizations.ksp if self._factorizations else self.ksp
         with _Timer(work, "solve"):
-            self.ksp.solve(rhs, self.du)
+            ksp.solve(rhs, self.du)
             work.linear_solves += 1
-        reason = self.ksp.getConvergedReason()
-        its = self.ksp.getIterationNumber()
-        if self.ksp.getType() != "preonly":
+        reason = ksp.getConvergedReason()
+        its = ksp.getIterationNumber()
+        if ksp.getType() != "preonly":
             work.krylov_iterations += its
         if self.policy.reuse and reason < 0 and retry:
             # the old factorization no longer helps: refactorize, solve once more
