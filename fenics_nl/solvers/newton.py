@@ -29,6 +29,7 @@ numeric factorization only and reuse the symbolic analysis.
 
 from __future__ import annotations
 
+import collections
 import hashlib
 import logging
 import math
@@ -184,10 +185,11 @@ class Factorizations:
     factorized again. Full Newton on a path-dependent law assembles Hooke's tangent again
     and again: at every elastic increment, and at the first iteration of every plastic one
     (the trial state is the committed one, on the yield surface, hence elastic). The
-    factorization last made is reused when the tangent equals it; and once one has been
-    reused it is worth keeping: a copy of it is factorized aside (MUMPS, while both fit in
-    a quarter of the memory) and solves whenever the tangent comes back to it, while the
-    other tangents are factorized in the solver's own matrix. Tangents are compared through
+    factorization last made is reused when the tangent equals it; a tangent that comes back
+    after its factorization was replaced is factorized aside instead, in a copy (once per
+    solver, MUMPS, while both fit in a quarter of the memory), and solves each time it comes
+    back again, while the other tangents are factorized in the solver's own matrix: the
+    copy costs no factorization that would not be made anyway. Tangents are compared through
     their product with a fixed random vector, so that no copy is kept to compare with: a
     change it hides (rows whose change sums to zero against it, to the last bit) would
     leave a factorization off by round-off, which a Newton iteration tolerates (its
@@ -202,7 +204,8 @@ class Factorizations:
         self._probe.array[:] = rng.uniform(0.5, 1.5, self._probe.getLocalSize())
         self.ksp, self._own, self._make_ksp = ksp, ksp, make_ksp
         self._digest = None  # of the matrix `ksp`'s factorization is of
-        self._kept = None  # (digest, its matrix, its KSP): a reused factorization, aside
+        self._kept = None  # (digest, its matrix, its KSP): a returning tangent's, aside
+        self._replaced = collections.deque(maxlen=8)  # digests of replaced factorizations
         self._may_keep = make_ksp is not None and ksp.getType() == "preonly"
 
     def _same(self, a: bytes | None, b: bytes | None, comm) -> bool:
@@ -223,12 +226,15 @@ class Factorizations:
         pc = self._own.getPC()
         if self._same(digest, self._digest, comm):
             pc.setReusePreconditioner(True)  # A was assembled again: PETSc would refactor
-            if self._kept is None and self._may_keep and _room_for_another(pc, comm):
-                self._keep_aside(A, digest)
-                return True
             return False
+        returned = comm.allreduce(digest in self._replaced, op=MPI.LAND)
+        if returned and self._kept is None and self._may_keep and _room_for_another(pc, comm):
+            self._keep_aside(A, digest)
+            return True
         pc.setReusePreconditioner(False)
         setup()
+        if self._digest is not None:
+            self._replaced.append(self._digest)
         self._digest = digest
         return True
 
