@@ -195,7 +195,8 @@ class Factorizations:
     leave a factorization off by round-off, which a Newton iteration tolerates (its
     residual is exact). A restarted run has no factorization in memory: where the
     uninterrupted one kept one across the restart point, the restart makes one more, on
-    the same path.
+    the same path. `ksp` is the solver of the tangent last assembled (the solver's own,
+    or the copy's): solve through it, not through `NewtonSolver.ksp`.
     """
 
     def __init__(self, A: PETSc.Mat, ksp: PETSc.KSP, make_ksp):
@@ -232,15 +233,16 @@ class Factorizations:
             self._keep_aside(A, digest)
             return True
         pc.setReusePreconditioner(False)
-        setup()
         if self._digest is not None:
             self._replaced.append(self._digest)
+        self._digest = None  # a factorization that fails leaves none behind to reuse
+        setup()
         self._digest = digest
         return True
 
     def _keep_aside(self, A: PETSc.Mat, digest: bytes) -> None:
         copy = A.copy()
-        ksp = self._make_ksp(copy)
+        ksp = self._make_ksp(copy, self._own.getPC().getType())  # lu or cholesky, as its own
         ksp.getPC().setUp()
         self._kept = (digest, copy, ksp)
         self.ksp = ksp
@@ -251,7 +253,7 @@ def _room_for_another(pc: PETSc.PC, comm) -> bool:
     import os
 
     try:
-        megabytes = pc.getFactorMatrix().getMumpsInfog(21)  # all ranks' factorization memory
+        megabytes = pc.getFactorMatrix().getMumpsInfog(22)  # summed over the ranks
     except PETSc.Error:
         return False
     ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
@@ -467,7 +469,7 @@ class NewtonSolver:
                                   P=self.A if reuse else None, rtol=1e-12)
         # the block preconditioner is built from its own matrix: always set up again
         self._factorizations = None if self._M is not None or reuse else Factorizations(
-            self.A, self.ksp, lambda A: create_ksp(A, linear_solver, prefix, rtol=1e-12))
+            self.A, self.ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
