@@ -33,6 +33,7 @@ import collections
 import hashlib
 import logging
 import math
+import os
 import time
 from collections.abc import Sequence
 
@@ -207,7 +208,7 @@ class Factorizations:
         self._digest = None  # of the matrix `ksp`'s factorization is of
         self._kept = None  # (digest, its matrix, its KSP): a returning tangent's, aside
         self._replaced = collections.deque(maxlen=8)  # digests of replaced factorizations
-        self._may_keep = make_ksp is not None and ksp.getType() == "preonly"
+        self._may_keep = ksp.getType() == "preonly"  # a direct solver
 
     def _same(self, a: bytes | None, b: bytes | None, comm) -> bool:
         return comm.allreduce(a is not None and a == b, op=MPI.LAND)
@@ -228,8 +229,9 @@ class Factorizations:
         if self._same(digest, self._digest, comm):
             pc.setReusePreconditioner(True)  # A was assembled again: PETSc would refactor
             return False
-        returned = comm.allreduce(digest in self._replaced, op=MPI.LAND)
-        if returned and self._kept is None and self._may_keep and _room_for_another(pc, comm):
+        if (self._kept is None and self._may_keep  # the same on every rank
+                and comm.allreduce(digest in self._replaced, op=MPI.LAND)
+                and _room_for_another(pc, comm)):
             self._keep_aside(A, digest)
             return True
         pc.setReusePreconditioner(False)
@@ -250,8 +252,6 @@ class Factorizations:
 
 def _room_for_another(pc: PETSc.PC, comm) -> bool:
     """Whether a second MUMPS factorization as large as `pc`'s fits in a quarter of RAM."""
-    import os
-
     try:
         megabytes = pc.getFactorMatrix().getMumpsInfog(22)  # summed over the ranks
     except PETSc.Error:
@@ -747,17 +747,16 @@ class NewtonSolver:
         """
         with _Timer(work, "factorization"):
             if self._factorizations is not None:
-                made = self._factorizations.factorize(self.A, self.ksp.getPC().setUp)
-                work.factorizations += made
-                self.policy.factorized()
-                return
-            if self.policy.reuse and self.P is None:
-                self.P = self.A.copy()
-                self.ksp.setOperators(self.A, self.P)
-            elif self.policy.reuse:
-                self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            self.ksp.getPC().setUp()
-            work.factorizations += 1
+                work.factorizations += self._factorizations.factorize(
+                    self.A, self.ksp.getPC().setUp)
+            else:
+                if self.policy.reuse and self.P is None:
+                    self.P = self.A.copy()
+                    self.ksp.setOperators(self.A, self.P)
+                elif self.policy.reuse:
+                    self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+                self.ksp.getPC().setUp()
+                work.factorizations += 1
         self.policy.factorized()
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
