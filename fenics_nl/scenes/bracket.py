@@ -248,9 +248,12 @@ class Bracket:
         """Resultant force on the bolts (and on the base from the floor), see `boundary`."""
         return boundary.reactions(self.residual, self.u, self.part.groups, space=self.V)
 
-    def lifted_off_area(self) -> float:
-        """Area of the base not in contact with the floor [mm²] (contact support only)."""
-        c = self.solver
-        tags = c.active_facets()
-        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=tags)
-        return self.mesh.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds(0))))
+    def floor_areas(self) -> tuple[float, float]:
+        """Areas of the base lifted off the floor and in contact with it [mm²].
+
+        Contact support only; a facet is in contact when all its vertices are active. Their
+        sum is the meshed base's area (polygonal bolt holes: a little more than the exact).
+        """
+        ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=self.solver.active_facets())
+        return tuple(self.mesh.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds(tag))))
+                     for tag in (0, 1))

@@ -94,7 +94,7 @@ def summary(b, steps: list[dict], wall: float, args) -> tuple[dict, fem.Function
                                "residual state")
     if args.support == "contact":
         c = b.solver
-        out["lifted_off_area"] = b.lifted_off_area()
+        out["lifted_off_area"], out["contact_area"] = b.floor_areas()
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
         out["max_floor_pressure"] = global_max(comm, c.pressure()[c.active])
         if args.friction is not None:  # Coulomb on the whole floor: |T_t| <= f T_n

@@ -39,12 +39,15 @@ def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
 
 def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
                near_nullspace: PETSc.NullSpace | None = None, rtol: float = 1e-10,
-               P: PETSc.Mat | None = None) -> PETSc.KSP:
+               P: PETSc.Mat | None = None, indefinite: bool = False) -> PETSc.KSP:
     """A KSP on `A`: direct MUMPS LU/Cholesky, or CG+GAMG (needs `near_nullspace`).
 
     With a separate preconditioning matrix `P` and a direct `kind`, the KSP is CG
     preconditioned by the factorization of P: P may lag behind A (an older tangent, older
-    Dirichlet rows) and the factorization is reused until it no longer pays.
+    Dirichlet rows) and the factorization is reused until it no longer pays. An
+    `indefinite` A (a saddle point) takes GMRES instead, preconditioned on the right so
+    that it stops on the true residual: CG's energy norm does not exist there, and
+    P⁻¹A = I + (a few rows' worth of rank) converges in as few iterations either way.
     PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
     command line can override every choice made here.
     """
@@ -55,8 +58,11 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     ksp.setOperators(A, P if P is not None else A)
     pc = ksp.getPC()
     if kind in ("lu", "cholesky") and P is not None:
-        ksp.setType("cg")
+        ksp.setType("gmres" if indefinite else "cg")
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=50)
+        if indefinite:  # no restart within max_it; ‖A x − b‖ is what Newton needs
+            ksp.setGMRESRestart(50)
+            ksp.setPCSide(PETSc.PC.Side.RIGHT)
         pc.setType(kind)
         pc.setFactorSolverType("mumps")
     elif kind in ("lu", "cholesky"):

@@ -466,7 +466,8 @@ class NewtonSolver:
         else:
             nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
             self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
-                                  P=self.A if reuse else None, rtol=1e-12)
+                                  P=self.A if reuse else None, rtol=1e-12,
+                                  indefinite=V.ufl_element().is_mixed)
         # the block preconditioner is built from its own matrix: always set up again
         self._factorizations = None if self._M is not None or reuse else Factorizations(
             self.A, self.ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
