@@ -70,6 +70,37 @@ def test_iterative_linear_solver_gives_the_same_solution(snes_reference):
     assert inexact.work.krylov_iterations < 0.85 * tight.total.krylov_iterations
 
 
+def test_an_amg_hierarchy_is_built_once_per_solve_and_lags_behind_the_tangent(
+        snes_reference):
+    # full Newton on CG + GAMG keeps the first tangent's hierarchy (PETSc counts its
+    # set-ups) while CG needs at most twice its first count; the same answer, the same
+    # Newton iterations, fewer set-ups than with a hierarchy per tangent
+    _, tip_ref = snes_reference
+    counted = ["PCSetUp_GAMG+"]
+    runs = {}
+    for lag in (True, False):
+        counter = EventCounter(counted)
+        p, r = solve(NewtonSolver, method="full", linear_solver="gamg", lag_preconditioner=lag)
+        runs[lag] = r, counter.stop()[counted[0]][0]
+        assert abs(tip(p) - tip_ref) < 1e-7 * abs(tip_ref)
+    (lagged, lagged_setups), (fresh, fresh_setups) = runs[True], runs[False]
+    assert fresh_setups == fresh.work.factorizations == fresh.iterations
+    assert lagged_setups == lagged.work.factorizations < fresh_setups / 2
+    assert lagged.iterations <= fresh.iterations + 1
+
+
+@pytest.mark.parametrize("method", ["modified", "bfgs"])
+def test_a_frozen_operator_on_cg_solves_no_tighter_than_it_converges(method, snes_reference):
+    # modified Newton and BFGS converge linearly (superlinearly) whatever the solve's
+    # accuracy below their own contraction: CG to 1e-3 throughout, not tightened with the
+    # residual as full Newton's corrections are; the same answer
+    _, tip_ref = snes_reference
+    p, r = solve(NewtonSolver, method=method, linear_solver="gamg")
+    assert abs(tip(p) - tip_ref) < 1e-7 * abs(tip_ref)
+    # measured 12-13 CG iterations per correction (30 when tightened with the residual)
+    assert r.work.krylov_iterations < 20 * r.iterations
+
+
 def test_full_newton_is_quadratic_and_snes_agrees_iteration_by_iteration():
     _, r = solve(NewtonSolver, method="full")
     _, s = solve(SnesSolver, method="full")
@@ -170,6 +201,17 @@ def test_parallel_solve_matches_serial(method):
     ps, rs = solve(NewtonSolver, comm=MPI.COMM_SELF, method=method)
     assert abs(tip(p) - tip(ps)) < 1e-8 * abs(tip(ps))
     assert r.iterations == rs.iterations
+
+
+@pytest.mark.mpi
+def test_lagged_amg_on_two_ranks_gives_the_serial_answer():
+    # the decision to keep a hierarchy (CG's iteration count) is the same on every rank
+    comm = MPI.COMM_WORLD
+    assert comm.size > 1, "run under mpiexec -n 2"
+    p, r = solve(NewtonSolver, comm=comm, linear_solver="gamg")
+    ps, rs = solve(NewtonSolver, comm=MPI.COMM_SELF, linear_solver="gamg")
+    assert abs(tip(p) - tip(ps)) < 1e-7 * abs(tip(ps))
+    assert r.work.factorizations < r.iterations and rs.work.factorizations < rs.iterations
 
 
 def test_linear_solver_failure_keeps_the_residual_history():

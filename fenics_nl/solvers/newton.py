@@ -126,16 +126,22 @@ class TangentPolicy:
     * a tangent with no coefficient (linear material) once per solve: it is exact;
     * with `reuse` (a direct solver as CG preconditioner), a new tangent keeps the last
       factorization while CG on it needs at most REUSE_ITERATIONS iterations, or while the
-      Dirichlet rows changed only a little (`bcs_changed(small=True)`).
+      Dirichlet rows changed only a little (`bcs_changed(small=True)`);
+    * with `lag` (CG + AMG), a new tangent within a solve keeps the AMG hierarchy of the
+      solve's first one while CG needs at most twice the iterations it took on it fresh.
+
+    "Factorization" stands for the preconditioner's set-up: an AMG hierarchy too.
     """
 
     REUSE_ITERATIONS = 10
 
-    def __init__(self, method: str, period: int, *, fixed: bool, for_life: bool, reuse: bool):
+    def __init__(self, method: str, period: int, *, fixed: bool, for_life: bool, reuse: bool,
+                 lag: bool = False):
         self.method, self.period = method, period
-        self.fixed, self.for_life, self.reuse = fixed, for_life, reuse
+        self.fixed, self.for_life, self.reuse, self.lag = fixed, for_life, reuse, lag
         self.ready = False  # a tangent valid for this solve is assembled and factorized
         self.factorization_current = False  # the factorization is of the current tangent
+        self._fresh_its = None  # lag: CG iterations on the hierarchy's own tangent
 
     def start_solve(self) -> None:
         """A new solve: the state moved, so every tangent is stale but two.
@@ -145,6 +151,8 @@ class TangentPolicy:
         """
         if not (self.for_life or self.fixed):
             self.ready = False
+        if self.lag:  # a new step: the hierarchy is rebuilt on its first tangent
+            self.factorization_current = False
 
     def bcs_changed(self, small: bool) -> None:
         """New Dirichlet rows: rebuild the tangent; refactorize unless only a few changed."""
@@ -164,19 +172,28 @@ class TangentPolicy:
 
     def needs_factorization(self) -> bool:
         """After a tangent assembly."""
-        return not (self.reuse and self.factorization_current)
+        return not ((self.reuse or self.lag) and self.factorization_current)
 
     def factorized(self) -> None:
         """A factorization of the current tangent was made."""
         self.factorization_current = True
+        self._fresh_its = None
 
     def assembled(self) -> None:
         """The tangent for this solve is in place."""
         self.ready = True
 
     def krylov_iterations(self, its: int) -> None:
-        """CG on a reused factorization took `its`: beyond a few, refactorize next time."""
-        self.factorization_current = its <= self.REUSE_ITERATIONS
+        """CG on a reused factorization took `its`: beyond a few, refactorize next time.
+
+        Lagged AMG: beyond twice what the hierarchy's own tangent took, set it up again.
+        """
+        if not self.lag:
+            self.factorization_current = its <= self.REUSE_ITERATIONS
+        elif self._fresh_its is None:
+            self._fresh_its = its
+        else:
+            self.factorization_current = its <= 2 * self._fresh_its
 
 
 class Factorizations:
@@ -364,6 +381,10 @@ class NewtonSolver:
         divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ stops with ConvergenceError.
         linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
+        lag_preconditioner: with ``gamg``, keep the AMG hierarchy of a solve's first tangent
+            for its later ones while CG needs at most twice the iterations it took on it
+            (PETSc's -snes_lag_preconditioner, adaptive): one set-up per load step.
+            ``-{prefix}lag_preconditioner false`` on the command line: one per tangent.
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
         prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
@@ -402,6 +423,7 @@ class NewtonSolver:
         # the linear solver
         linear_solver: str = "lu",
         reuse_factorization: bool = False,
+        lag_preconditioner: bool = True,
         preconditioner: ufl.Form | None = None,
         prefix: str = "newton_",
     ):
@@ -482,7 +504,13 @@ class NewtonSolver:
             # options turned CG off: a lagging factorization would then give wrong solves
             log.warning("%sksp_type preonly: factorization reuse disabled", prefix)
             reuse = False
-        self.policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse)
+        # the block preconditioner's matrix is assembled with the tangent: not lagged
+        opts = PETSc.Options()
+        if opts.hasName(f"{prefix}lag_preconditioner"):  # the command line's choice
+            lag_preconditioner = opts.getBool(f"{prefix}lag_preconditioner")
+        lag = lag_preconditioner and linear_solver == "gamg" and self._M is None
+        self.policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse,
+                                    lag=lag)
         self.bfgs = InverseBFGS(bfgs_memory) if method == "bfgs" else None
         self.total = WorkCounts()
         self.motions = RigidMotions.of(V)  # None: not a displacement (sub-)space
@@ -555,8 +583,9 @@ class NewtonSolver:
                                        result(False, "diverged"))
             try:
                 self.update_tangent(k, work)
-                if self.forcing:
-                    self.ksp.setTolerances(rtol=forcing_term(rnorm / norms[0]))
+                if self.forcing:  # a frozen operator's own error is ~ its contraction
+                    frozen = self.method in ("modified", "bfgs")
+                    self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else rnorm / norms[0]))
                 b_old = self.b.copy() if self.bfgs else None
                 self.solve_linear(self.b, self.du, work)
             except LinearSolveError as err:
@@ -727,6 +756,8 @@ class NewtonSolver:
             self._supports_checked = True
         if self.policy.needs_factorization():
             self._factorize(work)
+        elif self.policy.lag:  # the solve's first hierarchy, on the new operator
+            self.ksp.getPC().setReusePreconditioner(True)
         self.policy.assembled()
 
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
@@ -770,13 +801,14 @@ class NewtonSolver:
         its = ksp.getIterationNumber()
         if ksp.getType() != "preonly":
             work.krylov_iterations += its
-        if self.policy.reuse and reason < 0 and retry:
+        lagging = self.policy.reuse or self.policy.lag
+        if lagging and reason < 0 and retry:
             # the old factorization no longer helps: refactorize, solve once more
             self._factorize(work)
             return self._linear_solve(rhs, work, retry=False)
         if reason < 0:
             raise LinearSolveError(reason)
-        if self.policy.reuse:  # many iterations: cheaper to refactorize next time
+        if lagging:  # many iterations: cheaper to refactorize next time
             self.policy.krylov_iterations(its)
 
     def _step(self, rnorm: float, work: WorkCounts, full_step: bool = False
