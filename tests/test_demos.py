@@ -475,10 +475,26 @@ def test_bracket_iterative_solver_matches_direct(demo):
     assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-7)
 
 
+BRACKET_ON_FLOOR_GAMG = (*BRACKET_ON_FLOOR, "--solver", "gamg")
+
+
+def test_bracket_on_its_floor_on_the_iterative_path_gives_the_direct_answer(demo):
+    # the active-set loop with CG + GAMG inner solves: the same active set (the same lifted
+    # area, to the bit: the same facets), the same answer within Newton's tolerance; the
+    # AMG hierarchy is set up once per inner solve, not per Newton iteration
+    d = demo.bracket(*BRACKET_ON_FLOOR)
+    g = demo.bracket(*BRACKET_ON_FLOOR_GAMG)
+    assert g["active_set_iterations"] == d["active_set_iterations"]
+    assert g["lifted_off_area"] == d["lifted_off_area"]
+    assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-8)
+    assert g["max_floor_pressure"] == pytest.approx(d["max_floor_pressure"], rel=1e-8)
+    assert g["krylov_iterations"] > g["newton_iterations"] > g["factorizations"]
+
+
 # the serial runs the serial suite makes (the clamped bracket's page, the bracket on its floor
-# of tests/test_friction.py): their answers are the references
-@pytest.mark.parametrize("args", [tuple(SMALL["bracket.py"]), BRACKET_ON_FLOOR],
-                         ids=["clamped", "contact"])
+# of tests/test_friction.py, and on the iterative path): their answers are the references
+@pytest.mark.parametrize("args", [tuple(SMALL["bracket.py"]), BRACKET_ON_FLOOR,
+                                  BRACKET_ON_FLOOR_GAMG], ids=["clamped", "contact", "gamg"])
 @pytest.mark.spawns_mpi
 def test_bracket_two_ranks_match_serial(args, demo):
     # 20 mm elements (11.6k unknowns): the partition still cuts the holes and the floor

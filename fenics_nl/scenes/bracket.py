@@ -214,7 +214,7 @@ class Bracket:
             self.solver = contact(
                 residual, self.u, self.bcs, part.base_facets, lambda x: np.zeros(x.shape[1]),
                 normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
-                newton_options={k: v for k, v in opts.items() if k != "linear_solver"},
+                newton_options=opts,
                 displacement_space=part.V if part.mixed else None)
         elif newton == "snes":
             self.solver = SnesSolver(residual, self.u, self.bcs, prefix="bracket_snes_",
