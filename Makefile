@@ -93,9 +93,10 @@ test-mpi: $(VENV)/.installed
 # every benchmark at sizes for 2 cores (about 50 min), results in benchmarks/results/, the
 # README tables and the "which method when" reading regenerated from them;
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
-# `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min)
-BENCHMARKS := newton contact buckling bracket plasticity plasticity_peer mixed friction \
-	continuation damage damage_peer identification forming
+# `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min),
+# and every capability on the iterative path at ~1M
+BENCHMARKS := newton contact buckling bracket iterative plasticity plasticity_peer mixed \
+	friction continuation damage damage_peer identification forming
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done
@@ -103,6 +104,7 @@ bench: $(VENV)/.bench-installed
 
 bench-large: $(VENV)/.installed
 	$(PY) benchmarks/bracket.py --large --update-docs
+	$(PY) benchmarks/iterative.py --large --update-docs
 	$(PY) benchmarks/reading.py --update-docs
 
 # the site in docs/_build/html (open index.html): every demo executed as a notebook first

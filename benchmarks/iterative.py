@@ -1,0 +1,135 @@
+"""Every capability of the bracket on the iterative path (CG + GAMG), under refinement.
+
+The bracket (`demos/bracket.py --solver gamg`, 2 ranks) in the power law (full Newton, one
+step), in J2 (two steps and the unloading), on its floor (frictionless active set, two
+steps), on a rough floor (Coulomb, f = 0.3) and mixed (Taylor–Hood u–p, MINRES with the
+block preconditioner, one step), each on meshes halved twice. Per run: Newton iterations,
+Krylov iterations per Newton iteration (flat under refinement: the preconditioner is
+h-independent), AMG set-ups (one per load step or active-set iteration while CG keeps up),
+time, and time in linear solves of the same mesh (`--material linear`, CG + GAMG, solved to
+1e-11: one such solve is the unit). At the coarsest mesh each answer is checked against the
+direct solver's (MUMPS) within Newton's tolerance.
+
+Arc-length is not here: past a limit point its tangent is indefinite, where CG breaks down
+(the snap-through and the beam run on MUMPS).
+
+    python benchmarks/iterative.py [--quick] [--update-docs] [--large]
+
+Standard: 12, 6 and 3 mm elements (about 19k, 31k and 170k unknowns), about 15 min on 2
+cores; --large adds 1.55 mm (about 1M unknowns) for `make bench-large`; --quick: 20 mm,
+nothing written.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from common import ROOT, elapsed, machine, update_docs
+
+DEMO = ROOT / "demos" / "bracket.py"
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
+# each capability's flags and its KSP's options prefix
+CAPABILITIES = {
+    "power law": (["--steps", "1"], "bracket_"),
+    "J2, loaded and unloaded": (["--material", "j2", "--steps", "2", "--unload"], "bracket_"),
+    "contact": (["--support", "contact", "--steps", "2"], "bracket_elim_"),
+    "friction": (["--support", "contact", "--friction", "0.3", "--steps", "2"],
+                 "bracket_elim_"),
+    "mixed u-p (MINRES)": (["--mixed", "--steps", "1"], "bracket_fieldsplit_u_"),
+}
+
+
+def gamg(prefix: str) -> list[str]:
+    """CG + GAMG, its drop threshold 0.02 (25 % fewer CG iterations, benchmarks/bracket.py)."""
+    return ["--solver", "gamg", f"-{prefix}pc_gamg_threshold", "0.02"]
+
+
+KEYS = ("dofs", "newton_iterations", "krylov_iterations", "factorizations", "solve_time_s",
+        "load_point_displacement", "active_set_iterations", "peak_memory_mb")
+
+
+def say(text: str) -> None:
+    print(text, flush=True)
+
+
+def run(*args, ranks: int) -> dict:
+    """One demo run on `ranks` ranks; its --json output."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "out.json"
+        cmd = [sys.executable, str(DEMO), *map(str, args), "--json", str(out)]
+        if ranks > 1:
+            cmd = [str(MPIEXEC), "-n", str(ranks), *cmd]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr}")
+        d = json.loads(out.read_text())
+    return {k: d[k] for k in KEYS if k in d}
+
+
+def mesh(size: float, ranks: int, check: bool) -> dict:
+    """Every capability on one mesh; against MUMPS too when `check`."""
+    linear = run("--size", size, "--material", "linear", "--steps", "1", *gamg("bracket_"),
+                 ranks=ranks)
+    out = {"size": size, "linear": linear, "capabilities": {}}
+    for name, (flags, prefix) in CAPABILITIES.items():
+        r = run("--size", size, *flags, *gamg(prefix), ranks=ranks)
+        r["krylov_per_newton"] = r["krylov_iterations"] / r["newton_iterations"]
+        r["over_linear"] = r["solve_time_s"] / linear["solve_time_s"]
+        if check:
+            direct = run("--size", size, *flags, ranks=ranks)
+            r["direct_rel_difference"] = abs(r["load_point_displacement"]
+                                             / direct["load_point_displacement"] - 1)
+        out["capabilities"][name] = r
+        say(f"{size} mm, {r['dofs']} unknowns, {name}: {r['solve_time_s']:.1f} s, "
+            f"{r['newton_iterations']} Newton its, {r['krylov_per_newton']:.0f} CG its each, "
+            f"{r['factorizations']} AMG set-ups, {r['over_linear']:.1f} linear solves")
+    return out
+
+
+def table(out: dict) -> str:
+    rows = out["meshes"]
+    lines = [f"CG + GAMG on {out['ranks']} ranks; one linear solve of the same mesh is the "
+             "unit of the last column. Krylov iterations per Newton iteration stay within a "
+             "factor under refinement where the preconditioner is h-independent.", "",
+             "| capability | unknowns | Newton its | Krylov its / Newton it | AMG set-ups | "
+             "time (s) | / linear solve | vs MUMPS |", "|---|---|---|---|---|---|---|---|"]
+    for name in CAPABILITIES:
+        for m in rows:
+            r = m["capabilities"][name]
+            check = (f"{r['direct_rel_difference']:.0e}" if "direct_rel_difference" in r
+                     else "")
+            lines.append(f"| {name} | {r['dofs']} | {r['newton_iterations']} | "
+                         f"{r['krylov_per_newton']:.0f} | {r['factorizations']} | "
+                         f"{r['solve_time_s']:.1f} | {r['over_linear']:.1f} | {check} |")
+    lines += ["", "One linear solve: " + ", ".join(
+        f"{m['linear']['dofs']} unknowns {m['linear']['solve_time_s']:.2f} s "
+        f"({m['linear']['krylov_iterations']} CG its)" for m in rows) + "."]
+    return "\n".join(lines)
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--quick", action="store_true", help="20 mm elements, nothing written")
+    p.add_argument("--large", action="store_true", help="add 1.55 mm (about 1M unknowns)")
+    p.add_argument("--update-docs", action="store_true")
+    args = p.parse_args()
+    sizes = [20.0] if args.quick else [12.0, 6.0, 3.0] + ([1.55] if args.large else [])
+    ranks = 2
+    out = {"machine": machine(ranks), "ranks": ranks,
+           "meshes": [mesh(s, ranks, check=i == 0) for i, s in enumerate(sizes)]}
+    out["benchmark_time_s"] = elapsed()
+    text = table(out)
+    say(text)
+    if not args.quick:
+        name = "iterative_large" if args.large else "iterative"
+        (ROOT / "benchmarks" / "results" / f"{name}.json").write_text(json.dumps(out, indent=2))
+        if args.update_docs:
+            update_docs(name.replace("_", "-"), text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
