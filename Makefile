@@ -90,11 +90,11 @@ test-serial: $(VENV)/.installed
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -m mpi -q -p no:cacheprovider
 
-# every benchmark at sizes for 2 cores (about 50 min), results in benchmarks/results/, the
+# every benchmark at sizes for 2 cores (about 85 min), results in benchmarks/results/, the
 # README tables and the "which method when" reading regenerated from them;
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min),
-# and every capability on the iterative path at ~1M
+# and every capability on the iterative path at ~1M (about an hour more)
 BENCHMARKS := newton contact buckling bracket iterative plasticity plasticity_peer mixed \
 	friction continuation damage damage_peer identification forming
 bench: $(VENV)/.bench-installed

@@ -84,12 +84,13 @@ def bracket(b: dict, large: dict | None) -> list[str]:
             f"* **With CG + GAMG** (bracket, {kilo(g['linear']['dofs'])} unknowns, one "
             f"step) the ranking turns over: {items}; **{best}** wins. With no factorization to "
             "amortize, every iteration costs a Krylov solve, so the fewest iterations win; "
-            "the inexact-Newton forcing term keeps the early CG solves loose, and what a "
-            "frozen tangent saved with a direct solver, the set-up, full Newton saves by "
-            "keeping the step's first AMG hierarchy"
+            "the inexact-Newton forcing term keeps the early CG solves loose. Keeping the "
+            "step's first AMG hierarchy, what a frozen tangent saves with a direct solver, "
+            "saves little here"
             + (f" ({lag['factorizations']} set-ups for {lag['newton_iterations']} "
                f"iterations, {lag['solve_time_s']:.1f} s against "
-               f"{fresh['solve_time_s']:.1f} s with one per tangent)"
+               f"{fresh['solve_time_s']:.1f} s with one per tangent: GAMG reuses its "
+               "interpolation, so a set-up is cheap)"
                if (lag := v.get("full")) and (fresh := v.get("full, AMG per tangent"))
                else "") + ".")
     extrapolated = [r for r in (b, large) if r and r["richardson"]]

@@ -97,8 +97,9 @@ class BracketParameters(Parameters):
     mesh: str | None = text(None, "a .msh file with groups bolts, load, base (in --units; not "
                             "with --size)", metavar="MSH")
     solver: str = choice("lu", ["lu", "gamg"], "MUMPS LU, or CG + GAMG with rigid-body "
-                         "near-nullspace (every support and material; one AMG set-up per "
-                         "load step or active-set iteration while CG keeps up)", spelling=True)
+                         "near-nullspace (every support and material; a Newton solve keeps its "
+                         "first AMG hierarchy while CG keeps up, the mixed form excepted)",
+                         spelling=True)
     material: str = choice("power-law", ["power-law", "j2", "linear"], "the power law below; "
                            "j2: von Mises plasticity (sigma0, --hardening), path-dependent; or "
                            "linear elasticity (E, nu)")

@@ -79,7 +79,7 @@ class EliminationSystem:
         # a saddle point's (u, p) GMRES needs about as many iterations per changed node as
         # a factorization costs back-solves (3D Taylor–Hood, measured): only new springs
         # on the same rows, which move the matrix a little, keep its factorization
-        self.small_change = 0 if u.function_space.ufl_element().is_mixed else self.SMALL_CHANGE
+        self.small_change = 0 if opts.get("saddle_point") else self.SMALL_CHANGE
 
     def set_active(self, active: np.ndarray, changes: int | None,
                    extra_bcs: Sequence[fem.DirichletBC] = ()) -> None:

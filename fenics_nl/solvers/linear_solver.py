@@ -47,7 +47,8 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     Dirichlet rows) and the factorization is reused until it no longer pays. An
     `indefinite` A (a saddle point) takes GMRES instead, preconditioned on the right so
     that it stops on the true residual: CG's energy norm does not exist there, and
-    P⁻¹A = I + (a few rows' worth of rank) converges in as few iterations either way.
+    P⁻¹A = I + (a term of the rank of the changed rows and springs) converges in about as
+    many iterations either way.
     PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
     command line can override every choice made here.
     """

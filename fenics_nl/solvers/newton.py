@@ -128,7 +128,8 @@ class TangentPolicy:
       factorization while CG on it needs at most REUSE_ITERATIONS iterations, or while the
       Dirichlet rows changed only a little (`bcs_changed(small=True)`);
     * with `lag` (CG + AMG), a new tangent within a solve keeps the AMG hierarchy of the
-      solve's first one while CG needs at most twice the iterations it took on it fresh.
+      solve's first one while CG needs at most twice the iterations per digit of residual
+      reduction it took on it fresh (per digit: the inexact-Newton tolerance tightens).
 
     "Factorization" stands for the preconditioner's set-up: an AMG hierarchy too.
     """
@@ -141,7 +142,8 @@ class TangentPolicy:
         self.fixed, self.for_life, self.reuse, self.lag = fixed, for_life, reuse, lag
         self.ready = False  # a tangent valid for this solve is assembled and factorized
         self.factorization_current = False  # the factorization is of the current tangent
-        self._fresh_its = None  # lag: CG iterations on the hierarchy's own tangent
+        self._fresh_rate = None  # lag: CG iterations per digit on the hierarchy's tangent
+        self.stale = False  # the last tangent is solved with an older one's factorization
 
     def start_solve(self) -> None:
         """A new solve: the state moved, so every tangent is stale but two.
@@ -177,23 +179,27 @@ class TangentPolicy:
     def factorized(self) -> None:
         """A factorization of the current tangent was made."""
         self.factorization_current = True
-        self._fresh_its = None
+        self._fresh_rate = None
+        self.stale = False
 
     def assembled(self) -> None:
         """The tangent for this solve is in place."""
         self.ready = True
 
-    def krylov_iterations(self, its: int) -> None:
-        """CG on a reused factorization took `its`: beyond a few, refactorize next time.
+    def krylov_iterations(self, its: int, rtol: float) -> None:
+        """CG on a reused factorization took `its` to `rtol`: beyond a few, refactorize.
 
-        Lagged AMG: beyond twice what the hierarchy's own tangent took, set it up again.
+        Lagged AMG: beyond twice the iterations per digit the hierarchy's own tangent took,
+        set it up again (next time).
         """
         if not self.lag:
             self.factorization_current = its <= self.REUSE_ITERATIONS
-        elif self._fresh_its is None:
-            self._fresh_its = its
+            return
+        rate = its / max(-math.log10(rtol), 1.0)
+        if self._fresh_rate is None:
+            self._fresh_rate = rate
         else:
-            self.factorization_current = its <= 2 * self._fresh_its
+            self.factorization_current = rate <= 2 * self._fresh_rate
 
 
 class Factorizations:
@@ -383,8 +389,12 @@ class NewtonSolver:
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
         lag_preconditioner: with ``gamg``, keep the AMG hierarchy of a solve's first tangent
             for its later ones while CG needs at most twice the iterations it took on it
-            (PETSc's -snes_lag_preconditioner, adaptive): one set-up per load step.
+            per digit (PETSc's -snes_lag_preconditioner, adaptive). Measured on the bracket:
+            2 set-ups for 7 iterations, and no faster than 7, since GAMG reuses its
+            interpolation and a set-up is then cheap (benchmarks/bracket.py).
             ``-{prefix}lag_preconditioner false`` on the command line: one per tangent.
+        saddle_point: the tangent is indefinite (a displacement–pressure unknown): a reused
+            factorization preconditions GMRES, not CG.
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
         prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
@@ -424,6 +434,7 @@ class NewtonSolver:
         linear_solver: str = "lu",
         reuse_factorization: bool = False,
         lag_preconditioner: bool = True,
+        saddle_point: bool = False,
         preconditioner: ufl.Form | None = None,
         prefix: str = "newton_",
     ):
@@ -489,7 +500,7 @@ class NewtonSolver:
             nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
             self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                                   P=self.A if reuse else None, rtol=1e-12,
-                                  indefinite=V.ufl_element().is_mixed)
+                                  indefinite=saddle_point)
         # the block preconditioner is built from its own matrix: always set up again
         self._factorizations = None if self._M is not None or reuse else Factorizations(
             self.A, self.ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
@@ -756,8 +767,10 @@ class NewtonSolver:
             self._supports_checked = True
         if self.policy.needs_factorization():
             self._factorize(work)
-        elif self.policy.lag:  # the solve's first hierarchy, on the new operator
-            self.ksp.getPC().setReusePreconditioner(True)
+        else:  # an older tangent's factorization (reuse) or AMG hierarchy (lag) serves
+            if self.policy.lag:
+                self.ksp.getPC().setReusePreconditioner(True)
+            self.policy.stale = True
         self.policy.assembled()
 
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
@@ -802,14 +815,14 @@ class NewtonSolver:
         if ksp.getType() != "preonly":
             work.krylov_iterations += its
         lagging = self.policy.reuse or self.policy.lag
-        if lagging and reason < 0 and retry:
+        if lagging and reason < 0 and retry and self.policy.stale:
             # the old factorization no longer helps: refactorize, solve once more
             self._factorize(work)
             return self._linear_solve(rhs, work, retry=False)
         if reason < 0:
             raise LinearSolveError(reason)
         if lagging:  # many iterations: cheaper to refactorize next time
-            self.policy.krylov_iterations(its)
+            self.policy.krylov_iterations(its, ksp.getTolerances()[0])
 
     def _step(self, rnorm: float, work: WorkCounts, full_step: bool = False
               ) -> tuple[float, float]:
