@@ -22,15 +22,12 @@ NAME...: some capabilities; --quick: 20 mm, nothing written.
 
 import argparse
 import json
-import subprocess
 import sys
-import tempfile
-from pathlib import Path
 
+from bracket import run as demo_run
+from bracket import say
 from common import ROOT, elapsed, machine, update_docs
 
-DEMO = ROOT / "demos" / "bracket.py"
-MPIEXEC = Path(sys.executable).parent / "mpiexec"
 # each capability: its label, flags and KSP options prefix
 CAPABILITIES = {
     "power-law": ("power law", ["--steps", "1"], "bracket_"),
@@ -52,21 +49,9 @@ KEYS = ("dofs", "newton_iterations", "krylov_iterations", "factorizations", "sol
         "load_point_displacement", "active_set_iterations", "peak_memory_mb")
 
 
-def say(text: str) -> None:
-    print(text, flush=True)
-
-
 def run(*args, ranks: int) -> dict:
-    """One demo run on `ranks` ranks; its --json output."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp) / "out.json"
-        cmd = [sys.executable, str(DEMO), *map(str, args), "--json", str(out)]
-        if ranks > 1:
-            cmd = [str(MPIEXEC), "-n", str(ranks), *cmd]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr}")
-        d = json.loads(out.read_text())
+    """One demo run on `ranks` ranks (benchmarks/bracket.py's): the keys of its JSON kept."""
+    d = demo_run(*args, ranks=ranks)
     return {k: d[k] for k in KEYS if k in d}
 
 
