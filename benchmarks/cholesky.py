@@ -12,6 +12,14 @@ PC type by option reset the factorization package to PETSc's own sequential Chol
 `linear_solver.create_ksp` now keeps MUMPS.
 
     python benchmarks/cholesky.py [--size 6] [--json benchmarks/results/cholesky.json]
+
+On 2 ranks (`mpiexec -n 2`), the same factorizations scale differently (issue 31): the
+records of 81k and 300k unknowns on 1 and 2 ranks, factorizations only at 300k:
+
+    [mpiexec -n 2] python benchmarks/cholesky.py --size 4 \
+        --json benchmarks/results/cholesky_81k_<n>ranks.json
+    [mpiexec -n 2] python benchmarks/cholesky.py --size 2.4 --cases lu cholesky-symmetric \
+        --repeat 2 --no-newton --load-steps 0 --json benchmarks/results/cholesky_300k_<n>ranks.json
 """
 import argparse
 import json
@@ -26,22 +34,38 @@ from petsc4py import PETSc
 from fenics_nl.materials.laws import PowerLaw
 from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.solvers.result import WorkCounts
 
 p = argparse.ArgumentParser()
+CASES = {"lu": ("lu", None, None), "cholesky": ("cholesky", None, None),
+         "cholesky-symmetric": ("cholesky", "symmetric", None),
+         "cholesky-spd": ("cholesky", "spd", None), "cholesky-spd-metis": ("cholesky", "spd", 5)}
+# MUMPS options tried for 2 ranks (issue 31): the root front without ScaLAPACK
+# (ICNTL(13) = 1), and the analysis in parallel with PT-Scotch (ICNTL(28) = 2, ICNTL(29) = 1)
+ICNTL = {"lu-sequential-root": {13: 1}, "lu-parallel-analysis": {28: 2, 29: 1}}
+CASES.update({name: ("lu", None, None) for name in ICNTL})
+p = argparse.ArgumentParser()
 p.add_argument("--size", type=float, default=6.0)
+p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(CASES))
+p.add_argument("--repeat", type=int, default=3, help="numeric refactorizations timed (the least)")
+p.add_argument("--no-newton", action="store_true", help="the factorizations only")
+p.add_argument("--load-steps", type=int, default=4,
+               help="Newton steps to the 8 kN state whose tangent is factorized (0: the "
+                    "unloaded state's, the same pattern and factor size)")
 p.add_argument("--json")
 args = p.parse_args()
 
 b = build_bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
             force_scale=8e3)
-for k in range(1, 5):  # the 8 kN state, so that the tangent is the non-linear one
-    b.set_load(8e3 * k / 4)
+for k in range(1, args.load_steps + 1):  # the 8 kN state: the tangent is the non-linear one
+    b.set_load(8e3 * k / args.load_steps)
     b.solver.solve()
+if args.load_steps == 0:
+    b.solver.update_tangent(0, WorkCounts())  # the unloaded state's
 A = b.solver.A  # the last assembled tangent, with identity Dirichlet rows
 rows = []
-CASES = [("lu", None, None), ("cholesky", None, None), ("cholesky", "symmetric", None),
-         ("cholesky", "spd", None), ("cholesky", "spd", 5)]
-for kind, flag, ordering in CASES:
+for case in args.cases:
+    kind, flag, ordering = CASES[case]
     spd = flag == "spd"
     M = A.copy()
     if flag:
@@ -59,23 +83,26 @@ for kind, flag, ordering in CASES:
     F = pc.getFactorMatrix()
     if ordering is not None:
         F.setMumpsIcntl(7, ordering)
+    for key, value in ICNTL.get(case, {}).items():
+        F.setMumpsIcntl(key, value)
     t0 = time.perf_counter()
     pc.setUp()  # symbolic + numeric
     first = time.perf_counter() - t0
     M.setOption(PETSc.Mat.Option.NEW_NONZERO_LOCATION_ERR, True)
     times = []
-    for _ in range(3):  # numeric factorizations only, as Newton does
+    for _ in range(args.repeat):  # numeric factorizations only, as Newton does
         M.shift(1e-300)  # new values for PETSc (state bumped): a numeric refactorization
         t0 = time.perf_counter()
         ksp.setOperators(M)
         pc.setUp()
         times.append(time.perf_counter() - t0)
     F = pc.getFactorMatrix()
-    row = {"kind": kind, "matrix_flag": flag or "none",
+    row = {"case": case, "kind": kind, "matrix_flag": flag or "none",
            "ordering": "metis" if ordering == 5 else "default",
            "mumps_sym": 0 if kind == "lu" else (1 if spd else 2),
            "first_setup_s": first, "numeric_factorization_s": min(times),
            "ordering_used": F.getMumpsInfog(7), "factor_entries": F.getMumpsInfog(29),
+           "factorization_gflop": F.getMumpsRinfog(3) / 1e9,
            "factor_memory_mb": F.getMumpsInfog(22)}
     rows.append(row)
     if MPI.COMM_WORLD.rank == 0:
@@ -84,7 +111,7 @@ for kind, flag, ordering in CASES:
     M.destroy()
 # the same comparison inside Newton: full Newton, 4 load steps to 8 kN, same mesh
 newton = []
-for kind in ("lu", "cholesky"):
+for kind in () if args.no_newton else ("lu", "cholesky"):
     c = build_bracket(PowerLaw(200e3, 0.3, sigma0=200.0, n=0.2), size=args.size, degree=2,
                 force_scale=8e3, linear_solver=kind)
     t0 = time.perf_counter()
@@ -97,5 +124,7 @@ for kind in ("lu", "cholesky"):
     if MPI.COMM_WORLD.rank == 0:
         print(newton[-1], flush=True)
 if args.json and MPI.COMM_WORLD.rank == 0:
-    json.dump({"dofs": b.dofs, "size_mm": args.size, "factorizations": rows,
+    json.dump({"dofs": b.dofs, "size_mm": args.size, "ranks": MPI.COMM_WORLD.size,
+               "load_steps": args.load_steps,
+               "factorizations": rows,
                "full_newton": newton}, open(args.json, "w"), indent=2)
