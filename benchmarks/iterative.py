@@ -17,7 +17,9 @@ Arc-length is not here: past a limit point its tangent is indefinite, where CG b
 
 Standard: 12, 6 and 3 mm elements (18k, 31k and 169k unknowns), 14 min on 2 cores;
 --large: 1.55 mm (about 1M unknowns) for `make bench-large`, the third halving; --only
-NAME...: some capabilities; --quick: 20 mm, nothing written.
+NAME...: some capabilities (with --large, merged into the capabilities recorded already:
+each row keeps the time of the linear solve it is divided by); --quick: 20 mm, nothing
+written.
 """
 
 import argparse
@@ -65,6 +67,7 @@ def mesh(size: float, ranks: int, names: list[str], check: bool) -> dict:
         r = run("--size", size, *flags, *gamg(prefix), ranks=ranks)
         r["krylov_per_newton"] = r["krylov_iterations"] / r["newton_iterations"]
         r["over_linear"] = r["solve_time_s"] / linear["solve_time_s"]
+        r["linear_solve_time_s"] = linear["solve_time_s"]
         if check:
             direct = run("--size", size, *flags, ranks=ranks)
             r["direct_rel_difference"] = abs(r["load_point_displacement"]
@@ -74,6 +77,20 @@ def mesh(size: float, ranks: int, names: list[str], check: bool) -> dict:
             f"{r['newton_iterations']} Newton its, {r['krylov_per_newton']:.0f} CG its each, "
             f"{r['factorizations']} AMG set-ups, {r['over_linear']:.1f} linear solves")
     return out
+
+
+def merge_recorded(out: dict, path) -> None:
+    """The capabilities recorded in `path` on the same mesh, under those just run."""
+    if not path.exists():
+        return
+    before = json.loads(path.read_text())
+    for m in out["meshes"]:
+        for old in before["meshes"]:
+            if old["size"] != m["size"]:
+                continue
+            for name, r in old["capabilities"].items():
+                r.setdefault("linear_solve_time_s", old["linear"]["solve_time_s"])
+                m["capabilities"].setdefault(name, r)
 
 
 def table(out: dict) -> str:
@@ -115,6 +132,8 @@ def main() -> int:
            "meshes": [mesh(s, ranks, names, check=i == 0 and not args.large)
                       for i, s in enumerate(sizes)]}
     out["benchmark_time_s"] = elapsed()
+    if args.large and args.only:
+        merge_recorded(out, ROOT / "benchmarks" / "results" / "iterative_large.json")
     text = table(out)
     say(text)
     if not args.quick:
