@@ -36,7 +36,6 @@ from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 
-p = argparse.ArgumentParser()
 CASES = {"lu": ("lu", None, None), "cholesky": ("cholesky", None, None),
          "cholesky-symmetric": ("cholesky", "symmetric", None),
          "cholesky-spd": ("cholesky", "spd", None), "cholesky-spd-metis": ("cholesky", "spd", 5)}
