@@ -39,6 +39,7 @@ from scipy.optimize import brentq
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.scenes.necking_bar import NARROWING, RADIUS, NeckingBar, simo_material
 from fenics_nl.scenes.upsetting import Billet, Upsetting
+from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,14 +57,14 @@ def linear_solve_time(up) -> float:
     """One assembly, factorization and solve of the elastic tangent at rest (MUMPS)."""
     import ufl
     from dolfinx import fem
-    from dolfinx.fem import petsc
     from petsc4py import PETSc
 
     b = up.billet
     K = fem.form(ufl.derivative(up.residual, up.u))
     t0 = time.perf_counter()
-    A = petsc.assemble_matrix(K, bcs=b.supports)
-    A.assemble()
+    matrix = FormMatrix(K)  # the solvers' own assembly
+    matrix.assemble(K, b.supports)
+    A = matrix.mat
     ksp = PETSc.KSP().create(b.mesh.comm)
     ksp.setOperators(A)
     ksp.setType("preonly")

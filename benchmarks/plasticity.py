@@ -45,6 +45,7 @@ from petsc4py import PETSc
 from fenics_nl.io import cli
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.scenes.vessel import VesselBody
+from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import create_ksp
 
 HERE = Path(__file__).resolve().parent
@@ -75,8 +76,9 @@ def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float, dx
 
     def solve() -> float:
         t0 = time.perf_counter()
-        matrix = petsc.assemble_matrix(K, bcs=body.supports)
-        matrix.assemble()
+        form_matrix = FormMatrix(K)  # the solvers' own assembly
+        form_matrix.assemble(K, body.supports)
+        matrix = form_matrix.mat
         b = petsc.assemble_vector(L)
         petsc.apply_lifting(b, [K], [body.supports])
         b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)

@@ -240,14 +240,23 @@ def peer(vb: VesselBody, snes_type: str = "vinewtonrsls", factorization: str = "
     return {"time_s": spent, "iterations": iterations, "path": path, "phase_time_s": phases}
 
 
-def compare(h: float) -> dict:
+def compare(h: float, repeat: int = 1) -> dict:
+    """Every code on the mesh of size `h`, `repeat` rounds in turn, each code's fastest run:
+    a burst of the VM's load then slows one round, not one code."""
     vb = body(h)
-    row = {"h": h, "dofs": vb.dofs, "linear_solve_s": linear_solve_time(vb)}
-    for name, run in (("ours", ours), ("ours, LDLᵀ", partial(ours, linear_solver="cholesky")),
-                      ("peer", peer), ("peer, newtonls", partial(peer, snes_type="newtonls")),
-                      ("peer, newtonls, LDLᵀ",
-                       partial(peer, snes_type="newtonls", factorization="cholesky"))):
-        r = run(vb)
+    row = {"h": h, "dofs": vb.dofs, "linear_solve_s": linear_solve_time(vb),
+           "repeat": repeat}
+    codes = (("ours", ours), ("ours, LDLᵀ", partial(ours, linear_solver="cholesky")),
+             ("peer", peer), ("peer, newtonls", partial(peer, snes_type="newtonls")),
+             ("peer, newtonls, LDLᵀ",
+              partial(peer, snes_type="newtonls", factorization="cholesky")))
+    fastest = {}
+    for _ in range(repeat):
+        for name, run in codes:
+            r = run(vb)
+            if name not in fastest or r["time_s"] < fastest[name]["time_s"]:
+                fastest[name] = r
+    for name, r in fastest.items():
         row[name] = {"time_s": r["time_s"], "newton_iterations": sum(r["iterations"]),
                      "iterations_per_increment": r["iterations"],
                      "inner_displacement": r["path"][-1],
@@ -301,10 +310,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="two coarse meshes, nothing written")
     ap.add_argument("--update-docs", action="store_true")
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="rounds of every code on each mesh; each code's fastest is kept")
     args = ap.parse_args()
     sizes = [0.04, 0.02] if args.quick else [0.02, 0.01, 0.007]
     compare(0.05)  # warm-up: forms and the Numba kernel compiled
-    rows = [compare(h) for h in sizes]
+    rows = [compare(h, args.repeat) for h in sizes]
     h_ref = sizes[-1] / 2
     vb = body(h_ref)
     reference = {"h": h_ref, "dofs": vb.dofs, **ours(vb)}

@@ -48,6 +48,7 @@ from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.errors import SolveError
 from fenics_nl.io import output
+from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
     block_preconditioned_ksp,
     create_ksp,
@@ -477,7 +478,9 @@ class NewtonSolver:
         else:
             self._K_used = self._K
         self._constant = method in ("modified", "bfgs")
-        self.A = petsc.create_matrix(self._K)
+        # on one rank with MUMPS the tangent is filled by DOLFINx's CSR assembler (form_matrix)
+        self._matrix = FormMatrix(self._K, native=linear_solver in ("lu", "cholesky"))
+        self.A = self._matrix.mat
         # reuse: the factorized matrix P lags behind A and preconditions CG on A
         reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
@@ -752,9 +755,7 @@ class NewtonSolver:
             if self.policy.fixed and not self._constant:
                 self._apply_bcs_to_fixed_tangent(work)
             else:
-                self.A.zeroEntries()
-                petsc.assemble_matrix(self.A, self._K_used, bcs=self.bcs, diag=1.0)
-                self.A.assemble()
+                self._matrix.assemble(self._K_used, self.bcs)
                 work.tangent_assemblies += 1
             self.nodal.add_to_tangent(self.A)
             if self._M is not None:  # its Dirichlet rows follow the tangent's
@@ -776,8 +777,7 @@ class NewtonSolver:
     def _apply_bcs_to_fixed_tangent(self, work: WorkCounts) -> None:
         """A = K with the Dirichlet rows and columns replaced by the identity (no assembly)."""
         if self._K_fixed is None:
-            petsc.assemble_matrix(self.A, self._K)
-            self.A.assemble()
+            self._matrix.assemble(self._K)
             work.tangent_assemblies += 1
             self._K_fixed = self.A.copy()
         else:
