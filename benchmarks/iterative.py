@@ -110,10 +110,28 @@ def table(out: dict) -> str:
             lines.append(f"| {name} | {r['dofs']} | {r['newton_iterations']} | "
                          f"{r['krylov_per_newton']:.0f} | {r['factorizations']} | "
                          f"{r['solve_time_s']:.1f} | {r['over_linear']:.1f} | {check} |")
-    lines += ["", "One linear solve: " + ", ".join(
-        f"{m['linear']['dofs']} unknowns {m['linear']['solve_time_s']:.2f} s "
-        f"({m['linear']['krylov_iterations']} CG its)" for m in rows) + "."]
+    lines += ["", "One linear solve: " + ", ".join(linear_units(m) for m in rows) + "."]
     return "\n".join(lines)
+
+
+def linear_units(m: dict) -> str:
+    """The linear solve(s) a mesh's rows are divided by: this run's, and those of the
+    earlier runs whose rows `merge_recorded` kept (each row records its own)."""
+    lin = m["linear"]
+    text = (f"{lin['dofs']} unknowns {lin['solve_time_s']:.2f} s "
+            f"({lin['krylov_iterations']} CG its)")
+    units: dict[float, list[str]] = {}
+    for name, r in m["capabilities"].items():
+        units.setdefault(r.get("linear_solve_time_s", lin["solve_time_s"]), []).append(name)
+    if len(units) == 1:
+        return text
+    def rows_of(names):
+        return ", ".join(f'"{n}"' for n in names)
+
+    this = units.pop(lin["solve_time_s"], [])
+    return (f"{text} for {rows_of(this)}; " + "; ".join(
+        f"{t:.2f} s (an earlier run of the same mesh) for {rows_of(names)}"
+        for t, names in units.items()))
 
 
 def main() -> int:

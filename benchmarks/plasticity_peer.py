@@ -310,7 +310,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="two coarse meshes, nothing written")
     ap.add_argument("--update-docs", action="store_true")
-    ap.add_argument("--repeat", type=int, default=2,
+    ap.add_argument("--repeat", type=int, default=3,
                     help="rounds of every code on each mesh; each code's fastest is kept")
     args = ap.parse_args()
     sizes = [0.04, 0.02] if args.quick else [0.02, 0.01, 0.007]

@@ -257,8 +257,19 @@ def plasticity_peer(q: dict) -> str:
             f"`newtonls`, which takes {plain['time_s']:.1f} s "
             f"({plain['time_s'] / ours['time_s']:.2f}x ours). The Numba return map itself "
             f"costs {peer['phase_time_s']['return map (Numba)']:.1f} s; ours evaluates the "
-            f"radial return inside the tangent kernel: {ours['phase_time_s']['tangent']:.1f} s "
-            f"of tangent assembly against the peer's {plain['phase_time_s']['tangent']:.1f} s.")
+            f"radial return inside the tangent kernel, assembled on one rank into DOLFINx's "
+            f"CSR matrix that MUMPS reads: {ours['phase_time_s']['tangent']:.1f} s of tangent "
+            f"assembly against the peer's {plain['phase_time_s']['tangent']:.1f} s.")
+    ldl = all("ours, LDLᵀ" in row and "peer, newtonls, LDLᵀ" in row for row in q["rows"])
+    text += (" The peer's `newtonls` over ours on every mesh ("
+             + ", ".join(f"{row['dofs']}" for row in q["rows"]) + " unknowns): LU "
+             + ", ".join(f"{row['peer, newtonls']['time_s'] / row['ours']['time_s']:.2f}"
+                         for row in q["rows"])
+             + ("; LDLᵀ against LDLᵀ " + ", ".join(
+                 f"{row['peer, newtonls, LDLᵀ']['time_s'] / row['ours, LDLᵀ']['time_s']:.2f}"
+                 for row in q["rows"]) if ldl else "")
+             + (f" (each code's fastest of {q['rows'][0]['repeat']} rounds)."
+                if q["rows"][0].get("repeat", 1) > 1 else "."))
     if ours_ldl and plain_ldl:
         gain = (ours["phase_time_s"]["factorization"]
                 / ours_ldl["phase_time_s"]["factorization"])

@@ -1,6 +1,7 @@
 """The KSP factory: a factorization chosen by option stays MUMPS (PETSc's own is 7x slower)."""
 
 import numpy as np
+import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -36,3 +37,68 @@ def test_cholesky_by_option_keeps_mumps_and_solves():
     finally:
         opts.delValue("cholopt_pc_type")
     assert np.isfinite(x.norm())
+
+
+def _elasticity_with_a_support(comm):
+    """P2 elasticity of a unit square clamped on x = 0: its form, support and modulus."""
+    import ufl
+    from dolfinx import fem, mesh
+
+    msh = mesh.create_unit_square(comm, 6, 6)
+    V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    E = fem.Constant(msh, 1.0)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    eps = ufl.sym(ufl.grad(u))
+    a = fem.form(E * (ufl.inner(eps, ufl.sym(ufl.grad(v))) + 0.5 * ufl.div(u) * ufl.div(v))
+                 * ufl.dx)
+    clamped = fem.locate_dofs_geometrical(V, lambda x: np.isclose(x[0], 0.0))
+    bc = fem.dirichletbc(np.zeros(2), clamped, V)
+    return a, bc, E
+
+
+def test_the_native_tangent_is_petscs_bit_for_bit_and_refactorized_when_it_changes():
+    # FormMatrix on one rank: DOLFINx's CSR assembler writes into the arrays of the PETSc
+    # matrix MUMPS factorizes; the same entries as petsc.assemble_matrix, and a new assembly
+    # is a new matrix state (a stale factorization would solve with the old values)
+    from dolfinx.fem import petsc
+
+    from fenics_nl.solvers.form_matrix import FormMatrix
+
+    a, bc, E = _elasticity_with_a_support(MPI.COMM_SELF)
+    native = FormMatrix(a)
+    assert native.mat.getType() == "seqaij"
+    for modulus in (1.0, 3.0):
+        E.value = modulus
+        native.assemble(a, [bc])
+        reference = petsc.assemble_matrix(a, bcs=[bc], diag=1.0)
+        reference.assemble()
+        reference.axpy(-1.0, native.mat, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        assert reference.norm() == 0.0
+    ksp = create_ksp(native.mat, "lu")
+    b, x = native.mat.createVecs()
+    b.set(1.0)
+    petsc.set_bc(b, [bc])
+    ksp.solve(b, x)
+    before = x.copy()
+    E.value = 6.0  # twice the modulus: half the displacement (to round-off), same KSP
+    native.assemble(a, [bc])
+    ksp.solve(b, x)
+    free = np.abs(before.array) > 0
+    assert np.allclose(x.array[free] * 2.0, before.array[free], rtol=1e-10, atol=0.0)
+
+
+@pytest.mark.mpi
+def test_on_two_ranks_the_tangent_is_petscs_own():
+    # the CSR's ghost rows would need an exchange of their own: PETSc's matrix and assembler
+    from dolfinx.fem import petsc
+
+    from fenics_nl.solvers.form_matrix import FormMatrix
+
+    a, bc, _ = _elasticity_with_a_support(MPI.COMM_WORLD)
+    matrix = FormMatrix(a)
+    matrix.assemble(a, [bc])
+    reference = petsc.assemble_matrix(a, bcs=[bc], diag=1.0)
+    reference.assemble()
+    reference.axpy(-1.0, matrix.mat, PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+    assert reference.norm() == 0.0
+    assert (matrix.mat.getType() == "seqaij") == (MPI.COMM_WORLD.size == 1)
