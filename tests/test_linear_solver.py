@@ -40,7 +40,8 @@ def test_cholesky_by_option_keeps_mumps_and_solves():
 
 
 def _elasticity_with_a_support(comm):
-    """P2 elasticity of a unit square clamped on x = 0: its form, support and modulus."""
+    """P2 elasticity of a unit square clamped on x = 0: its bilinear form (UFL), support and
+    modulus (a Constant)."""
     import ufl
     from dolfinx import fem, mesh
 
@@ -49,22 +50,22 @@ def _elasticity_with_a_support(comm):
     E = fem.Constant(msh, 1.0)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     eps = ufl.sym(ufl.grad(u))
-    a = fem.form(E * (ufl.inner(eps, ufl.sym(ufl.grad(v))) + 0.5 * ufl.div(u) * ufl.div(v))
-                 * ufl.dx)
+    a = E * (ufl.inner(eps, ufl.sym(ufl.grad(v))) + 0.5 * ufl.div(u) * ufl.div(v)) * ufl.dx
     clamped = fem.locate_dofs_geometrical(V, lambda x: np.isclose(x[0], 0.0))
-    bc = fem.dirichletbc(np.zeros(2), clamped, V)
-    return a, bc, E
+    return a, fem.dirichletbc(np.zeros(2), clamped, V), E
 
 
 def test_the_native_tangent_is_petscs_bit_for_bit_and_refactorized_when_it_changes():
     # FormMatrix on one rank: DOLFINx's CSR assembler writes into the arrays of the PETSc
     # matrix MUMPS factorizes; the same entries as petsc.assemble_matrix, and a new assembly
     # is a new matrix state (a stale factorization would solve with the old values)
+    from dolfinx import fem
     from dolfinx.fem import petsc
 
     from fenics_nl.solvers.form_matrix import FormMatrix
 
     a, bc, E = _elasticity_with_a_support(MPI.COMM_SELF)
+    a = fem.form(a)
     native = FormMatrix(a)
     assert native.mat.getType() == "seqaij"
     for modulus in (1.0, 3.0):
@@ -85,16 +86,44 @@ def test_the_native_tangent_is_petscs_bit_for_bit_and_refactorized_when_it_chang
     ksp.solve(b, x)
     free = np.abs(before.array) > 0
     assert np.allclose(x.array[free] * 2.0, before.array[free], rtol=1e-10, atol=0.0)
+    # PETSc's own row operations keep the CSR's pattern: the next assembly is still exact
+    # (a compacted pattern would put the values where the CSR's indices do not say)
+    rows = np.arange(0, 40, 3, dtype=PETSc.IntType)
+    native.mat.zeroRowsColumnsLocal(rows, diag=1.0)
+    native.mat.zeroRowsLocal(rows + 1, diag=1.0)  # this one would compact by default
+    native.assemble(a, [bc])
+    reference = petsc.assemble_matrix(a, bcs=[bc], diag=1.0)
+    reference.assemble()
+    reference.axpy(-1.0, native.mat, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert reference.norm() == 0.0
+
+
+def test_newtons_tangent_is_the_native_matrix_on_one_rank():
+    # DOLFINx's own PETSc matrix of this 2-vector space has block size 2, the native one 1
+    import ufl
+    from dolfinx import fem
+
+    from fenics_nl.solvers.newton import NewtonSolver
+
+    a, bc, _ = _elasticity_with_a_support(MPI.COMM_SELF)
+    V = a.arguments()[0].ufl_function_space()
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    residual = ufl.action(a, u) - ufl.dot(ufl.as_vector((0.0, -1.0)), v) * ufl.dx
+    for kind, block in (("lu", 1), ("gamg", 2)):
+        solver = NewtonSolver(residual, u, [bc], linear_solver=kind, prefix=f"native_{kind}_")
+        assert solver.A.getBlockSize() == block
 
 
 @pytest.mark.mpi
 def test_on_two_ranks_the_tangent_is_petscs_own():
     # the CSR's ghost rows would need an exchange of their own: PETSc's matrix and assembler
+    from dolfinx import fem
     from dolfinx.fem import petsc
 
     from fenics_nl.solvers.form_matrix import FormMatrix
 
     a, bc, _ = _elasticity_with_a_support(MPI.COMM_WORLD)
+    a = fem.form(a)
     matrix = FormMatrix(a)
     matrix.assemble(a, [bc])
     reference = petsc.assemble_matrix(a, bcs=[bc], diag=1.0)

@@ -24,23 +24,29 @@ class FormMatrix:
     """`mat`, the PETSc matrix of bilinear form `form`'s pattern; `assemble` fills it.
 
     `native=False` (or more than one rank) keeps PETSc's own matrix and assembler: GAMG, for
-    one, reads the block size that DOLFINx gives its PETSc matrices.
+    one, reads the block size that DOLFINx gives its PETSc matrices (the native one has 1).
     """
 
     def __init__(self, form: fem.Form, native: bool = True):
         self._csr = None
-        if not (native and form.mesh.comm.size == 1):
+        if not (native and form.mesh.comm.size == 1 and form.dtype == PETSc.ScalarType):
             self.mat = petsc.create_matrix(form)
             return
         self._csr = fem.create_matrix(form, block_mode=la.BlockMode.expanded)
-        n = self._csr.indptr.size - 1
-        # the values array is shared (PETSc's integer type may need a copy of the indices)
+        rows, cols = (self._csr.index_map(i).size_global * self._csr.block_size[i]
+                      for i in (0, 1))
+        # the values array is shared (the indices are copied to PETSc's integer type)
         pattern = (self._csr.indptr.astype(PETSc.IntType), self._csr.indices.astype(
             PETSc.IntType), self._csr.data)
-        self.mat = PETSc.Mat().createAIJWithArrays((n, n), pattern, comm=PETSc.COMM_SELF)
+        self.mat = PETSc.Mat().createAIJWithArrays((rows, cols), pattern, comm=PETSc.COMM_SELF)
+        # the pattern is the CSR's, for life: a PETSc operation that compacted it (MatZeroRows
+        # without this) or allocated a new entry would move the values away from the CSR's
+        self.mat.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        self.mat.setOption(PETSc.Mat.Option.NEW_NONZERO_LOCATION_ERR, True)
         # the solver's *Local calls (Dirichlet rows of a fixed tangent): local is global here
-        identity = PETSc.LGMap().create(np.arange(n, dtype=PETSc.IntType), comm=PETSc.COMM_SELF)
-        self.mat.setLGMap(identity, identity)
+        row_map, col_map = (PETSc.LGMap().create(np.arange(n, dtype=PETSc.IntType),
+                                                 comm=PETSc.COMM_SELF) for n in (rows, cols))
+        self.mat.setLGMap(row_map, col_map)
         self.mat.assemble()
 
     def assemble(self, form: fem.Form, bcs=(), diag: float = 1.0) -> None:

@@ -479,7 +479,8 @@ class NewtonSolver:
             self._K_used = self._K
         self._constant = method in ("modified", "bfgs")
         # on one rank with MUMPS the tangent is filled by DOLFINx's CSR assembler (form_matrix)
-        self._matrix = FormMatrix(self._K, native=linear_solver in ("lu", "cholesky"))
+        # (the pattern of the form assembled: K, or a given constant tangent)
+        self._matrix = FormMatrix(self._K_used, native=linear_solver in ("lu", "cholesky"))
         self.A = self._matrix.mat
         # reuse: the factorized matrix P lags behind A and preconditions CG on A
         reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
