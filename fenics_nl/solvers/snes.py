@@ -17,6 +17,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.supports import RigidMotions, check_supports
@@ -169,10 +170,13 @@ class SnesSolver:
             self.problem = petsc.NonlinearProblem(residual, u, bcs=self.bcs, J=J,
                                                   petsc_options_prefix=prefix,
                                                   petsc_options=passed)
-        if linear_solver == "cholesky":
-            self.problem.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-            self.problem.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes = self.problem.solver
+        # the Jacobian in the matrix NewtonSolver assembles (form_matrix: DOLFINx's CSR on one
+        # rank), so that the two loops are compared on the same assembly
+        self.A = self._own_jacobian(self.problem, self.bcs)
+        if linear_solver == "cholesky":
+            self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            self.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes.setConvergenceHistory(reset=True)
         scale_absolute_tolerance(self.snes, atol, force_scale)
         # time of each residual norm, as SolveResult.elapsed. The monitor holds the list,
@@ -184,6 +188,22 @@ class SnesSolver:
         self.counter = EventCounter(all_event_names())
         self.motions = RigidMotions.of(u.function_space)
         self._supports_checked = False
+
+    def _own_jacobian(self, problem, bcs) -> PETSc.Mat:
+        """SNES's Jacobian assembled into a `FormMatrix` (DOLFINx's PETSc matrix freed)."""
+        matrix = self._matrix = FormMatrix(problem.J)
+        form, u = problem.J, problem.u
+
+        # a closure, not a method: SNES holding self would make a cycle that the garbage
+        # collector breaks in a different order on each rank
+        def jacobian(snes, x, J, P):
+            x.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+            petsc.assign(x, u)
+            matrix.assemble(form, bcs)
+
+        self.snes.setJacobian(jacobian, matrix.mat, matrix.mat)
+        problem.A.destroy()  # no longer SNES's (NonlinearProblem's own destroy then skips it)
+        return matrix.mat
 
     def solve(self) -> SolveResult:
         """Solve from the current `u`, the boundary values imposed first.
@@ -198,11 +218,8 @@ class SnesSolver:
             # MUMPS factorizes a singular K without a word, and SNES then converges to an
             # answer with an arbitrary rigid motion in it: the tangent at the start (an
             # unstressed state for a first solve) is checked before SNES runs
-            A = self.problem.A
-            A.zeroEntries()
-            petsc.assemble_matrix(A, self.problem.J, bcs=self.bcs, diag=1.0)
-            A.assemble()
-            check_supports(A, self.motions, self.bcs)
+            self._matrix.assemble(self.problem.J, self.bcs)
+            check_supports(self.A, self.motions, self.bcs)
             self._supports_checked = True
         self.counter.start()
         self._stamps.clear()
