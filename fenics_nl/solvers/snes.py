@@ -176,7 +176,8 @@ class SnesSolver:
         self.snes = self.problem.solver
         # the Jacobian in the matrix NewtonSolver assembles (form_matrix: DOLFINx's CSR on one
         # rank), so that the two loops are compared on the same assembly
-        self.A = self._own_jacobian(self.problem, self.bcs)
+        self._matrix = self._own_jacobian(self.problem, self.bcs)
+        self.A = self._matrix.mat
         if linear_solver == "cholesky":
             self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
@@ -192,9 +193,9 @@ class SnesSolver:
         self.motions = RigidMotions.of(u.function_space)
         self._supports_checked = False
 
-    def _own_jacobian(self, problem, bcs) -> PETSc.Mat:
+    def _own_jacobian(self, problem, bcs) -> FormMatrix:
         """SNES's Jacobian assembled into a `FormMatrix` (DOLFINx's PETSc matrix freed)."""
-        matrix = self._matrix = FormMatrix(problem.J)
+        matrix = FormMatrix(problem.J)
         form, u = problem.J, problem.u
 
         # a closure, not a method: SNES holding self would make a cycle that the garbage
@@ -206,7 +207,7 @@ class SnesSolver:
 
         self.snes.setJacobian(jacobian, matrix.mat, matrix.mat)
         problem.A.destroy()  # no longer SNES's (NonlinearProblem's own destroy then skips it)
-        return matrix.mat
+        return matrix
 
     def solve(self) -> SolveResult:
         """Solve from the current `u`, the boundary values imposed first.
