@@ -24,6 +24,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -35,6 +36,12 @@ DEMOS = ROOT / "demos"
 sys.path.append(str(ROOT / "benchmarks"))
 sys.path.append(str(ROOT / "docs"))  # notebooks.py: the demos run as notebooks
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
+# pytest's cache, where the serial suite keeps its demo runs (Demos.json); the mpi suite runs
+# without the cache plugin (two ranks would write its files at once) and reads them here
+CACHE = ROOT / ".pytest_cache" / "v"
+# what MPICH's launcher tells a process: without it, a process started by a rank is a
+# serial run of its own (an MPI singleton), not a third rank of this one
+LAUNCHER_VARIABLES = ("PMI_", "HYDRA_", "MPI_LOCALNRANKS", "MPI_LOCALRANKID")
 
 if MPI.COMM_WORLD.size > 1:
     gc.disable()
@@ -57,18 +64,21 @@ SOURCE_DIGEST = source_digest()
 class Demos:
     """Runs demos/<name> as a user does, in `tmp_path`.
 
-    Serially the demo's cells run in this process through `cli.run_file`, under the same
-    contract as the script (scikit-fem's test_examples style: no interpreter start, forms
-    stay compiled); with ranks > 1 it runs under
-    `mpiexec -n ranks` in a subprocess. Either way the result is a CompletedProcess with
-    the exit status, stdout and stderr (captured at the file descriptors, so PETSc's own
-    output is in it).
+    On as many ranks as this pytest has (1 in the serial suite, 2 in the mpi suite) the
+    demo's cells run in this process through `cli.run_file`, under the same contract as the
+    script (scikit-fem's test_examples style: no interpreter start, forms stay compiled).
+    From the serial suite, other ranks run under `mpiexec -n ranks` in a subprocess
+    (`spawns_mpi` tests); from the mpi suite, a serial run is a subprocess of rank 0 (or the
+    serial suite's, from its cache: see `json`). Either way the result is a CompletedProcess
+    with the exit status, stdout and stderr (captured at the file descriptors, so PETSc's
+    own output is in it), the same on every rank but for an in-process run's output.
     """
 
     def __init__(self, tmp_path, capfd, monkeypatch, request):
         self.tmp_path, self.capfd, self.monkeypatch = tmp_path, capfd, monkeypatch
         self.spawns_mpi = request.node.get_closest_marker("spawns_mpi") is not None
-        self.cache = request.config.cache
+        self.cache = getattr(request.config, "cache", None)  # the mpi suite has none
+        self.world = MPI.COMM_WORLD
 
     def run(self, args, check=True, ranks=1) -> subprocess.CompletedProcess:
         """`python demos/args[0] args[1:]`; with `check`, a non-zero exit fails the test.
@@ -76,16 +86,21 @@ class Demos:
         args[0] = "-m fenics_nl" runs the case-file command instead of a demo.
         """
         name, argv = str(args[0]), [str(a) for a in args[1:]]
-        proc = self._in_process(name, argv) if ranks == 1 else self._mpiexec(name, argv, ranks)
+        if ranks == self.world.size:
+            proc = self._in_process(name, argv)
+        elif self.world.size == 1:
+            proc = self._mpiexec(name, argv, ranks)
+        elif ranks == 1:
+            proc = self._serial_on_rank_0(name, argv)
+        else:
+            raise ValueError(f"the mpi suite runs on {self.world.size} ranks or 1, not {ranks}")
         if check:
             assert proc.returncode == 0, proc.stderr
         return proc
 
     def case(self, *args, ranks=1) -> dict:
         """`python -m fenics_nl run args...` and its JSON."""
-        out = self.tmp_path / f"case{next(_runs)}.json"
-        self.run(["-m fenics_nl", "run", *args, "--json", out], ranks=ranks)
-        return json.loads(out.read_text())
+        return self._run_json("-m fenics_nl", ["run", *args], ranks)
 
     def _in_process(self, name, argv):
         if name == "-m fenics_nl":
@@ -129,6 +144,20 @@ class Demos:
         return subprocess.run(cmd, cwd=self.tmp_path, capture_output=True, text=True,
                               timeout=900, env=env)
 
+    def _serial_on_rank_0(self, name, argv):
+        # the other ranks sleep meanwhile: MPICH's busy wait in a collective would take the
+        # core the serial run needs
+        proc = None
+        if self.world.rank == 0:
+            script = ["-m", "fenics_nl"] if name == "-m fenics_nl" else [str(DEMOS / name)]
+            env = {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_VARIABLES)}
+            proc = subprocess.run([sys.executable, *script, *argv], cwd=self.tmp_path,
+                                  capture_output=True, text=True, timeout=900, env=env)
+        done = self.world.Ibarrier()
+        while not done.Test():
+            time.sleep(0.05)
+        return self.world.bcast(proc)
+
     def json(self, name, *args, ranks=1) -> dict:
         """Run demos/`name` with `args` and return its JSON.
 
@@ -149,6 +178,15 @@ class Demos:
             return self._run_json(name, args, ranks)
         if key in _serial_references:
             return copy.deepcopy(_serial_references[key])
+        if self.world.size > 1:  # the mpi suite: the serial suite's run, or one made now
+            result = self._cached_on_rank_0(cache_key)
+            if result is None:
+                result = self._run_json(name, args, ranks)
+                if self.world.rank == 0:
+                    (CACHE / cache_key).parent.mkdir(parents=True, exist_ok=True)
+                    (CACHE / cache_key).write_text(json.dumps(result, indent=2, sort_keys=True))
+            _serial_references[key] = copy.deepcopy(result)
+            return result
         # the other xdist worker may be making this very run: wait for it rather than
         # make it twice (a lock per run, held while it is made)
         lock = self.cache.mkdir("fenics_nl_locks") / hashlib.sha1(cache_key.encode()).hexdigest()
@@ -161,10 +199,17 @@ class Demos:
         _serial_references[key] = copy.deepcopy(result)
         return result
 
+    def _cached_on_rank_0(self, cache_key):
+        path = CACHE / cache_key
+        found = json.loads(path.read_text()) if self.world.rank == 0 and path.is_file() else None
+        return self.world.bcast(found)
+
     def _run_json(self, name, args, ranks) -> dict:
-        out = self.tmp_path / f"{Path(name).stem}{next(_runs)}.json"
+        # rank 0 writes the JSON: every rank names its file and reads it from rank 0
+        stem = "case" if name == "-m fenics_nl" else Path(name).stem
+        out = self.world.bcast(self.tmp_path / f"{stem}{next(_runs)}.json")
         self.run([name, *args, "--json", out], ranks=ranks)
-        return json.loads(out.read_text())
+        return self.world.bcast(json.loads(out.read_text()) if self.world.rank == 0 else None)
 
     def punch(self, *args, ranks=1) -> dict:
         return self.json("punch.py", *args, ranks=ranks)

@@ -225,7 +225,7 @@ def test_every_shipped_case_checks(demo, path):
     assert "the case is complete" in proc.stdout
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_two_ranks_give_the_serial_answer(demo):
     s = demo.case(CASES / "thick_cylinder.toml")
     p = demo.case(CASES / "thick_cylinder.toml", ranks=2)

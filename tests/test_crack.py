@@ -95,7 +95,7 @@ def test_a_crack_coarser_than_two_cells_warns_with_what_it_costs(demo):
     assert d["dissipated_energy_per_width"] == pytest.approx(d["mesh_toughness"], rel=0.01)
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_the_notched_square_on_two_ranks_is_the_serial_one(demo):
     s, p = demo.json("crack.py", *TENSION), demo.json("crack.py", *TENSION, ranks=2)
     assert p["ranks"] == 2 and p["crack_tip_history"] == s["crack_tip_history"]

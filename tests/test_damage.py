@@ -93,7 +93,7 @@ def test_ell_below_two_elements_is_said_with_its_effective_toughness(demo):
     assert t["dissipated_energy"] / d["cross_section"] == pytest.approx(effective, rel=0.01)
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_damage_bar_two_ranks_give_the_serial_answer(demo):
     s, p = demo.json("damage_bar.py"), demo.json("damage_bar.py", ranks=2)
     assert p["ranks"] == 2 and p["localized"]

@@ -218,7 +218,7 @@ def test_punch_formulations_agree(demo):
     assert m["contact_radius"] == e["contact_radius"]
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_punch_two_ranks_match_serial(demo):
     s = demo.punch("--steps", "2")
     p = demo.punch("--steps", "2", ranks=2)
@@ -353,7 +353,7 @@ def test_an_arch_whose_second_limit_load_is_zero_says_its_error_in_q_limit(demo)
     assert abs(d["limit_loads"][1]) < 0.02 * d["limit_load_reference"]
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_snap_through_two_ranks_match_serial(demo):
     args = ("--slenderness", "100", "--load-ratio", "1.1")
     s, p = demo.json("snap_through.py", *args), demo.json("snap_through.py", *args, ranks=2)
@@ -393,7 +393,7 @@ def test_snap_through_bad_input_one_clear_line(args, message, demo):
     assert message in proc.stderr and "Traceback" not in proc.stderr
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_beam_two_ranks_match_serial(demo):
     # the notebook's run (tests/test_notebooks.py): the serial answer is made there
     s = demo.beam("--load-ratio", "1.2", "--steps", "10")
@@ -498,7 +498,7 @@ def test_bracket_on_its_floor_on_the_iterative_path_gives_the_direct_answer(demo
 # of tests/test_friction.py, and on the iterative path): their answers are the references
 @pytest.mark.parametrize("args", [tuple(SMALL["bracket.py"]), BRACKET_ON_FLOOR,
                                   BRACKET_ON_FLOOR_GAMG], ids=["clamped", "contact", "gamg"])
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_bracket_two_ranks_match_serial(args, demo):
     # 20 mm elements (11.6k unknowns): the partition still cuts the holes and the floor
     s = demo.bracket(*args)

@@ -209,7 +209,7 @@ def test_vanishing_friction_is_frictionless_and_large_friction_sticks(demo):
     assert rough["slip_nodes"] == 0 and rough["stick_nodes"] == rough["nodes_in_contact"]
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_friction_two_ranks_give_the_serial_answer(demo):
     # a block 10 a wide: there the partition cuts the contact zone (both ranks own stick
     # and slip nodes: `test_friction_on_a_cut_contact_zone` checks it)
@@ -322,7 +322,7 @@ def test_bracket_on_a_rough_floor(demo):
     assert rough["load_point_displacement"] < free["load_point_displacement"]
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_bracket_on_a_rough_floor_on_two_ranks(demo):
     rough = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0.3")
     two = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0.3", ranks=2)

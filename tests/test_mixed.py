@@ -182,7 +182,7 @@ def test_mixed_punch_multipliers_equal_the_elimination(demo, model):
 
 
 @pytest.mark.parametrize("formulation", ["elimination", "multiplier"])
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_mixed_punch_two_ranks_give_the_serial_answer(demo, formulation):
     ranks = 2
     # the arguments of `test_mixed_punch_multipliers_equal_the_elimination`: its serial runs
@@ -282,7 +282,7 @@ def test_incompressible_beam_leaves_a_higher_branch(demo, on_elastica):
 
 
 @pytest.mark.parametrize("ranks", [2])
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_mixed_beam_two_ranks_give_the_serial_answer(demo, ranks):
     args = (*INCOMPRESSIBLE_BEAM, "--load-ratio", "1.2", "--steps", "20")
     s, p = demo.beam(*args), demo.beam(*args, ranks=ranks)

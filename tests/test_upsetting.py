@@ -55,7 +55,7 @@ def test_friction_barrels_the_billet_against_the_slab_estimate(demo):
     assert d["status_iterations"] > len(d["force_history"])
 
 
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_two_ranks_give_the_serial_answer(demo):
     s, p = demo.json("upsetting.py"), demo.json("upsetting.py", ranks=2)
     assert p["ranks"] == 2

@@ -81,7 +81,7 @@ def test_beyond_the_limit_load_is_one_line(demo):
 
 
 @pytest.mark.parametrize("ranks", [2])
-@pytest.mark.spawns_mpi
+@pytest.mark.mpi
 def test_two_ranks_give_the_serial_answer(demo, ranks):
     args = ("--pressure-ratio", "0.8", "--unload", "--steps", "5")  # as the serial suite's
     s, p = demo.json("pressure_vessel.py", *args), demo.json("pressure_vessel.py", *args,
