@@ -61,6 +61,12 @@ from notebooks import source_digest  # noqa: E402
 SOURCE_DIGEST = source_digest()
 
 
+def _python(name: str) -> list[str]:
+    """The command that runs demos/`name` ("-m fenics_nl": the case-file command)."""
+    return [sys.executable, *(["-m", "fenics_nl"] if name == "-m fenics_nl"
+                              else [str(DEMOS / name)])]
+
+
 class Demos:
     """Runs demos/<name> as a user does, in `tmp_path`.
 
@@ -134,8 +140,7 @@ class Demos:
         # (pytest-xdist) serial suite, alone; MPICH's busy-waiting ranks crawl when
         # oversubscribed
         assert self.spawns_mpi, "a test that runs mpiexec must be marked spawns_mpi"
-        script = ["-m", "fenics_nl"] if name == "-m fenics_nl" else [str(DEMOS / name)]
-        cmd = [str(MPIEXEC), "-n", str(ranks), sys.executable, *script, *argv]
+        cmd = [str(MPIEXEC), "-n", str(ranks), *_python(name), *argv]
         env = dict(os.environ)
         if ranks > (os.cpu_count() or 1):
             # more ranks than cores: MPICH's progress engine then polls less often, which
@@ -149,9 +154,8 @@ class Demos:
         # core the serial run needs
         proc = None
         if self.world.rank == 0:
-            script = ["-m", "fenics_nl"] if name == "-m fenics_nl" else [str(DEMOS / name)]
             env = {k: v for k, v in os.environ.items() if not k.startswith(LAUNCHER_VARIABLES)}
-            proc = subprocess.run([sys.executable, *script, *argv], cwd=self.tmp_path,
+            proc = subprocess.run([*_python(name), *argv], cwd=self.tmp_path,
                                   capture_output=True, text=True, timeout=900, env=env)
         done = self.world.Ibarrier()
         while not done.Test():
@@ -182,20 +186,18 @@ class Demos:
             result = self._cached_on_rank_0(cache_key)
             if result is None:
                 result = self._run_json(name, args, ranks)
-                if self.world.rank == 0:
-                    (CACHE / cache_key).parent.mkdir(parents=True, exist_ok=True)
-                    (CACHE / cache_key).write_text(json.dumps(result, indent=2, sort_keys=True))
-            _serial_references[key] = copy.deepcopy(result)
-            return result
-        # the other xdist worker may be making this very run: wait for it rather than
-        # make it twice (a lock per run, held while it is made)
-        lock = self.cache.mkdir("fenics_nl_locks") / hashlib.sha1(cache_key.encode()).hexdigest()
-        with open(lock, "w") as held:
-            fcntl.flock(held, fcntl.LOCK_EX)
-            result = self.cache.get(cache_key, None)
-            if result is None:
-                result = self._run_json(name, args, ranks)
-                self.cache.set(cache_key, result)
+                self._cache_on_rank_0(cache_key, result)
+        else:
+            # the other xdist worker may be making this very run: wait for it rather than
+            # make it twice (a lock per run, held while it is made)
+            lock = self.cache.mkdir("fenics_nl_locks") / hashlib.sha1(
+                cache_key.encode()).hexdigest()
+            with open(lock, "w") as held:
+                fcntl.flock(held, fcntl.LOCK_EX)
+                result = self.cache.get(cache_key, None)
+                if result is None:
+                    result = self._run_json(name, args, ranks)
+                    self.cache.set(cache_key, result)
         _serial_references[key] = copy.deepcopy(result)
         return result
 
@@ -203,6 +205,12 @@ class Demos:
         path = CACHE / cache_key
         found = json.loads(path.read_text()) if self.world.rank == 0 and path.is_file() else None
         return self.world.bcast(found)
+
+    def _cache_on_rank_0(self, cache_key, result):
+        # as pytest's cache.set writes it, so that the serial suite finds it too
+        if self.world.rank == 0:
+            (CACHE / cache_key).parent.mkdir(parents=True, exist_ok=True)
+            (CACHE / cache_key).write_text(json.dumps(result, indent=2, sort_keys=True))
 
     def _run_json(self, name, args, ranks) -> dict:
         # rank 0 writes the JSON: every rank names its file and reads it from rank 0
