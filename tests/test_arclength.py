@@ -148,3 +148,20 @@ def test_the_beam_path_on_two_ranks_is_the_serial_one():
     assert pp.critical_points[0].between == pytest.approx(ps.critical_points[0].between,
                                                           rel=1e-8)
     assert abs(tp["rotation"]) == pytest.approx(abs(ts["rotation"]), rel=1e-6)
+
+
+def test_a_residual_that_falls_onto_its_round_off_is_accepted_one_iteration_later():
+    from fenics_nl.solvers.arclength import _at_round_off
+
+    # the arch with 8 elements through its thickness (demos/snap_through.py --elements 8),
+    # one step's |R|: full Newton reaches the internal forces' round-off (2e-13) in two
+    # iterations, just above the tolerance 1e-8 |q|; before, 4 more iterations confirmed it
+    # and the adaptive arc shrank on them until the path stalled (300 steps short of λ)
+    largest, threshold = 1.6e-5, 1.1e-13
+    falls = [1.6e-05, 1.3e-10, 2.1e-13]
+    assert not _at_round_off(falls, largest, threshold)  # still falling fast
+    assert _at_round_off([*falls, 2.1e-13], largest, threshold)
+    # a fall onto a level far above the tolerance is not round-off, nor a slow linear rate
+    # (that takes the 5 iterates of the modified variants' test)
+    assert not _at_round_off([1.6e-5, 1.3e-8, 1.2e-8], largest, threshold)
+    assert not _at_round_off([1e-11, 5e-12, 3e-12], largest, threshold)

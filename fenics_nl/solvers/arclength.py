@@ -85,12 +85,19 @@ def _at_round_off(norms: list[float], largest: float, threshold: float) -> bool:
 
     A slender body's internal forces are far larger than its load (membrane forces), and
     near a critical point K is nearly singular and amplifies the round-off of each
-    correction: the residual then stops falling just above a tolerance on the load. "Stopped":
-    the last 5 within a factor 3 and the last not below half the one 4 iterations earlier
-    (a steady linear rate, even 0.85, halves it in 4 iterations).
+    correction: the residual then stops falling just above a tolerance on the load; the
+    finer the mesh, the higher that floor. "Stopped": either a fall of 100x or more onto a
+    residual that the next iteration does not halve (Newton in its quadratic phase meets the
+    floor: one iteration confirms it), or the last 5 within a factor 3 and the last not below
+    half the one 4 iterations earlier (a steady linear rate, even 0.85, halves it in 4
+    iterations: the modified and quasi-Newton variants).
     """
+    low = min(1e-6 * largest, 1e4 * threshold)
+    if (len(norms) >= 3 and norms[-2] <= 1e-2 * norms[-3] and norms[-1] > 0.5 * norms[-2]
+            and max(norms[-2:]) < low):
+        return True
     last = norms[-5:]
-    return (len(last) == 5 and max(last) < min(1e-6 * largest, 1e4 * threshold)
+    return (len(last) == 5 and max(last) < low
             and max(last) < 3 * min(last) and last[-1] > 0.5 * last[0])
 
 
