@@ -11,7 +11,8 @@ time, and time in linear solves of the same mesh (`--material linear`, CG + GAMG
 direct solver's (MUMPS) within Newton's tolerance.
 
 Arc-length is not here: past a limit point its tangent is indefinite, where CG breaks down
-(the snap-through and the beam run on MUMPS).
+(the snap-through and the beam run on MUMPS; benchmarks/arch_iterative.py measures GMRES +
+GAMG on the arch).
 
     python benchmarks/iterative.py [--quick] [--update-docs] [--large] [--only NAME...]
 

@@ -131,3 +131,30 @@ def test_on_two_ranks_the_tangent_is_petscs_own():
     reference.axpy(-1.0, matrix.mat, PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
     assert reference.norm() == 0.0
     assert (matrix.mat.getType() == "seqaij") == (MPI.COMM_WORLD.size == 1)
+
+
+def test_gamg_on_an_indefinite_tangent_is_right_preconditioned_gmres_and_solves_it():
+    # a tangent past a limit point: K shifted between its two lowest eigenvalues (one
+    # negative direction), where CG stops at once (KSP_DIVERGED_INDEFINITE_PC, residual 1.8)
+    from dolfinx import fem
+    from dolfinx.fem import petsc
+
+    from fenics_nl.solvers.linear_solver import rigid_body_modes
+
+    a, bc, _ = _elasticity_with_a_support(MPI.COMM_SELF)
+    A = petsc.assemble_matrix(fem.form(a), bcs=[bc])
+    A.assemble()
+    lowest = np.linalg.eigvalsh(A.copy().convert("dense").getDenseArray())[:2]
+    A.shift(-lowest.mean())
+    V = a.arguments()[0].ufl_function_space()
+    ksp = create_ksp(A, "gamg", prefix="indef_", near_nullspace=rigid_body_modes(V),
+                     rtol=1e-10, indefinite=True)
+    assert ksp.getType() == "gmres" and ksp.getPCSide() == PETSc.PC.Side.RIGHT
+    b, x = A.createVecs()
+    b.setRandom()
+    ksp.solve(b, x)
+    assert ksp.getConvergedReason() > 0
+    r = b.duplicate()
+    A.mult(x, r)
+    r.axpy(-1.0, b)
+    assert r.norm() < 1e-9 * b.norm()  # the true residual: right preconditioning's norm

@@ -48,7 +48,8 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     `indefinite` A (a saddle point) takes GMRES instead, preconditioned on the right so
     that it stops on the true residual: CG's energy norm does not exist there, and
     P⁻¹A = I + (a term of the rank of the changed rows and springs) converges in about as
-    many iterations either way.
+    many iterations either way. With GAMG an `indefinite` A (a tangent past a limit point)
+    takes GMRES too, restarted every 200 iterations: CG diverges on it.
     PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
     command line can override every choice made here.
     """
@@ -77,9 +78,14 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         if near_nullspace is None:
             raise ValueError("the gamg solver needs the rigid-body near-nullspace")
         A.setNearNullSpace(near_nullspace)
-        ksp.setType("cg")
         # the true residual ‖A x − b‖ is what an inexact Newton step needs to control
-        ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
+        if indefinite:
+            ksp.setType("gmres")
+            ksp.setGMRESRestart(200)
+            ksp.setPCSide(PETSc.PC.Side.RIGHT)
+        else:
+            ksp.setType("cg")
+            ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
         pc.setType("gamg")
     ksp.setFromOptions()

@@ -396,6 +396,9 @@ class NewtonSolver:
             ``-{prefix}lag_preconditioner false`` on the command line: one per tangent.
         saddle_point: the tangent is indefinite (a displacement–pressure unknown): a reused
             factorization preconditions GMRES, not CG.
+        indefinite: the tangent may be indefinite (a path past a limit point, in
+            arc-length): with ``gamg`` too, GMRES (right-preconditioned) instead of CG, which
+            diverges there.
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
         prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
@@ -436,6 +439,7 @@ class NewtonSolver:
         reuse_factorization: bool = False,
         lag_preconditioner: bool = True,
         saddle_point: bool = False,
+        indefinite: bool = False,
         preconditioner: ufl.Form | None = None,
         prefix: str = "newton_",
     ):
@@ -504,7 +508,7 @@ class NewtonSolver:
             nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
             self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                                   P=self.A if reuse else None, rtol=1e-12,
-                                  indefinite=saddle_point)
+                                  indefinite=saddle_point or indefinite)
         # the block preconditioner is built from its own matrix: always set up again
         self._factorizations = None if self._M is not None or reuse else Factorizations(
             self.A, self.ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
@@ -598,9 +602,7 @@ class NewtonSolver:
                                        result(False, "diverged"))
             try:
                 self.update_tangent(k, work)
-                if self.forcing:  # a frozen operator's own error is ~ its contraction
-                    frozen = self.method in ("modified", "bfgs")
-                    self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else rnorm / norms[0]))
+                self.set_forcing(rnorm / norms[0])
                 b_old = self.b.copy() if self.bfgs else None
                 self.solve_linear(self.b, self.du, work)
             except LinearSolveError as err:
@@ -664,6 +666,16 @@ class NewtonSolver:
             return False
         self._assemble_tangent(work)
         return True
+
+    def set_forcing(self, relative_residual: float) -> None:
+        """Inexact Newton (CG or GMRES + GAMG): the next corrections' relative tolerance.
+
+        From ‖R_k‖/‖R_0‖ (`forcing_term`); a frozen operator's (modified, BFGS) from 1: its
+        own error is about its contraction, a tighter solve buys nothing.
+        """
+        if self.forcing:
+            frozen = self.method in ("modified", "bfgs")
+            self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else relative_residual))
 
     def solve_linear(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
         """out = K⁻¹ rhs with the current operator (BFGS: its corrected inverse H rhs).
