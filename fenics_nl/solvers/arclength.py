@@ -405,7 +405,7 @@ class ArcLength:
             tangent.copy(dq)  # the corrector's first iteration builds its own tangent
         else:
             s.update_tangent(0, work)
-            s.set_forcing(1.0)  # an iterative solver's: a predictor needs a direction
+            s.set_forcing(1.0, 1.0)  # an iterative solver's: a predictor needs a direction
             s.solve_linear(q, dq, work)
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)
@@ -475,7 +475,7 @@ class ArcLength:
                 if k == s.max_it:
                     raise _StepFailed(f"no convergence in {s.max_it} iterations "
                                       f"(|R| = {rnorm:.3e})")
-                s.set_forcing(rnorm / norms[0])  # an iterative solver's tolerance
+                s.set_forcing(rnorm, norms[0])  # an iterative solver's tolerance
                 if s.update_tangent(k, work):
                     if c.ds is not None:
                         s.solve_linear(c.q, c.dq, work)

@@ -602,7 +602,7 @@ class NewtonSolver:
                                        result(False, "diverged"))
             try:
                 self.update_tangent(k, work)
-                self.set_forcing(rnorm / norms[0])
+                self.set_forcing(rnorm, norms[0])
                 b_old = self.b.copy() if self.bfgs else None
                 self.solve_linear(self.b, self.du, work)
             except LinearSolveError as err:
@@ -667,15 +667,15 @@ class NewtonSolver:
         self._assemble_tangent(work)
         return True
 
-    def set_forcing(self, relative_residual: float) -> None:
+    def set_forcing(self, rnorm: float, first: float) -> None:
         """Inexact Newton (CG or GMRES + GAMG): the next corrections' relative tolerance.
 
-        From ‖R_k‖/‖R_0‖ (`forcing_term`); a frozen operator's (modified, BFGS) from 1: its
-        own error is about its contraction, a tighter solve buys nothing.
+        From ‖R_k‖/‖R_0‖ = rnorm/first (`forcing_term`); a frozen operator's (modified,
+        BFGS) from 1: its own error is about its contraction, a tighter solve buys nothing.
         """
         if self.forcing:
-            frozen = self.method in ("modified", "bfgs")
-            self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else relative_residual))
+            frozen = self.method in ("modified", "bfgs") or not first
+            self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else rnorm / first))
 
     def solve_linear(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
         """out = K⁻¹ rhs with the current operator (BFGS: its corrected inverse H rhs).
