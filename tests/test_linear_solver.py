@@ -144,7 +144,9 @@ def test_gamg_on_an_indefinite_tangent_is_right_preconditioned_gmres_and_solves_
     a, bc, _ = _elasticity_with_a_support(MPI.COMM_SELF)
     A = petsc.assemble_matrix(fem.form(a), bcs=[bc])
     A.assemble()
-    lowest = np.linalg.eigvalsh(A.copy().convert("dense").getDenseArray())[:2]
+    dense = A.copy().convert("dense")
+    lowest = np.linalg.eigvalsh(dense.getDenseArray())[:2]
+    dense.destroy()
     A.shift(-lowest.mean())
     V = a.arguments()[0].ufl_function_space()
     ksp = create_ksp(A, "gamg", prefix="indef_", near_nullspace=rigid_body_modes(V),
@@ -154,6 +156,7 @@ def test_gamg_on_an_indefinite_tangent_is_right_preconditioned_gmres_and_solves_
     b.setRandom()
     ksp.solve(b, x)
     assert ksp.getConvergedReason() > 0
+    assert ksp.getIterationNumber() < 60  # 32 with GAMG; GMRES unpreconditioned takes 177
     r = b.duplicate()
     A.mult(x, r)
     r.axpy(-1.0, b)

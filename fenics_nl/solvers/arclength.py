@@ -58,9 +58,12 @@ log = logging.getLogger(__name__)
 # diagonal entry count as positive: near a bifurcation point round-off puts them on either
 # side, and the inertia would flicker. A critical point is then found later by Δλ/λ ≈
 # margin · max diag K / μ₀ (μ₀: the critical mode's eigenvalue at rest). A thin body's
-# bending μ₀ falls with the mesh size (the arch's μ₀/max diag ~1e-11 at 106k unknowns): at
-# 1e-12 its limit loads came out 4.7 % and 10 % late, at 1e-14 1.2 % and 2.4 % (the mesh's
-# own error); 1e-14 is ~50 ε, still above an LDLᵀ's backward error on its eigenvalues
+# bending μ₀ falls with the mesh size (the arch's μ₀ ~1e-11 max diag at 106k unknowns): at
+# 1e-12 its limit loads were 4.7 % low and 10 % high, at 1e-14 (Δλ/λ ~0.1 %) −1.2 % and
+# +2.4 % (the continuum's gap to the closed form grows the same way at 27k). Round-off on
+# an LDLᵀ's eigenvalues is c·ε·‖K‖ with c unmeasured here: 1e-14 is ~45 ε, and the beam's
+# bifurcation and the arch's tests showed no flicker at it; the window between the two
+# closes on still finer thin meshes (a margin scaled to μ₀ would be the cure)
 INERTIA_MARGIN = 1e-14
 # the iterations a step should take, per variant: fewer and the arc grows, more and it shrinks
 DESIRED_ITERATIONS = {"full": 5, "periodic": 8, "bfgs": 12, "modified": 20}
