@@ -60,11 +60,11 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     ksp.setOperators(A, P if P is not None else A)
     pc = ksp.getPC()
     if kind in ("lu", "cholesky") and P is not None:
-        ksp.setType("gmres" if indefinite else "cg")
+        if indefinite:  # no restart within max_it
+            _true_residual_gmres(ksp, restart=50)
+        else:
+            ksp.setType("cg")
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=50)
-        if indefinite:  # no restart within max_it; ‖A x − b‖ is what Newton needs
-            ksp.setGMRESRestart(50)
-            ksp.setPCSide(PETSc.PC.Side.RIGHT)
         pc.setType(kind)
         pc.setFactorSolverType("mumps")
     elif kind in ("lu", "cholesky"):
@@ -78,12 +78,9 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         if near_nullspace is None:
             raise ValueError("the gamg solver needs the rigid-body near-nullspace")
         A.setNearNullSpace(near_nullspace)
-        # the true residual ‖A x − b‖ is what an inexact Newton step needs to control
         if indefinite:
-            ksp.setType("gmres")
-            ksp.setGMRESRestart(200)
-            ksp.setPCSide(PETSc.PC.Side.RIGHT)
-        else:
+            _true_residual_gmres(ksp, restart=200)
+        else:  # the true residual ‖A x − b‖ is what an inexact Newton step controls
             ksp.setType("cg")
             ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
@@ -91,6 +88,13 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     ksp.setFromOptions()
     _keep_mumps(ksp, A, prefix)
     return ksp
+
+
+def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
+    """GMRES preconditioned on the right: it stops on ‖A x − b‖, what Newton needs."""
+    ksp.setType("gmres")
+    ksp.setGMRESRestart(restart)
+    ksp.setPCSide(PETSc.PC.Side.RIGHT)
 
 
 def _keep_mumps(ksp: PETSc.KSP, A: PETSc.Mat, prefix: str) -> None:
