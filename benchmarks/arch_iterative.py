@@ -15,7 +15,7 @@ through its thickness (4, 8, 16 elements, aspect 4: 7k, 27k, 106k unknowns):
 
     python benchmarks/arch_iterative.py [--quick] [--update-docs]
 
-About 2 min on 1 core; --quick: 4 elements only, 8 steps, nothing written.
+About 70 s on 1 core; --quick: 4 elements only, 8 steps, nothing written.
 """
 
 import dataclasses

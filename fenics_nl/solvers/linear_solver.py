@@ -1,8 +1,8 @@
 """PETSc KSP set-ups for the tangent systems: MUMPS LU/Cholesky, or CG + GAMG.
 
-hypre is not in this PETSc build, so the iterative option is CG preconditioned by smoothed
-aggregation (GAMG) with the rigid-body modes as near-nullspace: without them GAMG's
-coarse spaces miss rotations and CG stalls on elasticity.
+hypre is not in this PETSc build, so the iterative option is CG (GMRES on an indefinite
+tangent) preconditioned by smoothed aggregation (GAMG) with the rigid-body modes as
+near-nullspace: without them GAMG's coarse spaces miss rotations and CG stalls on elasticity.
 """
 
 from __future__ import annotations
