@@ -217,7 +217,7 @@ def main():
 def table(s) -> str:
     rich = s["richardson"]
     lines = ["| unknowns | variant | time (s) | / linear solve | iterations | s / iteration | "
-             "factorizations | peak memory (MB) | |u_load| (mm) | error |",
+             "factorizations | peak memory (MB) | \\|u_load\\| (mm) | error |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for row in s["refinement"]:
         lin = row["linear"]

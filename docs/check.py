@@ -33,7 +33,7 @@ def browser_path() -> str:
 
 
 # in the page: what did not load, and where every link inside the site points
-PAGE_STATE = """() => ({
+PAGE_STATE = r"""() => ({
   broken_images: Array.from(document.images)
       .filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src),
   math: document.querySelectorAll('div.math, span.math').length,
@@ -51,6 +51,11 @@ PAGE_STATE = """() => ({
     }
     return found;
   })(),
+  // a Markdown table that did not parse (a cell's unescaped "|" shifts its columns) is a
+  // paragraph of pipes (its |---| row typeset as dashes)
+  stray_tables: Array.from((document.querySelector('article') || document.body)
+      .querySelectorAll('p')).map(p => p.textContent.trim())
+      .filter(t => t.startsWith('|') && /\|\s*(---|—)/.test(t)).map(t => t.slice(0, 60)),
   links: Array.from(document.querySelectorAll('a[href]')).map(a => a.href)
       .filter(h => h.startsWith('file:')),
   ids: Array.from(document.querySelectorAll('[id]')).map(e => e.id),
@@ -78,6 +83,7 @@ def check_page(page, path: Path) -> tuple[list[str], dict]:
         problems.append(f"{state['math'] - state['typeset']} of {state['math']} formulas not "
                         "typeset (MathJax)")
     problems += [f"a formula left as text: {t!r}" for t in state["stray_dollars"]]
+    problems += [f"a table left as text: {t!r}" for t in state["stray_tables"]]
     if state["math_errors"]:
         problems.append(f"{state['math_errors']} formulas MathJax could not read")
     return problems, state
