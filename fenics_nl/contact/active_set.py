@@ -89,7 +89,7 @@ class EliminationSystem:
         """
         small = changes is not None and changes <= self.small_change
         self.newton.set_bcs([*self.bcs, self.surface.dirichlet(active), *extra_bcs],
-                            small_change=small)
+                            small_change=small, new_path=changes is None)
 
     def solve(self) -> SolveResult:
         """Newton on the current set."""

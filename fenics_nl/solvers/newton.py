@@ -56,6 +56,7 @@ from fenics_nl.solvers.linear_solver import (
 )
 from fenics_nl.solvers.nodal import NodalTerms
 from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.row_update import RowUpdate
 from fenics_nl.solvers.supports import RigidMotions, check_supports
 
 __all__ = [
@@ -489,6 +490,9 @@ class NewtonSolver:
         # reuse: the factorized matrix P lags behind A and preconditions CG on A
         reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
         self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
+        # with reuse and a linear material: new Dirichlet rows solved on the last
+        # factorization, by a bordered solve on the rows that changed (made with K)
+        self._rows: RowUpdate | None = None
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
         # point forces and nodal springs (friction, a truss's apex load): the one hook for
@@ -549,12 +553,18 @@ class NewtonSolver:
         """Global number of scalar unknowns."""
         return output.dofs(self.u.function_space)
 
-    def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False) -> None:
+    def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False,
+                new_path: bool = False) -> None:
         """Replace the Dirichlet conditions (their rows change, so the tangent is stale).
 
         `small_change`: only a few rows differ from the last factorized tangent, so with
         `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
+        `new_path`: a change of unknown size (a load step's start): a linear material's
+        tangent is factorized afresh rather than updated (`solvers.row_update`), as a run
+        restarted there would: both then take the same path, work counts included.
         """
+        if new_path and self._rows is not None:
+            self._rows.factor = None
         # a small change of no row at all (an active set that settled, new values on the
         # same rows): the same matrix, nothing to rebuild. (A change of unknown size, as
         # at a load step's start, refactorizes as before: a restart, which has no
@@ -779,7 +789,15 @@ class NewtonSolver:
             # a free rigid motion makes K singular: refused before any factorization
             check_supports(self.A, self.motions, self.bcs)
             self._supports_checked = True
-        if self.policy.needs_factorization():
+        if self._rows is not None:
+            self._rows.serving = False
+        if self._rows is not None and self.nodal.springs is None:
+            # a linear material's new rows: on the last factorization while that pays
+            with _Timer(work, "solve"):  # its columns are back-solves
+                serves = self._rows.set_rows(_constrained_rows(self.bcs), work)
+            if not serves:
+                self._factorize(work)
+        elif self.policy.needs_factorization():
             self._factorize(work)
         else:  # an older tangent's factorization (reuse) or AMG hierarchy (lag) serves
             if self.policy.lag:
@@ -793,6 +811,8 @@ class NewtonSolver:
             self._matrix.assemble(self._K)
             work.tangent_assemblies += 1
             self._K_fixed = self.A.copy()
+            if self.policy.reuse:
+                self._rows = RowUpdate(self._K_fixed)
         else:
             self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         rows = _constrained_rows(self.bcs)
@@ -816,9 +836,23 @@ class NewtonSolver:
                 self.ksp.getPC().setUp()
                 work.factorizations += 1
         self.policy.factorized()
+        if self._rows is not None:  # the next rows are solved on this factorization
+            pc = self.ksp.getPC()
+            if pc.getFactorSolverType() != "mumps":  # (the options chose another package)
+                self._rows = None
+            elif self.nodal.springs is None:
+                self._rows.rebase(pc.getFactorMatrix(), _constrained_rows(self.bcs))
+            else:  # its K would miss the springs
+                self._rows.factor = None
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
         """du = K⁻¹ rhs (the Newton correction is −du)."""
+        if self._rows is not None and self._rows.serving and self._rows.size:
+            # (the base's own rows go through the KSP: its options, -ksp_view, apply)
+            with _Timer(work, "solve"):
+                self._rows.solve(rhs, self.du)
+                work.linear_solves += 1
+            return
         ksp = self._factorizations.ksp if self._factorizations else self.ksp
         with _Timer(work, "solve"):
             ksp.solve(rhs, self.du)

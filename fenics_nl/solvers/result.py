@@ -21,6 +21,7 @@ class WorkCounts:
     factorizations: int = 0
     linear_solves: int = 0
     krylov_iterations: int = 0  # CG iterations (GAMG, or a reused factorization), else 0
+    update_columns: int = 0  # back-solves of new Dirichlet rows on an old factorization
     time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
 
     def add(self, other: WorkCounts) -> None:
@@ -30,6 +31,7 @@ class WorkCounts:
         self.factorizations += other.factorizations
         self.linear_solves += other.linear_solves
         self.krylov_iterations += other.krylov_iterations
+        self.update_columns += other.update_columns
         for k, v in other.time.items():
             self.time[k] = self.time.get(k, 0.0) + v
 

@@ -1,0 +1,101 @@
+"""New Dirichlet rows solved on an old factorization (`solvers.row_update`)."""
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from dolfinx.fem import petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from fenics_nl.solvers.result import WorkCounts
+from fenics_nl.solvers.row_update import RowUpdate
+
+
+def elastic_square(comm, n=12):
+    """K of a plane elastic square; its bottom's rows, and its top's vertical rows by x."""
+    domain = mesh.create_unit_square(comm, n, n)
+    V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
+    a = fem.form((2 * ufl.inner(eps(u), eps(v)) + ufl.div(u) * ufl.div(v)) * ufl.dx)
+    fdim = domain.topology.dim - 1
+    bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0))
+    top = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 1))
+    bottom_dofs = fem.locate_dofs_topological(V, fdim, bottom)
+    top_dofs = fem.locate_dofs_topological(V.sub(1), fdim, top)
+    x_top = V.tabulate_dof_coordinates()[top_dofs // 2, 0]
+    zero = np.zeros(2, dtype=PETSc.ScalarType)
+    supports = fem.dirichletbc(zero, bottom_dofs, V)
+
+    def rows(where):
+        """Dirichlet conditions: the bottom, and the top's vertical rows where x is in it."""
+        top_bc = fem.dirichletbc(PETSc.ScalarType(0), top_dofs[where(x_top)], V.sub(1))
+        bcs = [supports, top_bc]
+        owned = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in bcs]
+        return bcs, np.unique(np.concatenate(owned))
+
+    K = petsc.assemble_matrix(a)
+    K.assemble()
+    return a, K, rows
+
+
+def factorized(a, bcs):
+    M = petsc.assemble_matrix(a, bcs=bcs)
+    M.assemble()
+    ksp = PETSc.KSP().create(M.comm)
+    ksp.setOperators(M)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.setUp()
+    return M, ksp
+
+
+def check_rows_added_and_released(comm):
+    a, K, rows = elastic_square(comm)
+    base_bcs, base_rows = rows(lambda x: x < 0.55)
+    new_bcs, new_rows = rows(lambda x: x > 0.3)  # adds x > 0.55, releases x < 0.3
+    _, base = factorized(a, base_bcs)
+    update = RowUpdate(K)
+    update.rebase(base.getPC().getFactorMatrix(), base_rows)
+    work = WorkCounts()
+    assert update.set_rows(new_rows, work)
+    changed = comm.allreduce(len(np.setxor1d(base_rows, new_rows)))
+    assert work.update_columns == changed > 0 and changed <= update.budget
+    M_new, direct = factorized(a, new_bcs)
+    r, x, x_ref = (M_new.createVecRight() for _ in range(3))
+    r.array[:] = np.random.default_rng(comm.rank).standard_normal(r.getLocalSize())
+    update.solve(r, x)
+    direct.solve(r, x_ref)
+    # the bordered solve is exact: round-off of two MUMPS solves and a dense one
+    assert (x - x_ref).norm() <= 1e-11 * x_ref.norm()
+    # and back to the base's rows: no change, no column, the base's own solve
+    assert update.set_rows(base_rows, work) and update.size == 0
+    update.solve(r, x)
+    base.solve(r, x_ref)
+    assert (x - x_ref).norm() <= 1e-13 * x_ref.norm()
+
+
+def test_rows_added_and_released_solve_as_a_new_factorization():
+    check_rows_added_and_released(MPI.COMM_SELF)
+
+
+@pytest.mark.mpi
+def test_rows_added_and_released_in_parallel():
+    assert MPI.COMM_WORLD.size > 1  # the columns and the capacitance system span ranks
+    check_rows_added_and_released(MPI.COMM_WORLD)
+
+
+def test_columns_costing_more_than_a_factorization_are_declined():
+    a, K, rows = elastic_square(MPI.COMM_SELF, n=40)
+    base_bcs, base_rows = rows(lambda x: x < 0.1)
+    _, base = factorized(a, base_bcs)
+    update = RowUpdate(K)
+    update.rebase(base.getPC().getFactorMatrix(), base_rows)
+    work = WorkCounts()
+    # 36 new rows, more than the columns its flops pay for (29 here, counted by MUMPS):
+    # declined before any is made; the caller then factorizes (and rebases)
+    assert 0 < update.budget < 36
+    assert not update.set_rows(rows(lambda x: x >= 0)[1], work)
+    assert not update.serving and work.update_columns == 0
