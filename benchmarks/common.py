@@ -92,6 +92,8 @@ def save_figure(fig, path: Path) -> None:
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
     plain = FuncFormatter(lambda v, _: f"{v:g}")
+    # between decades only 2 and 5 (0.6, 0.7, 0.8, 0.9 ran together on the contact plot)
+    two_five = FuncFormatter(lambda v, _: f"{v:g}" if _mantissa(v) in (2, 5) else "")
     for ax in fig.axes:
         for axis, scale, (lo, hi) in ((ax.xaxis, ax.get_xscale(), ax.get_xlim()),
                                       (ax.yaxis, ax.get_yscale(), ax.get_ylim())):
@@ -99,12 +101,19 @@ def save_figure(fig, path: Path) -> None:
                 continue
             if math.log10(hi / lo) <= 1.5:
                 axis.set_major_formatter(plain)
-                axis.set_minor_formatter(plain)
+                axis.set_minor_formatter(two_five)
             else:
                 axis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     print(f"wrote {path}", flush=True)
+
+
+def _mantissa(v: float) -> int:
+    """The leading digit of v > 0 (2 for 0.2, 20, 2e-3)."""
+    import math
+
+    return round(v / 10 ** math.floor(math.log10(v) + 1e-9))
 
 
 def timed_linear_solve(a, L, bcs, kind: str, prefix: str, x=None) -> float:

@@ -75,6 +75,9 @@ class RowUpdate:
         self.base[rows] = True
         self.budget = columns_per_factorization(factor)
         self.column_of: dict[int, int] = {}  # global row -> its column
+        for M in getattr(self, "_mats", ()):
+            M.destroy()
+        self._mats: list[PETSc.Mat] = []  # the dense X and K X, which the blocks view
         self._blocks: list[tuple[int, np.ndarray, np.ndarray]] = []  # (first, X, K X)
         self._set(rows, [], [])
 
@@ -206,12 +209,13 @@ class RowUpdate:
             self.factor.matSolve(Bt, X)
         KX = self.K.matMult(X)
         first = len(self.column_of)
-        # column-major, as PETSc stores them: the solves pick whole columns
-        self._blocks.append((first, np.array(X.getDenseArray(), order="F"),
-                             np.array(KX.getDenseArray(), order="F")))
+        # PETSc's own storage (column-major), kept and viewed, not copied
+        self._mats += [X, KX]
+        self._blocks.append((first, X.getDenseArray(readonly=True),
+                             KX.getDenseArray(readonly=True)))
         for c, (g, _) in enumerate(rows):
             self.column_of[g] = first + c
-        for M in (E, B, Bt, X, KX):
+        for M in (E, B, Bt):
             M.destroy()
 
     def _pick(self, which: int, rows: np.ndarray) -> np.ndarray:
