@@ -408,7 +408,9 @@ class ArcLength:
             tangent.copy(dq)  # the corrector's first iteration builds its own tangent
         else:
             s.update_tangent(0, work)
-            s.set_forcing(1.0, 1.0)  # an iterative solver's: a predictor needs a direction
+            # an iterative solver's tolerance: a predictor needs a direction (1e-3), but
+            # the first one sets the arc's unit of displacement, as LU's would (1e-9)
+            s.set_forcing(1e-6 if self._scale is None else 1.0, 1.0)
             s.solve_linear(q, dq, work)
         if self._scale is None:  # u_ref = ‖K₀⁻¹q‖: the arc's unit of displacement
             self._scale = 1.0 / self._dot(dq, dq)

@@ -49,7 +49,9 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     that it stops on the true residual: CG's energy norm does not exist there, and
     P⁻¹A = I + (a term of the rank of the changed rows and springs) converges in about as
     many iterations either way. With GAMG an `indefinite` A (a tangent past a limit point)
-    takes GMRES too, restarted every 200 iterations: CG diverges on it.
+    takes GMRES too, restarted every 200 iterations: CG diverges on it. Its 200 Krylov
+    vectors cost 1.6 kB per unknown (1.6 GB at a million, shared by the ranks);
+    `-{prefix}ksp_gmres_restart` lowers it.
     PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
     command line can override every choice made here.
     """
