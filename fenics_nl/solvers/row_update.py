@@ -177,7 +177,9 @@ class RowUpdate:
 
         The right-hand sides go to MUMPS as a sparse matrix (transposed, as MatMatSolve
         takes it): its forward elimination then skips what they do not reach (1.7x faster
-        than dense ones on the axisymmetric punch, measured).
+        than dense ones on the axisymmetric punch, measured). On one rank only: on two,
+        MUMPS refuses distributed sparse ones (INFOG(1) = −27, PETSc 3.25), and gathered
+        on rank 0 they gave zero columns for released rows (measured): dense there.
         """
         m, comm = len(rows), self.comm
         sizes = ((self.n, PETSc.DETERMINE), (PETSc.DECIDE, m))
@@ -202,7 +204,7 @@ class RowUpdate:
         if comm.size == 1:
             Bt = B.transpose()
             self.factor.matSolve(PETSc.Mat().createTranspose(Bt), X)
-        else:  # MUMPS fails on a distributed sparse one (INFOG(1) = -27, PETSc 3.25)
+        else:
             Bt = PETSc.Mat().createDense(sizes, comm=comm)
             Bt.setUp()
             B.convert("dense", Bt)
