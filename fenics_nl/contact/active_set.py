@@ -62,9 +62,11 @@ class EliminationSystem:
     """One active-set iteration with the active normal displacements as Dirichlet rows.
 
     The contact forces are the residual's reactions on S_C. With
-    ``reuse_factorization`` (the default) an iteration that changes at most SMALL_CHANGE
-    nodes keeps the last factorization as a CG preconditioner: the new matrix differs by a
-    few rows and columns, so CG needs about two iterations per changed node.
+    ``reuse_factorization`` (the default), a linear material's iterations are solved on
+    the first one's factorization, the rows that changed as a bordered system
+    (`solvers.row_update`); a non-linear material's iteration that changes at most
+    SMALL_CHANGE nodes keeps the last factorization as a CG preconditioner: the new matrix
+    differs by a few rows and columns, so CG needs about two iterations per changed node.
     """
 
     SMALL_CHANGE = 8

@@ -360,6 +360,9 @@ class NewtonSolver:
     refactorized; CG on it is preconditioned by the last factorization, which is renewed
     only when CG needed more than REUSE_ITERATIONS iterations. Where the tangent changes by
     a low-rank term (a few constrained rows), CG converges in a handful of iterations.
+    A linear material's new Dirichlet rows (a contact's active set), however many, are
+    solved on the last factorization by a bordered solve on the rows that changed
+    (`solvers.row_update`) while its columns cost less than a factorization.
 
     The options, keyword-only, come in three groups, in this order below: the variant (which
     tangent, when it is rebuilt: `method` to `line_search`), convergence (`rtol` to
