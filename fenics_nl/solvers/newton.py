@@ -568,6 +568,7 @@ class NewtonSolver:
         """
         if new_path and self._rows is not None:
             self._rows.factor = None
+            self._rows.serving = False  # no solve on it before the next factorization
         # a small change of no row at all (an active set that settled, new values on the
         # same rows): the same matrix, nothing to rebuild. (A change of unknown size, as
         # at a load step's start, refactorizes as before: a restart, which has no
