@@ -5,19 +5,20 @@ rows (u_n = γ at the active nodes). The matrix of a row set B is M_B = P K P + 
 P zeroing B's rows and columns, so that M_B x = r means x_B = r_B and, on the free rows F,
 Σ_{j∈F} K_ij x_j = r_i. With M_b factorized for a base set B_b, a set B adds the rows J
 (free in the base) and releases the rows L (constrained in it). Write x = M_b⁻¹ y, with the
-base's right-hand side y = r on B ∩ B_b, y_L = v (the released rows' values), y_J = μ (a
-force on the added rows), and on the rows free in both r + K_{·,J} r_J − K_{·,L} v (the
-forces M_B puts there, less those M_b adds itself). Then
+base's right-hand side y = r on B ∩ B_b, y_L = v (the released rows' values), y_J free
+(μ: whatever else lands on the added rows is absorbed there), and on the rows free in both
+r + K_{·,J} r_J − K_{·,L} v (the forces M_B puts there, less those M_b adds itself). Then
 
     x = x₀ + Z μ + W v,   Z_j = M_b⁻¹ e_j,   W_l = M_b⁻¹ (e_l − P_b K e_l),
 
 and the |J| + |L| unknowns (μ, v) follow from x_J = r_J and the released rows' equilibrium
-(K x)_L = r_L + (K r_B)_L: the capacitance system, Woodbury's identity in bordered form.
+(K (x − r_B))_L = r_L (r_B: r on B, 0 elsewhere): the capacitance system, Woodbury's
+identity in bordered form.
 It is regular when M_B is: (μ, v) ↦ x is one-to-one.
 
 The columns Z_j, W_l are back-solves with the base's factors, made once per row (blocked,
 MUMPS's MatMatSolve, the right-hand sides sparse) and kept until the next factorization.
-A solve then costs one back-solve, three products with K and a dense solve of |J| + |L|
+A solve then costs one back-solve, two products with K and a dense solve of |J| + |L|
 unknowns. The columns stop paying when they would cost more than the factorization they
 stand for (`columns_per_factorization`): `set_rows` then declines, and the caller
 factorizes again (a new base).
@@ -112,14 +113,11 @@ class RowUpdate:
         w.array[:] = y
         self.factor.solve(w, x0)
         x = x0.array_r.copy()
-        # the conditions' right-hand sides: x_J = r_J and (K x)_L = r_L + (K r_B)_L
-        w.array[:] = np.where(self.now, r, 0.0)
-        KrB = self._times_K(w, Kw).copy()
-        w.array[:] = x
-        Kx = self._times_K(w, Kw)
+        # the conditions' right-hand sides: x_J = r_J and (K (x − r_B))_L = r_L
+        w.array[:] = x - np.where(self.now, r, 0.0)
+        K_free = self._times_K(w, Kw)
         rows_J, rows_L = self.added_local, self.released_local
-        local = np.concatenate([r[rows_J] - x[rows_J],
-                                r[rows_L] + KrB[rows_L] - Kx[rows_L]])
+        local = np.concatenate([r[rows_J] - x[rows_J], r[rows_L] - K_free[rows_L]])
         if self.size:
             parts = self.comm.allgather((local[: len(rows_J)], local[len(rows_J):]))
             b = np.concatenate([p[0] for p in parts] + [p[1] for p in parts])
