@@ -71,6 +71,9 @@ def test_formulations_agree_to_solver_precision():
     cm, rm = axisymmetric_punch("multiplier")
     # the elimination's later sets are solved on its first factorization (row_update)
     assert re.work.factorizations == 1 and re.work.update_columns > 0
+    # one assembly of R(u) per iterate: the contact forces and the next set's first residual
+    # are the last solve's (Te below is a new assembly, after the loop)
+    assert re.work.residual_assemblies == re.iterations + 1
     assert re.active_sizes == rm.active_sizes
     assert np.array_equal(ce.active, cm.active)
     Te, Tm = ce.normal_forces(), cm.normal_forces()

@@ -30,6 +30,7 @@ S_C whose vertices are all active (`active_facets`), ready to write out.
 from __future__ import annotations
 
 import collections
+import contextlib
 import logging
 import time
 from collections.abc import Callable, Sequence
@@ -104,6 +105,9 @@ class EliminationSystem:
         constraint puts on the body.
         """
         b = self._reaction
+        if self.newton.unconstrained_residual(b):  # the last solve's, at this u
+            with b.localForm() as loc:
+                return loc.array_r.copy()
         with b.localForm() as loc:
             loc.set(0.0)
         petsc.assemble_vector(b, self._R)
@@ -316,36 +320,40 @@ class ActiveSetContact:
         res = SolveResult(False, self.STATUSES, 0, [], WorkCounts())
         changes = None  # nodes that changed since the last solve (None: unknown, many)
         loose = _Loosened(self.newton, self.LOOSE_TOLERANCE)
-        try:
-            for k in range(1, self.max_iterations + 1):
-                self._set_conditions(changes)
-                nr = self._inner_solve(k, res)
-                update = self._update_statuses()
-                if update.settled and loose.on:  # this set solved fully, and checked again
-                    loose.off()  # (every later solve is full)
-                    nr = self._inner_solve(k, res, nr.iterations)
+        # between inner solves only the conditions change (Dirichlet rows, nodal terms):
+        # a solve's last assembly of R(u) gives the forces and starts the next solve
+        same_form = self.newton.same_residual_form() if self.newton else contextlib.nullcontext()
+        with same_form:
+            try:
+                for k in range(1, self.max_iterations + 1):
+                    self._set_conditions(changes)
+                    nr = self._inner_solve(k, res)
                     update = self._update_statuses()
-                changes = update.changes
-                res.active_set_iterations = k
-                res.active_sizes = [*res.active_sizes, self.surface.count(self.active)]
-                res.history.append({**update.record, "newton_iterations": nr.iterations})
-                log.info("%s iteration %d: %s, %d changes", self.STATUSES, k, update.summary,
-                         changes)
-                if update.settled:
-                    self.force = self.total_force(update.T_n)
-                    res.converged, res.reason = True, f"{self.STATUSES} fixed"
-                    res.wall_time = time.perf_counter() - t0
-                    return res
-                if changes:
-                    seen[update.state] += 1
-                    if seen[update.state] > self.REVISITS and loose.on:
-                        loose.off()  # loose solves may have led it round: full ones decide
-                        seen.clear()
-                    elif seen[update.state] > self.REVISITS:
-                        raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
-                                           f"{update.summary})", res)
-        finally:
-            loose.off()
+                    if update.settled and loose.on:  # this set solved fully, and checked again
+                        loose.off()  # (every later solve is full)
+                        nr = self._inner_solve(k, res, nr.iterations)
+                        update = self._update_statuses()
+                    changes = update.changes
+                    res.active_set_iterations = k
+                    res.active_sizes = [*res.active_sizes, self.surface.count(self.active)]
+                    res.history.append({**update.record, "newton_iterations": nr.iterations})
+                    log.info("%s iteration %d: %s, %d changes", self.STATUSES, k, update.summary,
+                             changes)
+                    if update.settled:
+                        self.force = self.total_force(update.T_n)
+                        res.converged, res.reason = True, f"{self.STATUSES} fixed"
+                        res.wall_time = time.perf_counter() - t0
+                        return res
+                    if changes:
+                        seen[update.state] += 1
+                        if seen[update.state] > self.REVISITS and loose.on:
+                            loose.off()  # loose solves may have led it round: full ones decide
+                            seen.clear()
+                        elif seen[update.state] > self.REVISITS:
+                            raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
+                                               f"{update.summary})", res)
+            finally:
+                loose.off()
         raise ContactError(f"{self.STATUSES} did not settle in {self.max_iterations} "
                            "iterations", res)
 

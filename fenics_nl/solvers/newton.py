@@ -30,6 +30,7 @@ numeric factorization only and reuse the symbolic analysis.
 from __future__ import annotations
 
 import collections
+import contextlib
 import hashlib
 import logging
 import math
@@ -498,6 +499,12 @@ class NewtonSolver:
         self._rows: RowUpdate | None = None
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
+        # R(u) as assembled (owned rows summed; no Dirichlet rows, lifting or nodal terms),
+        # and, within `same_residual_form`, the u it was assembled at (None: not kept)
+        self._R_raw = petsc.create_vector(V)
+        self._R_raw_at: np.ndarray | None = None
+        self._keep_R_raw = False
+        self._lifting: PETSc.Vec | None = None
         # point forces and nodal springs (friction, a truss's apex load): the one hook for
         # terms that no integral gives
         self.nodal = NodalTerms(V, V.mesh.comm)
@@ -647,17 +654,65 @@ class NewtonSolver:
         δU = −K⁻¹b moves the boundary to g and the interior with it.
         """
         with _Timer(work, "residual"):
-            with self.b.localForm() as loc:
-                loc.set(0.0)
-            petsc.assemble_vector(self.b, self._R)
+            if not self._R_raw_is_current():
+                with self._R_raw.localForm() as loc:
+                    loc.set(0.0)
+                petsc.assemble_vector(self._R_raw, self._R)
+                self._R_raw.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+                work.residual_assemblies += 1
+                if self._keep_R_raw:
+                    self._R_raw_at = self.u.x.array.copy()
+            self._R_raw.copy(self.b)
             x = self.u.x.petsc_vec
             if lift:
-                petsc.apply_lifting(self.b, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
-            self.b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+                self.b.axpy(1.0, self._lifting_vector(x))
             self.nodal.add_to_residual(self.u.x.array, self.b.array)
             petsc.set_bc(self.b, self.bcs, x0=x, alpha=-1.0)
-            work.residual_assemblies += 1
             return self._force_norm()
+
+    @contextlib.contextmanager
+    def same_residual_form(self):
+        """Within this block, R's form and everything it reads but u stay as they are.
+
+        Only the Dirichlet rows and the `nodal` terms may change (an active-set loop): an
+        R(u) assembled at the same u then serves again, for the next solve's first residual
+        and for `unconstrained_residual` (the contact forces), instead of a new assembly
+        (the axisymmetric punch: 3 assemblies an active-set iteration down to 1).
+        """
+        self._keep_R_raw = True
+        try:
+            yield
+        finally:
+            self._keep_R_raw, self._R_raw_at = False, None
+
+    def unconstrained_residual(self, out: PETSc.Vec) -> bool:
+        """Copy R(u) as assembled, ghosts updated, into `out` if it is current; whether it was.
+
+        Current within `same_residual_form` while u is where it was assembled; else the
+        caller assembles it (collective: every rank answers alike).
+        """
+        if not self._R_raw_is_current():
+            return False
+        self._R_raw.copy(out)
+        out.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+        return True
+
+    def _R_raw_is_current(self) -> bool:
+        """Whether the kept R(u) is at the current u on every rank."""
+        if not self._keep_R_raw:
+            return False
+        here = self._R_raw_at is not None and np.array_equal(self._R_raw_at, self.u.x.array)
+        return self.b.comm.tompi4py().allreduce(here, op=MPI.LAND)
+
+    def _lifting_vector(self, x: PETSc.Vec) -> PETSc.Vec:
+        """−K (u − g) on the Dirichlet columns, owned rows summed (the lifted step's share)."""
+        if self._lifting is None:
+            self._lifting = self.b.duplicate()
+        with self._lifting.localForm() as loc:
+            loc.set(0.0)
+        petsc.apply_lifting(self._lifting, [self._K_used], bcs=[self.bcs], x0=[x], alpha=-1.0)
+        self._lifting.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        return self._lifting
 
     @property
     def residual_vector(self) -> PETSc.Vec:
