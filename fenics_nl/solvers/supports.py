@@ -173,7 +173,8 @@ def free_motions(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirichle
                  ) -> list[str]:
     """The rigid motions that neither the Dirichlet rows of `bcs` nor `A` resist, named.
 
-    `A` is the tangent as assembled, with the Dirichlet rows set to the identity. Collective.
+    `A` is the tangent as assembled, with the Dirichlet rows set to the identity, or without
+    them (its Dirichlet rows are not read). Collective.
     """
     held = constrained_dofs(bcs)
     C = motions.unconstrained(held)
@@ -195,6 +196,7 @@ def free_motions(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirichle
         r.array[:] = T @ C[:, k]
         A.mult(r, Kr)
         KR[:, k] = Kr.array_r[: motions.n_owned]
+    KR[held] = 0.0  # A's identity rows or K's own: the motions vanish there either way
     for v in (diag, r, Kr):
         v.destroy()
     # the combinations of the candidates that K does not resist: ‖K r‖ ≤ tol max|K_ii| ‖r‖
