@@ -99,3 +99,18 @@ def test_columns_costing_more_than_a_factorization_are_declined():
     assert 0 < update.budget < 36
     assert not update.set_rows(rows(lambda x: x >= 0)[1], work)
     assert not update.serving and work.update_columns == 0
+
+
+def test_rows_that_leave_the_body_free_are_left_to_a_factorization():
+    a, K, rows = elastic_square(MPI.COMM_SELF)
+    base_bcs, base_rows = rows(lambda x: x < 0.55)
+    _, base = factorized(a, base_bcs)
+    update = RowUpdate(K)
+    update.rebase(base.getPC().getFactorMatrix(), base_rows)
+    update.budget = 10**6  # past the count of columns, to the capacitance system itself
+    # the bottom released, the top's vertical rows kept: free to slide along x, M_B is
+    # singular, so is the capacitance matrix: declined (its columns were made)
+    bottom_rows = rows(lambda x: x < 0)[1]
+    work = WorkCounts()
+    assert not update.set_rows(np.setdiff1d(base_rows, bottom_rows), work)
+    assert not update.serving and work.update_columns == len(bottom_rows)

@@ -26,6 +26,8 @@ factorizes again (a new base).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.linalg
 from mpi4py import MPI
@@ -59,6 +61,9 @@ class RowUpdate:
     """
 
     MAX_BYTES = 2**30  # kept columns (Z or W, and K times them) per rank
+    # the capacitance matrix's least reciprocal condition number (equilibrated rows): below,
+    # its solve would keep fewer than about 6 of the 16 digits
+    RCOND_MIN = 1e-10
 
     def __init__(self, K: PETSc.Mat):
         self.K = K
@@ -95,10 +100,9 @@ class RowUpdate:
         released = self._gather(np.flatnonzero(self.base & ~now))
         new = [(g, False) for g in added if g not in self.column_of]
         new += [(g, True) for g in released if g not in self.column_of]
-        if not self._make_columns(new, work):
+        if not (self._make_columns(new, work) and self._set(rows, added, released)):
             self.serving = False
             return False
-        self._set(rows, added, released)
         return True
 
     def solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
@@ -122,15 +126,21 @@ class RowUpdate:
             parts = self.comm.allgather((local[: len(rows_J)], local[len(rows_J):]))
             b = np.concatenate([p[0] for p in parts] + [p[1] for p in parts])
             coefficients = np.zeros(len(self.column_of))
-            coefficients[self.columns] = scipy.linalg.lu_solve(self.lu, b)
+            coefficients[self.columns] = scipy.linalg.lu_solve(self.lu, b / self.row_scale)
             for first, X, _ in self._blocks:  # the unused columns' coefficients are 0
                 x += X @ coefficients[first:first + X.shape[1]]
         out.array[: self.n] = x
 
     # -- pieces ----------------------------------------------------------------------
 
-    def _set(self, rows, added: list[int], released: list[int]) -> None:
-        """The current rows, and the capacitance matrix of their change, factorized."""
+    def _set(self, rows, added: list[int], released: list[int]) -> bool:
+        """The current rows, and the capacitance matrix of their change, factorized.
+
+        False if that matrix is singular to working precision (then M_B is, or nearly):
+        its rows equilibrated (x_J's are compliances, the released rows' K X are numbers),
+        a reciprocal condition number below RCOND_MIN leaves the rows to a new
+        factorization, which has its own checks, rather than solve them to a few digits.
+        """
         self.now = np.zeros(self.n, dtype=bool)
         self.now[rows] = True
         local = lambda g: np.asarray([i - self.start for i in g  # noqa: E731
@@ -140,11 +150,18 @@ class RowUpdate:
         self.size = len(self.columns)
         self.serving = True
         if not self.size:
-            return
+            return True
         parts = self.comm.allgather((self._pick(0, self.added_local),
                                      self._pick(1, self.released_local)))
         G = np.vstack([p[0] for p in parts] + [p[1] for p in parts])
-        self.lu = scipy.linalg.lu_factor(G)
+        self.row_scale = np.abs(G).max(axis=1)
+        self.row_scale[self.row_scale == 0] = 1.0
+        G /= self.row_scale[:, None]
+        with warnings.catch_warnings():  # a zero pivot: rcond says it below
+            warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
+            self.lu = scipy.linalg.lu_factor(G)
+        rcond = scipy.linalg.lapack.dgecon(self.lu[0], np.linalg.norm(G, 1), norm="1")[0]
+        return bool(rcond >= self.RCOND_MIN)  # (every rank has the same G)
 
     def _gather(self, local_rows: np.ndarray) -> list[int]:
         """Global indices of every rank's `local_rows`, in increasing order.
