@@ -130,6 +130,8 @@ def main():
                          "ratios' two times vary by about 5 %% from one round to the next "
                          "(default: 3)")
     args = ap.parse_args()
+    if args.repeat < 1:
+        ap.error("--repeat must be at least 1")
     # warm-up: compile every form once
     punch("axisymmetric", 0).indent(DELTA)
     punch("axisymmetric", 0, formulation="multiplier").indent(DELTA)

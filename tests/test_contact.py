@@ -177,3 +177,27 @@ def test_a_cone_matches_sneddon():
     state = punch.indent(delta)
     assert state.force == pytest.approx(ref["force"], rel=1e-2)
     assert abs(state.contact_radius - ref["contact_radius"]) <= punch.block.h
+
+
+def test_a_kept_residual_is_the_assembly_at_the_same_u_and_only_there():
+    # the active-set loop's forces come from Newton's last assembly of R(u): the same vector
+    # as a new assembly while u stays; none once u moved, or outside the block
+    from dolfinx.fem import petsc
+    from petsc4py import PETSc
+
+    c, _ = axisymmetric_punch("elimination")
+    newton = c.newton
+    kept, fresh = newton.b.duplicate(), newton.b.duplicate()
+    with newton.reuse_residual_at_same_u():
+        assert not newton.copy_kept_residual(kept)  # nothing assembled in the block yet
+        newton.solve()
+        with newton.reuse_residual_at_same_u():  # nested: the outer block's kept R stays
+            pass
+        assert newton.copy_kept_residual(kept)
+        fresh.set(0.0)
+        petsc.assemble_vector(fresh, newton._R)  # (the form the solver assembles)
+        fresh.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        assert np.array_equal(kept.array_r, fresh.array_r)
+        newton.u.x.array[0] += 1e-6
+        assert not newton.copy_kept_residual(kept)
+    assert not newton.copy_kept_residual(kept)

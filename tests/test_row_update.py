@@ -12,13 +12,13 @@ from fenics_nl.solvers.result import WorkCounts
 from fenics_nl.solvers.row_update import RowUpdate
 
 
-def elastic_square(comm, n=12):
+def elastic_square(comm, n=12, modulus=1.0):
     """K of a plane elastic square; its bottom's rows, and its top's vertical rows by x."""
     domain = mesh.create_unit_square(comm, n, n)
     V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-    a = fem.form((2 * ufl.inner(eps(u), eps(v)) + ufl.div(u) * ufl.div(v)) * ufl.dx)
+    a = fem.form(modulus * (2 * ufl.inner(eps(u), eps(v)) + ufl.div(u) * ufl.div(v)) * ufl.dx)
     fdim = domain.topology.dim - 1
     bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0))
     top = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 1))
@@ -52,8 +52,8 @@ def factorized(a, bcs):
     return M, ksp
 
 
-def check_rows_added_and_released(comm):
-    a, K, rows = elastic_square(comm)
+def check_rows_added_and_released(comm, modulus=1.0):
+    a, K, rows = elastic_square(comm, modulus=modulus)
     base_bcs, base_rows = rows(lambda x: x < 0.55)
     new_bcs, new_rows = rows(lambda x: x > 0.3)  # adds x > 0.55, releases x < 0.3
     _, base = factorized(a, base_bcs)
@@ -77,8 +77,11 @@ def check_rows_added_and_released(comm):
     assert (x - x_ref).norm() <= 1e-13 * x_ref.norm()
 
 
-def test_rows_added_and_released_solve_as_a_new_factorization():
-    check_rows_added_and_released(MPI.COMM_SELF)
+@pytest.mark.parametrize("modulus", [1.0, 2e11])  # the stiffness in N/m: steel in SI units
+def test_rows_added_and_released_solve_as_a_new_factorization(modulus):
+    # the capacitance system mixes compliances and stiffnesses: whether it is solved must
+    # not depend on the units
+    check_rows_added_and_released(MPI.COMM_SELF, modulus)
 
 
 @pytest.mark.mpi
@@ -114,3 +117,44 @@ def test_rows_that_leave_the_body_free_are_left_to_a_factorization():
     work = WorkCounts()
     assert not update.set_rows(np.setdiff1d(base_rows, bottom_rows), work)
     assert not update.serving and work.update_columns == len(bottom_rows)
+
+
+def test_newton_on_changing_rows_and_back_to_its_base_matches_new_factorizations():
+    # a linear material's solver with reuse: the changed rows are served on the first
+    # factorization (its A left with the old rows), the base's rows again by its factors;
+    # each answer against a solver that factorizes its rows afresh
+    from fenics_nl.solvers.newton import NewtonSolver
+
+    domain = mesh.create_unit_square(MPI.COMM_SELF, 12, 12)
+    V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+    eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
+    fdim = 1
+    bottom = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 0))
+    top = mesh.locate_entities_boundary(domain, fdim, lambda x: np.isclose(x[1], 1))
+    Vy, _ = V.sub(1).collapse()
+    x_top = lambda where: top[where(domain.geometry.x[  # noqa: E731
+        mesh.entities_to_geometry(domain, fdim, top)[:, 0], 0])]
+
+    def problem(prefix, reuse):
+        u, v = fem.Function(V), ufl.TestFunction(V)
+        residual = (2 * ufl.inner(eps(u), eps(v)) + ufl.div(u) * ufl.div(v)) * ufl.dx \
+            - ufl.dot(ufl.as_vector((0.3, 0.0)), v) * ufl.dx
+        return u, NewtonSolver(residual, u, [], prefix=prefix, reuse_factorization=reuse)
+
+    def bcs(where):
+        held = fem.dirichletbc(np.zeros(2), fem.locate_dofs_topological(V, fdim, bottom), V)
+        dofs = fem.locate_dofs_topological((V.sub(1), Vy), fdim, x_top(where))
+        g = fem.Function(Vy)
+        g.x.array[:] = -0.01
+        return [held, fem.dirichletbc(g, dofs, V.sub(1))]
+
+    u, solver = problem("rows_reuse_", True)
+    for k, where in enumerate((lambda x: x < 0.55, lambda x: x > 0.3, lambda x: x < 0.55)):
+        solver.set_bcs(bcs(where))
+        solver.solve()
+        u_ref, direct = problem(f"rows_direct{k}_", False)
+        direct.set_bcs(bcs(where))
+        direct.solve()
+        assert np.allclose(u.x.array, u_ref.x.array, rtol=0, atol=1e-10 * np.abs(
+            u_ref.x.array).max())
+    assert solver.total.factorizations == 1 and solver.total.update_columns > 0

@@ -105,7 +105,7 @@ class EliminationSystem:
         constraint puts on the body.
         """
         b = self._reaction
-        if self.newton.unconstrained_residual(b):  # the last solve's, at this u
+        if self.newton.copy_kept_residual(b):  # the last solve's, at this u
             with b.localForm() as loc:
                 return loc.array_r.copy()
         with b.localForm() as loc:
@@ -322,8 +322,8 @@ class ActiveSetContact:
         loose = _Loosened(self.newton, self.LOOSE_TOLERANCE)
         # between inner solves only the conditions change (Dirichlet rows, nodal terms):
         # a solve's last assembly of R(u) gives the forces and starts the next solve
-        same_form = self.newton.same_residual_form() if self.newton else contextlib.nullcontext()
-        with same_form:
+        newton = self.newton
+        with newton.reuse_residual_at_same_u() if newton else contextlib.nullcontext():
             try:
                 for k in range(1, self.max_iterations + 1):
                     self._set_conditions(changes)

@@ -206,7 +206,7 @@ class FrictionalContact(ActiveSetContact):
         Settled when no status changed and the slip forces stopped moving.
         """
         S = self.surface
-        r = self.system.reactions()  # one assembly for T_n and T_t
+        r = self.system.reactions()  # T_n and T_t from the last solve's R(u)
         T_n, T_t, g = S.sign * r[S.dofs_V], self.tangential_forces(r), self.slip_increment()
         scale_T = global_max(self.comm, np.abs(T_n))
         # lengths of the state itself (not the far gap, which grows with the block): the

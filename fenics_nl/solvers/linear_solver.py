@@ -64,9 +64,8 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     if kind in ("lu", "cholesky") and P is not None:
         if indefinite:  # no restart within max_it
             _true_residual_gmres(ksp, restart=50)
-        else:  # on ‖A x − b‖: P = A (rows unchanged) is then one back-solve, not two
+        else:
             ksp.setType("cg")
-            ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=50)
         pc.setType(kind)
         pc.setFactorSolverType("mumps")

@@ -501,7 +501,7 @@ class NewtonSolver:
         self.b = petsc.create_vector(V)
         self.du = petsc.create_vector(V)
         # R(u) as assembled (owned rows summed; no Dirichlet rows, lifting or nodal terms),
-        # and, within `same_residual_form`, the u it was assembled at (None: not kept)
+        # and, within `reuse_residual_at_same_u`, the u it was assembled at (None: not kept)
         self._R_raw = petsc.create_vector(V)
         self._R_raw_at: np.ndarray | None = None
         self._keep_R_raw = False
@@ -650,6 +650,9 @@ class NewtonSolver:
     def residual(self, work: WorkCounts, lift: bool = False) -> float:
         """Assemble R(u) into `residual_vector` (u − g on the Dirichlet rows); its ‖·‖.
 
+        Within `reuse_residual_at_same_u`, an assembly at the same u serves again: the
+        caller promises that nothing else R reads (a load factor, a state) changes there.
+
         The norm is taken off the Dirichlet rows: a force, the equilibrium imbalance.
         `lift`: also b −= K (u − g) on the Dirichlet columns, so that the correction
         δU = −K⁻¹b moves the boundary to g and the interior with it.
@@ -672,24 +675,27 @@ class NewtonSolver:
             return self._force_norm()
 
     @contextlib.contextmanager
-    def same_residual_form(self):
+    def reuse_residual_at_same_u(self):
         """Within this block, R's form and everything it reads but u stay as they are.
 
         Only the Dirichlet rows and the `nodal` terms may change (an active-set loop): an
         R(u) assembled at the same u then serves again, for the next solve's first residual
-        and for `unconstrained_residual` (the contact forces), instead of a new assembly
+        and for `copy_kept_residual` (the contact forces), instead of a new assembly
         (the axisymmetric punch: 3 assemblies an active-set iteration down to 1).
         """
+        outer = self._keep_R_raw
         self._keep_R_raw = True
         try:
             yield
         finally:
-            self._keep_R_raw, self._R_raw_at = False, None
+            self._keep_R_raw = outer
+            if not outer:
+                self._R_raw_at = None
 
-    def unconstrained_residual(self, out: PETSc.Vec) -> bool:
+    def copy_kept_residual(self, out: PETSc.Vec) -> bool:
         """Copy R(u) as assembled, ghosts updated, into `out` if it is current; whether it was.
 
-        Current within `same_residual_form` while u is where it was assembled; else the
+        Current within `reuse_residual_at_same_u` while u is where it was assembled; else the
         caller assembles it (collective: every rank answers alike).
         """
         if not self._R_raw_is_current():
@@ -856,9 +862,8 @@ class NewtonSolver:
             # a linear material's new rows: on the last factorization while that pays
             with _Timer(work, "solve"):  # its columns are back-solves
                 serves = self._rows.set_rows(_constrained_rows(self.bcs), work)
-            if not (serves and self._rows.size):  # a factorization, or the KSP, reads A
+            if not serves:  # a factorization reads A
                 self._apply_rows_to_fixed_tangent()
-            if not serves:
                 self._factorize(work)
         elif self.policy.needs_factorization():
             self._factorize(work)
@@ -871,8 +876,8 @@ class NewtonSolver:
     def _fixed_tangent(self, work: WorkCounts) -> None:
         """K assembled once; A = K with the current Dirichlet rows, now or when it is read.
 
-        The row update's bordered solves read K, not A: while it may serve, A waits for a
-        factorization or a KSP solve (`_apply_rows_to_fixed_tangent`), a copy of K and a
+        The row update's solves read K and the base's factors, not A: while it may serve, A
+        waits for a factorization (`_apply_rows_to_fixed_tangent`), a copy of K and a
         sweep of its columns saved per active-set iteration (10 % of a linear solve on the
         axisymmetric punch, measured).
         """
@@ -924,10 +929,14 @@ class NewtonSolver:
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
         """du = K⁻¹ rhs (the Newton correction is −du)."""
-        if self._rows is not None and self._rows.serving and self._rows.size:
-            # (the base's own rows go through the KSP: its options, -ksp_view, apply)
+        if self._rows is not None and self._rows.serving:
+            # the base's own rows on its factors (CG on P = A would take a back-solve more,
+            # its norm's); other rows by the bordered solve
             with _Timer(work, "solve"):
-                self._rows.solve(rhs, self.du)
+                if self._rows.size:
+                    self._rows.solve(rhs, self.du)
+                else:
+                    self._rows.factor.solve(rhs, self.du)
                 work.linear_solves += 1
             return
         ksp = self._factorizations.ksp if self._factorizations else self.ksp

@@ -90,6 +90,9 @@ class RowUpdate:
     def set_rows(self, rows: np.ndarray, work: WorkCounts) -> bool:
         """Solve with the Dirichlet rows `rows` from now on; False if a factorization pays.
 
+        (It pays when the columns would cost more than one, and when their capacitance
+        matrix is singular to working precision: see `_set`.)
+
         Collective. Makes the columns of the rows that changed and have none yet.
         """
         if self.factor is None:
@@ -126,7 +129,8 @@ class RowUpdate:
             parts = self.comm.allgather((local[: len(rows_J)], local[len(rows_J):]))
             b = np.concatenate([p[0] for p in parts] + [p[1] for p in parts])
             coefficients = np.zeros(len(self.column_of))
-            coefficients[self.columns] = scipy.linalg.lu_solve(self.lu, b / self.row_scale)
+            r_scale, c_scale = self.scales
+            coefficients[self.columns] = scipy.linalg.lu_solve(self.lu, b / r_scale) / c_scale
             for first, X, _ in self._blocks:  # the unused columns' coefficients are 0
                 x += X @ coefficients[first:first + X.shape[1]]
         out.array[: self.n] = x
@@ -137,9 +141,11 @@ class RowUpdate:
         """The current rows, and the capacitance matrix of their change, factorized.
 
         False if that matrix is singular to working precision (then M_B is, or nearly):
-        its rows equilibrated (x_J's are compliances, the released rows' K X are numbers),
         a reciprocal condition number below RCOND_MIN leaves the rows to a new
         factorization, which has its own checks, rather than solve them to a few digits.
+        Its entries are compliances (Z on the added rows), numbers (W there, K Z on the
+        released rows) and stiffnesses (K W): equilibrated on both sides, rows then
+        columns, its condition does not depend on the units.
         """
         self.now = np.zeros(self.n, dtype=bool)
         self.now[rows] = True
@@ -154,14 +160,19 @@ class RowUpdate:
         parts = self.comm.allgather((self._pick(0, self.added_local),
                                      self._pick(1, self.released_local)))
         G = np.vstack([p[0] for p in parts] + [p[1] for p in parts])
-        self.row_scale = np.abs(G).max(axis=1)
-        self.row_scale[self.row_scale == 0] = 1.0
-        G /= self.row_scale[:, None]
+        self.scales = []
+        for axis in (1, 0):  # G ← diag(1/r) G diag(1/c)
+            scale = np.abs(G).max(axis=axis)
+            scale[scale == 0] = 1.0
+            G /= scale[:, None] if axis else scale[None, :]
+            self.scales.append(scale)
         with warnings.catch_warnings():  # a zero pivot: rcond says it below
             warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
             self.lu = scipy.linalg.lu_factor(G)
         rcond = scipy.linalg.lapack.dgecon(self.lu[0], np.linalg.norm(G, 1), norm="1")[0]
-        return bool(rcond >= self.RCOND_MIN)  # (every rank has the same G)
+        # every rank has the same G: one decision all the same (the calls that follow are
+        # collective)
+        return self.comm.allreduce(bool(rcond >= self.RCOND_MIN), op=MPI.LAND)
 
     def _gather(self, local_rows: np.ndarray) -> list[int]:
         """Global indices of every rank's `local_rows`, in increasing order.

@@ -174,7 +174,7 @@ def free_motions(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirichle
     """The rigid motions that neither the Dirichlet rows of `bcs` nor `A` resist, named.
 
     `A` is the tangent as assembled, with the Dirichlet rows set to the identity, or without
-    them (its Dirichlet rows are not read). Collective.
+    them: its Dirichlet rows and columns are not read. Collective.
     """
     held = constrained_dofs(bcs)
     C = motions.unconstrained(held)
@@ -194,9 +194,10 @@ def free_motions(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirichle
     KR = np.zeros((motions.n_owned, C.shape[1]))
     for k in range(C.shape[1]):
         r.array[:] = T @ C[:, k]
+        r.array[held] = 0.0  # (≈ 0 already): the Dirichlet columns are not read either
         A.mult(r, Kr)
         KR[:, k] = Kr.array_r[: motions.n_owned]
-    KR[held] = 0.0  # A's identity rows or K's own: the motions vanish there either way
+    KR[held] = 0.0  # A's identity rows or K's own: the same P K P r either way
     for v in (diag, r, Kr):
         v.destroy()
     # the combinations of the candidates that K does not resist: ‖K r‖ ≤ tol max|K_ii| ‖r‖
