@@ -877,9 +877,10 @@ class NewtonSolver:
         """K assembled once; A = K with the current Dirichlet rows, now or when it is read.
 
         The row update's solves read K and the base's factors, not A: while it may serve, A
-        waits for a factorization (`_apply_rows_to_fixed_tangent`), a copy of K and a
-        sweep of its columns saved per active-set iteration (10 % of a linear solve on the
-        axisymmetric punch, measured).
+        stays the base's matrix, the last one factorized (what the KSP solves with on the
+        base's own rows), until the next factorization (`_apply_rows_to_fixed_tangent`): a
+        copy of K and a sweep of its columns saved per active-set iteration (10 % of a
+        linear solve on the axisymmetric punch, measured).
         """
         if self._K_fixed is None:
             self._matrix.assemble(self._K)
@@ -929,14 +930,11 @@ class NewtonSolver:
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:
         """du = K⁻¹ rhs (the Newton correction is −du)."""
-        if self._rows is not None and self._rows.serving:
-            # the base's own rows on its factors (CG on P = A would take a back-solve more,
-            # its norm's); other rows by the bordered solve
+        if self._rows is not None and self._rows.serving and self._rows.size:
+            # (the base's own rows go through the KSP: its options, -ksp_view, apply; A is
+            # the base's matrix then, the last one factorized)
             with _Timer(work, "solve"):
-                if self._rows.size:
-                    self._rows.solve(rhs, self.du)
-                else:
-                    self._rows.factor.solve(rhs, self.du)
+                self._rows.solve(rhs, self.du)
                 work.linear_solves += 1
             return
         ksp = self._factorizations.ksp if self._factorizations else self.ksp
