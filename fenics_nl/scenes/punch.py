@@ -20,6 +20,7 @@ at 10 % (the default, L = 100a, h = a/12).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -298,9 +299,11 @@ class Punch:
         c = self.contact
         c.set_gap(self.gap(delta))
         c.add_penetrating()  # warm start: the last set and what penetrates now
-        res = c.solve()
-        radius = self._contact_radius()
-        p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])
+        # (the pressure below reads the loop's last R(u), not a new assembly)
+        with c.newton.reuse_residual_at_same_u() if c.newton else contextlib.nullcontext():
+            res = c.solve()
+            radius = self._contact_radius()
+            p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])
         return Indentation(delta, self.block.symmetry_factor * c.force, radius, p_max,
                            res.active_set_iterations, res.iterations, res.work.factorizations)
 
