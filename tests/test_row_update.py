@@ -158,3 +158,37 @@ def test_newton_on_changing_rows_and_back_to_its_base_matches_new_factorizations
         assert np.allclose(u.x.array, u_ref.x.array, rtol=0, atol=1e-10 * np.abs(
             u_ref.x.array).max())
     assert solver.total.factorizations == 1 and solver.total.update_columns > 0
+
+
+def test_springs_come_and_go_on_a_reused_factorization():
+    # springs added to A without a factorization, then removed: A must not keep them when
+    # the rows are the base's again (the KSP solves with A, preconditioned by the base)
+    from fenics_nl.solvers.newton import NewtonSolver
+
+    domain = mesh.create_unit_square(MPI.COMM_SELF, 8, 8)
+    V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+    eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
+    bottom = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 0))
+    held = fem.dirichletbc(np.zeros(2), fem.locate_dofs_topological(V, 1, bottom), V)
+
+    def problem(prefix, reuse, load):
+        u, v = fem.Function(V), ufl.TestFunction(V)
+        f = fem.Constant(domain, np.array(load))
+        residual = (2 * ufl.inner(eps(u), eps(v)) + ufl.div(u) * ufl.div(v)) * ufl.dx \
+            - ufl.dot(f, v) * ufl.dx
+        return u, f, NewtonSolver(residual, u, [held], prefix=prefix,
+                                  reuse_factorization=reuse)
+
+    u, f, solver = problem("springs_reuse_", True, [0.3, 0.0])
+    solver.solve()
+    top = np.flatnonzero(np.isclose(V.tabulate_dof_coordinates()[:, 1], 1.0))
+    dofs = np.column_stack([2 * top, 2 * top + 1])
+    solver.nodal.set_springs(dofs, np.tile(np.eye(2), (len(top), 1, 1)), np.zeros((len(top), 2)))
+    solver.solve()
+    solver.nodal.set_springs(np.zeros((0, 2)), np.zeros((0, 2, 2)), np.zeros((0, 2)))
+    f.value[:] = [0.0, -0.2]
+    solver.solve()
+    u_ref, _, direct = problem("springs_direct_", False, [0.0, -0.2])
+    direct.solve()
+    assert np.allclose(u.x.array, u_ref.x.array, rtol=0, atol=1e-10 * np.abs(
+        u_ref.x.array).max())

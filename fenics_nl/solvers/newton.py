@@ -478,6 +478,7 @@ class NewtonSolver:
         fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
         self._K_fixed = None  # K without Dirichlet rows, kept after its first assembly
         self._A_stale = False  # A is K_fixed with older rows (see `_fixed_tangent`)
+        self._A_factorized = False  # A is the matrix last factorized (no rows, springs since)
         for_life = (given or constant_tangent == "elastic") and method in ("modified", "bfgs")
         # the tangent that is assembled: K(u), K(0) (the same form at a zero displacement),
         # or the given one
@@ -889,7 +890,10 @@ class NewtonSolver:
             if self.policy.reuse:
                 self._rows = RowUpdate(self._K_fixed)
         self._A_stale = True
-        if self._rows is None or self._rows.factor is None or self.nodal.springs is not None:
+        # deferred only while A is the base's matrix: springs added since (and gone again)
+        # or other rows applied without a factorization leave another matrix in A
+        if (self._rows is None or self._rows.factor is None or self.nodal.springs is not None
+                or not self._A_factorized):
             self._apply_rows_to_fixed_tangent()
 
     def _apply_rows_to_fixed_tangent(self) -> None:
@@ -899,7 +903,7 @@ class NewtonSolver:
         self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         rows = _constrained_rows(self.bcs)
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
-        self._A_stale = False
+        self._A_stale = self._A_factorized = False
 
     def _factorize(self, work: WorkCounts) -> None:
         """Numeric factorization of the current tangent (the symbolic one is reused).
@@ -918,6 +922,7 @@ class NewtonSolver:
                     self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
                 self.ksp.getPC().setUp()
                 work.factorizations += 1
+        self._A_factorized = True
         self.policy.factorized()
         if self._rows is not None:  # the next rows are solved on this factorization
             pc = self.ksp.getPC()
