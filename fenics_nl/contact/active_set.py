@@ -197,6 +197,16 @@ class ActiveSetContact:
             self.system = MultiplierSystem(residual, u, bcs, self.surface, prefix=prefix, **opts)
         self.system.set_active(self.active, None)
 
+    def reusing_residual(self):
+        """A block where the inner solves' last R(u) serves again while u stays.
+
+        For the contact forces and the next solve's start: between inner solves only the
+        conditions change (Dirichlet rows, nodal terms). `NewtonSolver`'s
+        `reuse_residual_at_same_u`; nothing for the multiplier form (SNES).
+        """
+        newton = self.newton
+        return newton.reuse_residual_at_same_u() if newton else contextlib.nullcontext()
+
     @property
     def newton(self):
         """The Newton solver of the inner solves (None: the multiplier form's SNES)."""
@@ -320,40 +330,36 @@ class ActiveSetContact:
         res = SolveResult(False, self.STATUSES, 0, [], WorkCounts())
         changes = None  # nodes that changed since the last solve (None: unknown, many)
         loose = _Loosened(self.newton, self.LOOSE_TOLERANCE)
-        # between inner solves only the conditions change (Dirichlet rows, nodal terms):
-        # a solve's last assembly of R(u) gives the forces and starts the next solve
-        newton = self.newton
-        with newton.reuse_residual_at_same_u() if newton else contextlib.nullcontext():
-            try:
-                for k in range(1, self.max_iterations + 1):
-                    self._set_conditions(changes)
-                    nr = self._inner_solve(k, res)
+        with contextlib.ExitStack() as cleanup:
+            cleanup.enter_context(self.reusing_residual())
+            cleanup.callback(loose.off)
+            for k in range(1, self.max_iterations + 1):
+                self._set_conditions(changes)
+                nr = self._inner_solve(k, res)
+                update = self._update_statuses()
+                if update.settled and loose.on:  # this set solved fully, and checked again
+                    loose.off()  # (every later solve is full)
+                    nr = self._inner_solve(k, res, nr.iterations)
                     update = self._update_statuses()
-                    if update.settled and loose.on:  # this set solved fully, and checked again
-                        loose.off()  # (every later solve is full)
-                        nr = self._inner_solve(k, res, nr.iterations)
-                        update = self._update_statuses()
-                    changes = update.changes
-                    res.active_set_iterations = k
-                    res.active_sizes = [*res.active_sizes, self.surface.count(self.active)]
-                    res.history.append({**update.record, "newton_iterations": nr.iterations})
-                    log.info("%s iteration %d: %s, %d changes", self.STATUSES, k, update.summary,
-                             changes)
-                    if update.settled:
-                        self.force = self.total_force(update.T_n)
-                        res.converged, res.reason = True, f"{self.STATUSES} fixed"
-                        res.wall_time = time.perf_counter() - t0
-                        return res
-                    if changes:
-                        seen[update.state] += 1
-                        if seen[update.state] > self.REVISITS and loose.on:
-                            loose.off()  # loose solves may have led it round: full ones decide
-                            seen.clear()
-                        elif seen[update.state] > self.REVISITS:
-                            raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
-                                               f"{update.summary})", res)
-            finally:
-                loose.off()
+                changes = update.changes
+                res.active_set_iterations = k
+                res.active_sizes = [*res.active_sizes, self.surface.count(self.active)]
+                res.history.append({**update.record, "newton_iterations": nr.iterations})
+                log.info("%s iteration %d: %s, %d changes", self.STATUSES, k, update.summary,
+                         changes)
+                if update.settled:
+                    self.force = self.total_force(update.T_n)
+                    res.converged, res.reason = True, f"{self.STATUSES} fixed"
+                    res.wall_time = time.perf_counter() - t0
+                    return res
+                if changes:
+                    seen[update.state] += 1
+                    if seen[update.state] > self.REVISITS and loose.on:
+                        loose.off()  # loose solves may have led it round: full ones decide
+                        seen.clear()
+                    elif seen[update.state] > self.REVISITS:
+                        raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
+                                           f"{update.summary})", res)
         raise ContactError(f"{self.STATUSES} did not settle in {self.max_iterations} "
                            "iterations", res)
 

@@ -20,7 +20,6 @@ at 10 % (the default, L = 100a, h = a/12).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -300,7 +299,7 @@ class Punch:
         c.set_gap(self.gap(delta))
         c.add_penetrating()  # warm start: the last set and what penetrates now
         # (the pressure below reads the loop's last R(u), not a new assembly)
-        with c.newton.reuse_residual_at_same_u() if c.newton else contextlib.nullcontext():
+        with c.reusing_residual():
             res = c.solve()
             radius = self._contact_radius()
             p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])

@@ -58,7 +58,7 @@ from fenics_nl.solvers.linear_solver import (
 from fenics_nl.solvers.nodal import NodalTerms
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.row_update import RowUpdate
-from fenics_nl.solvers.supports import RigidMotions, check_supports
+from fenics_nl.solvers.supports import RigidMotions, check_supports, constrained_dofs
 
 __all__ = [
     "ConvergenceError",
@@ -102,12 +102,6 @@ def _round_off_hint(norms: list[float]) -> str:
         return (f"; |R| stalls at {min(norms[-5:]):.1e}, the round-off of the internal "
                 "forces: raise atol (relative to the force scale) above it")
     return ""
-
-
-def _constrained_rows(bcs: Sequence[fem.DirichletBC]) -> np.ndarray:
-    """The sorted local indices of the owned dofs that `bcs` constrain."""
-    rows = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in bcs]
-    return np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
 
 
 class _Timer:
@@ -583,7 +577,7 @@ class NewtonSolver:
         # at a load step's start, refactorizes as before: a restart, which has no
         # factorization, then takes the uninterrupted run's path, work counts included.)
         same = small_change and self.A.comm.tompi4py().allreduce(  # on every rank's rows
-            np.array_equal(_constrained_rows(bcs), _constrained_rows(self.bcs)), op=MPI.LAND)
+            np.array_equal(constrained_dofs(bcs), constrained_dofs(self.bcs)), op=MPI.LAND)
         self.bcs = list(bcs)
         if same:
             return
@@ -862,7 +856,7 @@ class NewtonSolver:
         if self._rows is not None and self.nodal.springs is None:
             # a linear material's new rows: on the last factorization while that pays
             with _Timer(work, "solve"):  # its columns are back-solves
-                serves = self._rows.set_rows(_constrained_rows(self.bcs), work)
+                serves = self._rows.set_rows(constrained_dofs(self.bcs), work)
             if not serves:  # a factorization reads A
                 self._apply_rows_to_fixed_tangent()
                 self._factorize(work)
@@ -901,7 +895,7 @@ class NewtonSolver:
         if not self._A_stale:
             return
         self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        rows = _constrained_rows(self.bcs)
+        rows = constrained_dofs(self.bcs)
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
         self._A_stale = self._A_factorized = False
 
@@ -929,7 +923,7 @@ class NewtonSolver:
             if pc.getFactorSolverType() != "mumps":  # (the options chose another package)
                 self._rows = None
             elif self.nodal.springs is None:
-                self._rows.rebase(pc.getFactorMatrix(), _constrained_rows(self.bcs))
+                self._rows.rebase(pc.getFactorMatrix(), constrained_dofs(self.bcs))
             else:  # its K would miss the springs
                 self._rows.factor = None
 
