@@ -78,6 +78,11 @@ class Isotropic:
             return math.inf
         return self.E / (3 * (1 - 2 * self.nu))
 
+    @property
+    def volumetric_modulus(self) -> float:
+        """k of `volumetric_split` (φ = φ̃ + k/2 g²): the bulk modulus κ by default."""
+        return self.kappa
+
     def require_compressible(self) -> None:
         """Raise ValueError at ν = 1/2: a displacement formulation cannot hold it."""
         if self.incompressible:
@@ -309,14 +314,27 @@ class NeoHookean(Isotropic, FiniteStrain):
         lnJ = 0.5 * ufl.ln(ufl.det(C))
         return 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ + 0.5 * self.lmbda * lnJ**2
 
-    def volumetric_split(self, e):
-        """φ = [μ/2 (tr C − 3) − μ ln J − μ/3 (ln J)²] + κ/2 (ln J)²  (λ/2 = κ/2 − μ/3).
+    @property
+    def volumetric_modulus(self) -> float:
+        """λ where it is positive (ν > 0), else κ: see `volumetric_split`."""
+        return self.lmbda if self.lmbda > 0 else self.kappa
 
-        κ > 0 for every ν > −1 (λ vanishes at ν = 0); at κ = ∞, J = 1 and the first term is
-        the incompressible neo-Hookean energy μ/2 (tr C − 3).
+    def volumetric_split(self, e):
+        """φ = [μ/2 (tr C − 3) − μ ln J] + λ/2 (ln J)² for ν > 0 (k = λ, ∞ at ν = 1/2).
+
+        φ̃ must not be concave in ln J: the P1 pressure holds ln J only in the mean over
+        each vertex patch, and the part of ln J it leaves free is held by φ̃ alone. The
+        split by the bulk modulus, φ̃ = [μ/2 (tr C − 3) − μ ln J − μ/3 (ln J)²] + κ/2 (ln J)²,
+        gives it −2μ/3 of stiffness there: an inflated incompressible sphere then lost
+        Newton's convergence near its pressure maximum and bifurcated onto mesh-scale modes
+        on a fine mesh (measured). For ν ≤ 0 (λ ≤ 0) that split is the only one with k > 0;
+        there the mixed form is not needed.
         """
         self.require_3x3(e)
         C = ufl.Identity(3) + 2 * e
         lnJ = 0.5 * ufl.ln(ufl.det(C))
-        rest = 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ - self.mu / 3 * lnJ**2
-        return rest, lnJ, self.kappa
+        rest = 0.5 * self.mu * (ufl.tr(C) - 3) - self.mu * lnJ
+        k = self.volumetric_modulus
+        if k != self.lmbda:  # κ: the rest of λ/2 (ln J)², (λ − κ)/2 = −μ/3
+            rest -= self.mu / 3 * lnJ**2
+        return rest, lnJ, k

@@ -153,7 +153,7 @@ def preconditioner(material, unknown: MixedUnknown, model: str, dx):
     W = unknown.W
     (du, dp), (v, q) = ufl.TrialFunctions(W), ufl.TestFunctions(W)
     eps = kinematics.small_strain
-    k = material.kappa  # every law's volumetric modulus in `volumetric_split`
+    k = material.volumetric_modulus  # the k of every law's `volumetric_split`
     c = 1 / material.mu + (0.0 if math.isinf(k) else 1 / k)
     weight = kinematics.measure_weight(W.mesh, model)
     return (2 * material.mu * ufl.inner(eps(du, model), eps(v, model)) + c * dp * q) \
