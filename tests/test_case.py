@@ -501,6 +501,7 @@ def test_a_case_loaded_past_its_limit_keeps_every_converged_step(tmp_path, demo)
     error = [line for line in proc.stderr.splitlines() if line.startswith("error")]
     assert len(error) == 1 and "load factor 1.2 not reached" in error[0], proc.stderr
     assert "last converged load factor is 0.8 " in error[0]
+    assert 'control = "arc-length"' in error[0]  # a pressure: it can take it
     d = json.loads(out.read_text())
     assert d["status"] == "failed" and d["message"] in error[0]
     assert d["load_factor"] == 0.8 and d["converged_steps"] == 2
@@ -917,3 +918,120 @@ def test_what_a_damage_case_cannot_be_is_one_line_each(tmp_path, demo, change, m
     write(tmp_path, "damage_strip.geo", (CASES / "damage_strip.geo").read_text())
     lines = check(demo, tmp_path, text.replace(*change))
     assert any(message in line for line in lines), lines
+
+
+def sphere_path(d):
+    """(λ_a, p/μ) at every step of the inflated sphere: λ_a = 1 + u_r(A)/A, p = λ μ."""
+    return (np.array([1 + s["probes"]["inner"]["displacement"][0] for s in d["steps"]]),
+            np.array([s["load_factor"] for s in d["steps"]]))
+
+
+def sphere_case(tmp_path, change):
+    """The shipped sphere, meshed finer (cells ≤ 0.04) or in the displacement formulation."""
+    text = (CASES / "inflated_sphere.toml").read_text()
+    (tmp_path / "inflated_sphere.geo").write_text((CASES / "inflated_sphere.geo").read_text())
+    if change == "fine":
+        text = text.replace("degree = 2\n", "degree = 2\nsize = 0.04\n")
+    elif change == "displacement":  # ν = 0.4999: compressible enough for P2 at h = 0.05
+        text = text.replace('formulation = "mixed"', "").replace("nu = 0.5", "nu = 0.4999")
+        text = text.replace("degree = 2\n", "degree = 2\nsize = 0.05\n")
+    return write(tmp_path, f"{change}.toml", text)
+
+
+@pytest.mark.parametrize("change", ["coarse", "fine", "displacement"])
+def test_the_inflated_sphere_passes_its_pressure_maximum_onto_the_falling_branch(
+        tmp_path, demo, change):
+    # the incompressible neo-Hookean sphere (formulas.md): arc-length through the limit
+    # point, down the falling branch until the stop condition u_r(A) = 1 (λ_a = 2). Each
+    # step on the closed form p(λ_a): measured 2.6e-5 (coarse), 3.0e-6 (fine), 2.9e-4
+    # (displacement, ν = 0.4999: its p is not the incompressible one to 1e-4)
+    from fenics_nl.theory.vessels import neo_hookean_sphere_maximum, neo_hookean_sphere_pressure
+
+    d = demo.case(CASES / "inflated_sphere.toml" if change == "coarse"
+                  else sphere_case(tmp_path, change))
+    assert d["status"] == "ok" and d["ended_by"] == "stop"
+    stretch, p = sphere_path(d)
+    assert np.all(np.diff(stretch) > 0)  # never back down the loading branch
+    assert 2.0 <= stretch[-1] < 2.1  # stopped at the first step past u_r = 1
+    exact = np.array([neo_hookean_sphere_pressure(s, 1.0, 1.2, 1.0) for s in stretch])
+    assert p == pytest.approx(exact, rel=1e-3)
+    (limit,) = d["critical_points"]
+    stretch_max, p_max = neo_hookean_sphere_maximum(1.0, 1.2, 1.0)
+    assert limit["kind"] == "limit" and limit["load_factor"] == pytest.approx(p_max, rel=1e-3)
+    # stable up to the maximum, one unstable direction (the pressure's) past it
+    k = limit["step"]
+    negative = [s["negative_eigenvalues"] for s in d["steps"]]
+    assert negative == [0] * (k - 1) + [1] * (len(negative) - k + 1)
+    assert stretch[k - 2] < stretch_max * 1.01 and stretch[k - 1] > stretch_max * 0.99
+
+
+@pytest.mark.mpi
+def test_the_inflated_sphere_on_two_ranks_follows_the_serial_path(demo):
+    # the same limit point and the same closed form along the path; the steps themselves
+    # agree to the solver's tolerance while both take the same iterations (docs/cases.md)
+    s = demo.case(CASES / "inflated_sphere.toml")
+    p = demo.case(CASES / "inflated_sphere.toml", ranks=2)
+    assert p["ranks"] == 2 and p["status"] == "ok" and p["ended_by"] == "stop"
+    assert p["critical_points"][0]["load_factor"] == pytest.approx(
+        s["critical_points"][0]["load_factor"], rel=1e-8)
+    stretch, load = sphere_path(p)
+    assert np.all(np.diff(stretch) > 0) and stretch[-1] >= 2.0
+    serial = dict(zip(*sphere_path(s), strict=True))
+    for a, b in zip(sphere_path(s)[0], stretch, strict=False):
+        if a != pytest.approx(b, rel=1e-8):  # the paths' steps parted: same curve still
+            break
+        assert load[list(stretch).index(b)] == pytest.approx(serial[a], rel=1e-8)
+
+
+def test_a_failed_arc_length_run_keeps_its_critical_points(tmp_path, demo):
+    # stopped by max_steps past the limit point: status failed, and the JSON still has the
+    # limit point met and every step's negative eigenvalues
+    text = (CASES / "inflated_sphere.toml").read_text().replace("max_steps = 100",
+                                                                 "max_steps = 22")
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("stop ="))
+    (tmp_path / "inflated_sphere.geo").write_text((CASES / "inflated_sphere.geo").read_text())
+    out = tmp_path / "failed.json"
+    proc = demo.run(["-m fenics_nl", "run", write(tmp_path, "short.toml", text), "--json",
+                     out], check=False)
+    assert proc.returncode == 2 and "not reached in 22 steps" in proc.stderr
+    d = json.loads(out.read_text())
+    assert d["status"] == "failed" and len(d["steps"]) == 22
+    (limit,) = d["critical_points"]
+    assert limit["kind"] == "limit" and limit["load_factor"] == pytest.approx(0.22514, rel=1e-3)
+    negative = [s["negative_eigenvalues"] for s in d["steps"]]
+    assert negative[0] == 0 and negative[-1] == 1
+
+
+@pytest.mark.parametrize("stop,message", [
+    ('{ probe = "outer", component = "r", value = 1.0 }',
+     "loading.stop.probe: 'outer' is not a [[probe]] of the case (it has: inner)"),
+    ('{ probe = "inner", component = "x", value = 1.0 }',
+     "loading.stop.component: 'x' is not a displacement component of the axisymmetric "
+     "model (one of r, z)"),
+    ('{ probe = "inner", component = "r", value = 0.0 }', "loading.stop.value: must not be 0"),
+    ('{ probe = "inner", component = "r" }', "loading.stop.value: missing"),
+])
+def test_a_stop_condition_is_checked(tmp_path, demo, stop, message):
+    text = (CASES / "inflated_sphere.toml").read_text()
+    text = "\n".join(f"stop = {stop}" if line.startswith("stop =") else line
+                     for line in text.splitlines())
+    (tmp_path / "inflated_sphere.geo").write_text((CASES / "inflated_sphere.geo").read_text())
+    lines = check(demo, tmp_path, text)
+    assert len(lines) == 1 and message in lines[0], lines
+
+
+def test_arc_length_is_advised_only_where_a_case_can_take_it(tmp_path, demo):
+    # a neo-Hookean cylinder driven by its bore's displacement, one Newton iteration a step:
+    # the step fails, and arc-length (which scales loads only) is not advised
+    text = (CASES / "thick_cylinder.toml").read_text()
+    text = text.replace('law = "linear-elastic"', 'law = "neo-hookean"')
+    text = text.replace("group = \"inner\"\npressure = 100.0",
+                        "group = \"inner\"\ndisplacement = [1.0, \"free\"]")
+    text = text.replace("steps = 1", "steps = 1\nadaptive = false") + (
+        "\n[solver]\nmax_iterations = 1\n")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    proc = demo.run(["-m fenics_nl", "run", write(tmp_path, "pulled.toml", text)],
+                    check=False)
+    error = [line for line in proc.stderr.splitlines() if line.startswith("error")]
+    assert proc.returncode == 2 and len(error) == 1, proc.stderr
+    assert "load factor 1 not reached" in error[0] and "arc-length" not in error[0]

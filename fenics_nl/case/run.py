@@ -12,6 +12,7 @@ from mpi4py import MPI
 from fenics_nl.case.damage import cell_sizes
 from fenics_nl.case.problem import CaseProblem
 from fenics_nl.case.resume import case_checkpoints
+from fenics_nl.case.spec import arc_length_obstacles
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
@@ -76,8 +77,8 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
         for record in steps:
             cli.converged_step(record)
 
-    def converged(t, result):
-        steps.append(step_record(problem, t, result))
+    def converged(t, result, **extra):
+        steps.append(step_record(problem, t, result) | extra)
         cli.converged_step(steps[-1], fields=lambda: fields(problem))
 
     def save(segment):  # after each converged step, with the driver's state
@@ -101,9 +102,9 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
         if not message.startswith("step "):
             say("  " + message)
 
-    critical = None
+    critical, ended_by = None, None
     if case.arc is not None:  # the load factor is an unknown: through limit points
-        critical = _follow_path(problem, solver, converged, steps, work, commit, show,
+        critical, ended_by = _follow_path(problem, solver, converged, steps, work, commit, show,
                                 saving, resumed.arc if resumed else None)
     elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
         n = len(case.factors)
@@ -114,7 +115,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
                                            on_step=converged, start=start, on_state=save(0))
             except LoadStepError as err:  # heading for the next of the n equal steps
                 asked = min(1.0, (math.floor(err.reached * n + 1e-9) + 1) / n)
-                raise _not_reached(err, asked, err.target, steps) from err
+                raise _not_reached(err, asked, err.target, steps, case) from err
             work.add(path.work)
     else:  # from factor to factor, each segment one step (cut in half on failure)
         previous = 0.0
@@ -136,7 +137,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
                                            on_state=save(k))
             except LoadStepError as err:  # err's factors are fractions of the segment
                 raise _not_reached(err, target, previous + err.target * (target - previous),
-                                   steps) from err
+                                   steps, case) from err
             work.add(path.work)
             previous = target
     last = steps[-1]
@@ -149,7 +150,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
            "warnings": warnings(problem)}
     if critical is not None:
         out["control"] = "arc-length"
-        out["critical_points"] = critical
+        out["critical_points"], out["ended_by"] = critical, ended_by
         passed = [c for c in critical if c["kind"] == "bifurcation"]
         if passed:  # the case runner does not switch branches
             out["warnings"].append(
@@ -163,27 +164,32 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     return out
 
 
-def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[dict]
-                 ) -> LoadStepError:
+def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[dict],
+                 case) -> LoadStepError:
     """The driver's failure in the case's own load factors (a segment's are fractions).
 
     `asked` is the factor of the case the path was heading for, `failed` the cut step's.
+    Arc-length control is advised only to a case that could take it.
     """
     reached = steps[-1]["load_factor"] if steps else 0.0
     cause = str(err.__cause__ or err).split(": ", 1)[-1] if err.__cause__ else str(err)
     return LoadStepError(
         f"load factor {asked:.6g} not reached: the last converged load factor is "
         f"{reached:.6g} ({len(steps)} converged steps); the step to {failed:.6g} failed "
-        f"({cause}): the limit load is reached, or the solver cannot take the step; past a "
-        'limit point, follow the path with [loading] control = "arc-length"', err.result,
-        reached=reached, target=asked)
+        f"({cause}): the limit load is reached, or the solver cannot take the step"
+        + ("" if arc_length_obstacles(case.law, case.newton, case.conditions) else
+           '; past a limit point, follow the path with [loading] control = "arc-length"'),
+        err.result, reached=reached, target=asked)
 
 
 def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
                  work: WorkCounts, commit, show, saving: PathCheckpoints | None,
-                 resume: ArcState | None) -> list[dict]:
-    """`loading.control = "arc-length"`: the path to the target; its critical points.
+                 resume: ArcState | None) -> tuple[list[dict], str]:
+    """`loading.control = "arc-length"`: the path to the target or the stop condition.
 
+    Returns its critical points and what ended it ("target" or "stop"). Each step's record
+    has the tangent's negative eigenvalues there, and the critical points met so far are in
+    any JSON written (`cli.known`): a run that fails later keeps both.
     `saving`: checkpoints of the continuation's state; `resume`: the state to go on from.
     """
     arc = problem.case.arc
@@ -193,20 +199,52 @@ def _follow_path(problem: CaseProblem, solver, converged, steps: list[dict],
         max_arc_length=arc["max_arc_length"], commit=commit, prefix="case_continuation_",
         metric_dofs=mixed.displacement_dofs if mixed else None,
         multipliers=mixed.pressure_dofs if mixed else 0)
+
+    def on_step(t, result):
+        path = continuation.path
+        converged(t, result, negative_eigenvalues=path.unstable[-1])  # 0 where stable
+        cli.known(critical_points=_critical_points(path))
+
     on_state = None
     if saving is not None:
         def on_state(state):
             saving.save_arc(state, steps)
-    path = continuation.run(arc["target"], arc["max_steps"], progress=show, on_step=converged,
-                            resume=resume, on_state=on_state)
+    path = continuation.run(arc["target"], arc["max_steps"], progress=show, on_step=on_step,
+                            resume=resume, on_state=on_state,
+                            stop=_stop_condition(arc["stop"], steps, problem.case.model))
     work.add(path.work)
-    for record, negative in zip(steps, path.unstable, strict=True):
-        record["negative_eigenvalues"] = negative  # of the tangent: 0 where stable
     for c in path.critical_points:
         say(f"  {c.kind} point at load factor {c.factor:.6g} (between {c.between[0]:.6g} "
             f"and {c.between[1]:.6g}, step {c.step})")
+    if path.stopped:
+        s = arc["stop"]
+        say(f"  stopped: probe {s['probe']!r} u_{s['component']} = "
+            f"{_probe_component(steps[-1], s, problem.case.model):.6g} has reached "
+            f"{s['value']:g}")
+    return _critical_points(path), "stop" if path.stopped else "target"
+
+
+def _critical_points(path) -> list[dict]:
     return [{"kind": c.kind, "load_factor": c.factor, "between": list(c.between),
              "step": c.step} for c in path.critical_points]
+
+
+def _probe_component(record: dict, stop: dict, model: str) -> float:
+    """The stop condition's displacement component in a step's record."""
+    from fenics_nl.case.spec import COMPONENTS
+
+    i = COMPONENTS[model].index(stop["component"])
+    return record["probes"][stop["probe"]]["displacement"][i]
+
+
+def _stop_condition(stop: dict | None, steps: list[dict], model: str):
+    """Whether the last converged step has reached `loading.stop` (None: no condition).
+
+    Reached: the component has gone from 0 to the value or beyond it, on its side.
+    """
+    if stop is None:
+        return None
+    return lambda: _probe_component(steps[-1], stop, model) / stop["value"] >= 1.0
 
 
 def step_record(problem: CaseProblem, t: float, result) -> dict:

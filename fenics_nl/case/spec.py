@@ -21,7 +21,7 @@ from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.vocabulary import canonical
 
-__all__ = ["Case", "CaseError", "Condition", "Probe", "read_case"]
+__all__ = ["Case", "CaseError", "Condition", "Probe", "arc_length_obstacles", "read_case"]
 
 FORMAT = """\
 [mesh]
@@ -84,6 +84,9 @@ adaptive = true          # optional: false stops at the first failed step instea
 # arc_length = 0.1       # the first arc length, > 0 (dimensionless: about one load step)
 # max_arc_length = 1.0   # optional: the largest (default: no bound)
 # max_steps = 100        # optional: steps before the run stops short of the target
+# stop = { probe = "inner", component = "r", value = 1.0 }   # optional: the run also ends
+#                        # (status ok) at the first step where this probe's displacement
+#                        # component has reached value: past a limit point, where λ falls
 
 [solver]                 # every key optional
 newton = "full"          # full | modified | periodic | bfgs | snes
@@ -328,20 +331,13 @@ def read_case(path: str | Path) -> Case:
         r.fail("solver.newton", '"snes" cannot run the contact active-set loop: use full, '
                                 "modified, periodic or bfgs")
     if arc is not None:
-        if newton == "snes":
-            r.fail("solver.newton", '"snes" has no arc-length control: use full, modified, '
-                                    "periodic or bfgs")
-        for c in conditions:
-            if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
-                r.fail(f"{c.key}", "arc-length control scales loads only: a contact or a "
-                                   "prescribed non-zero displacement cannot take part")
-        if law == "j2-finite":  # its commit may refuse a step, which only load steps cut
-            r.fail("loading.control", 'j2-finite is driven by load steps (its commit may '
-                                      'refuse a step too large, and a step is cut): remove '
-                                      'control = "arc-length"')
+        for key, message in arc_length_obstacles(law, newton, conditions):
+            r.fail(key, message)
     if law in DAMAGE:
-        _damage_limits(r, law, model, formulation, newton, linear, conditions, arc)
+        _damage_limits(r, law, model, formulation, newton, linear, conditions)
     probes = _probes(r, data, dim)
+    if arc is not None and arc["stop"] is not None and model is not None:
+        _check_stop(r, arc["stop"], probes, model)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
@@ -349,17 +345,35 @@ def read_case(path: str | Path) -> Case:
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation)
 
 
-def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, conditions,
-                   arc) -> None:
+def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
+                         ) -> list[tuple[str, str]]:
+    """Why a case cannot take control = "arc-length": (key, message) pairs, [] if it can."""
+    out = []
+    if newton == "snes":
+        out.append(("solver.newton", '"snes" has no arc-length control: use full, modified, '
+                                     "periodic or bfgs"))
+    for c in conditions:
+        if c.kind == "contact" or (c.kind == "displacement" and any(c.value or [])):
+            out.append((c.key, "arc-length control scales loads only: a contact or a "
+                               "prescribed non-zero displacement cannot take part"))
+    if law == "j2-finite":  # its commit may refuse a step, which only load steps cut
+        out.append(("loading.control", 'j2-finite is driven by load steps (its commit may '
+                                       'refuse a step too large, and a step is cut): remove '
+                                       'control = "arc-length"'))
+    if law in DAMAGE:
+        out.append(("loading.control", f"{law}: the damage is irreversible and the load "
+                                       "driven step by step: no arc-length control"))
+    return out
+
+
+def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, conditions
+                   ) -> None:
     """What a gradient damage case cannot have: each one line."""
     if model == "plane_stress":
         r.fail("mesh.model", f"{law} has no plane-stress form: use plane_strain, 3d or "
                              "axisymmetric")
     if formulation == "mixed":
         r.fail("mesh.formulation", f"{law} is in the displacement formulation only")
-    if arc is not None:
-        r.fail("loading.control", f"{law}: the damage is irreversible and the load driven "
-                                  "step by step: no arc-length control")
     if newton != "full" or linear != "lu":
         r.fail("solver.newton" if newton != "full" else "solver.linear",
                f"{law} is solved by alternate minimization, its u-solves by full Newton with "
@@ -526,7 +540,10 @@ def _loading(r: _Reader, data: dict):
     return factors, adaptive, None
 
 
-ARC_KEYS = ("target", "arc_length", "max_arc_length", "max_steps")
+ARC_KEYS = ("target", "arc_length", "max_arc_length", "max_steps", "stop")
+STOP_KEYS = ("probe", "component", "value")
+# the displacement components a stop condition names, per model (as in the load-path plot)
+COMPONENTS = {"3d": "xyz", "plane_strain": "xy", "plane_stress": "xy", "axisymmetric": "rz"}
 
 
 def _arc_length(r: _Reader, t: dict) -> dict | None:
@@ -542,10 +559,44 @@ def _arc_length(r: _Reader, t: dict) -> dict | None:
            "max_steps": r.get(t, "max_steps", "loading", int, default=100, minimum=1)}
     if arc["target"] == 0:
         r.fail("loading.target", "must not be 0 (the path starts there)")
+    arc["stop"] = _stop(r, t.get("stop"))
     top, first = arc["max_arc_length"], arc["arc_length"]
     if top is not None and first is not None and top < first:
         r.fail("loading.max_arc_length", f"must be >= arc_length ({first}), got {top}")
     return arc
+
+
+def _stop(r: _Reader, table) -> dict | None:
+    """`loading.stop`: a probe's displacement component that ends the path when reached.
+
+    Its probe and component are checked against the probes and the model later
+    (`_check_stop`).
+    """
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        r.fail("loading.stop", 'must be a table, e.g. { probe = "tip", component = "y", '
+                               "value = -1.0 }")
+        return None
+    r.unknown(table, "loading.stop", STOP_KEYS)
+    stop = {"probe": r.get(table, "probe", "loading.stop", str, required=True),
+            "component": r.get(table, "component", "loading.stop", str, required=True),
+            "value": r.get(table, "value", "loading.stop", float, required=True)}
+    if stop["value"] == 0:
+        r.fail("loading.stop.value", "must not be 0 (every displacement starts there)")
+    return None if None in stop.values() or stop["value"] == 0 else stop
+
+
+def _check_stop(r: _Reader, stop: dict, probes: list[Probe], model: str) -> None:
+    """The stop condition's probe is one of the case's, its component one of the model's."""
+    names = [p.name for p in probes]
+    if stop["probe"] not in names:
+        r.fail("loading.stop.probe", f"{stop['probe']!r} is not a [[probe]] of the case "
+                                     f"(it has: {', '.join(names) or 'none'})")
+    if stop["component"] not in COMPONENTS[model]:
+        r.fail("loading.stop.component", f"{stop['component']!r} is not a displacement "
+                                         f"component of the {model} model (one of "
+                                         f"{', '.join(COMPONENTS[model])})")
 
 
 def _probes(r: _Reader, data: dict, dim: int) -> list[Probe]:

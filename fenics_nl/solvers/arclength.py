@@ -130,6 +130,7 @@ class ContinuationPath:
     unstable: list[int] = field(default_factory=list)
     critical_points: list[CriticalPoint] = field(default_factory=list)
     switched: bool = False  # left a bifurcation along its mode
+    stopped: bool = False  # ended by `run`'s stop condition, not at the target
     failures: int = 0  # steps cut
     bracketing_steps: int = 0  # steps redone shorter to bracket a critical point
     inertia_factorizations: int = 0  # the stability checks' (not in `work`)
@@ -345,6 +346,9 @@ class ArcLength:
         self._largest = 0.0  # the largest first residual of a step: round-off's scale
         self._sense0 = 1.0  # the first step's sense of λ (towards the target)
         self._descending = False  # the target counts only when λ falls through it
+        # the path `run` follows, as far as it went (read it in `on_step`, or after a
+        # ContinuationError: its converged states and critical points stay)
+        self.path: ContinuationPath | None = None
 
     # -- the metric --------------------------------------------------------------------
 
@@ -542,8 +546,13 @@ class ArcLength:
             progress_every: int = 1,
             resume: ArcState | None = None,
             on_state: Callable[[ArcState], None] | None = None,
-            descending: bool = False) -> ContinuationPath:
+            descending: bool = False,
+            stop: Callable[[], bool] | None = None) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
+
+        `stop()`: asked after each converged step (after `on_step`); True ends the path
+        there, whatever λ (a condition on the state: a displacement reached on a falling
+        branch, where λ alone cannot say which side of the limit point the path is on).
 
         `descending`: only where λ falls through `target` (a softening branch past its limit
         point: the way up through the same λ goes on).
@@ -571,7 +580,7 @@ class ArcLength:
             self._weights.set(0.0)
             self._weights.array[self.metric_dofs[self.metric_dofs < x.getLocalSize()]] = 1.0
         if resume is None:
-            path = ContinuationPath()
+            path = self.path = ContinuationPath()
             self.set_load(start)
             self._largest = 0.0
             self._sense0 = math.copysign(1.0, target - start)  # the first step heads for it
@@ -580,6 +589,7 @@ class ArcLength:
                          self._sense0)
         else:
             path, walk, start = _path_from(resume.path), self._walk_from(resume), resume.start
+            self.path = path
             self.set_load(walk.lam)
         try:
             while len(path.factors) < max_steps:
@@ -590,6 +600,9 @@ class ArcLength:
                 if on_step:
                     on_step(walk.lam, result)
                 if step.landed:
+                    return path
+                if stop is not None and stop():
+                    path.stopped = True
                     return path
                 self._next_arc(walk, step)
                 if on_state:

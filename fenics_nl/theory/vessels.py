@@ -8,18 +8,27 @@ Hollow sphere a < r < b (exact for every ν: σ_eq = |σ_θ − σ_r|)::
 Cylinder, plane strain (Y = 2σ0/√3): limit Y ln(b/a) (exact); yield onset from Lamé with
 σ_z = ν(σ_r + σ_θ) (exact for every ν); c(p) = from p = Y ln(c/a) + (Y/2)(1 − c²/b²),
 which assumes σ_z = (σ_r + σ_θ)/2: exact for ν = 1/2 only.
+
+And an incompressible neo-Hookean sphere inflated (finite strain, exact): reference radii
+A < B, λ_a = a/A, λ_b = b/B with λ_b³ = 1 + (λ_a³ − 1) A³/B³ (the volume kept),
+
+    p = 2μ [(1/λ_b + 1/(4λ_b⁴)) − (1/λ_a + 1/(4λ_a⁴))],
+
+which rises to a maximum and falls: a limit point under pressure control.
 """
 
 from __future__ import annotations
 
 import math
 
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 __all__ = [
     "elastic_inner_compliance",
     "elastic_stresses",
     "limit_pressure",
+    "neo_hookean_sphere_maximum",
+    "neo_hookean_sphere_pressure",
     "plastic_radius",
     "residual_hoop_stress_inner",
     "sphere_inner_displacement",
@@ -109,3 +118,17 @@ def sphere_inner_displacement(a: float, b: float, E: float, nu: float, sigma0: f
     integral = (6 * sigma0 * (-c**3 / 9 - a**3 / 3 * math.log(a / c) + a**3 / 9)
                 + (2 * sigma0 - 3 * p_c) * (c**3 - a**3) / 3)
     return (c * c * u_c - (1 - 2 * nu) / E * integral) / (a * a)
+
+
+def neo_hookean_sphere_pressure(stretch: float, A: float, B: float, mu: float) -> float:
+    """p of the incompressible neo-Hookean sphere at the inner stretch λ_a = a/A (module)."""
+    lb = (1 + (stretch**3 - 1) * A**3 / B**3) ** (1 / 3)
+    return 2 * mu * ((1 / lb + 1 / (4 * lb**4)) - (1 / stretch + 1 / (4 * stretch**4)))
+
+
+def neo_hookean_sphere_maximum(A: float, B: float, mu: float) -> tuple[float, float]:
+    """(λ_a, p) at the pressure's maximum (B = 1.2 A: λ_a = 1.4702, p = 0.225138 μ)."""
+    best = minimize_scalar(lambda s: -neo_hookean_sphere_pressure(s, A, B, mu),
+                           bounds=(1.0, 10.0), method="bounded",
+                           options={"xatol": 1e-10})
+    return float(best.x), -float(best.fun)
