@@ -285,6 +285,16 @@ E = 1.0\nnu = 0.3\n[[boundary]]\ngroup = "x0"\ndisplacement = [0.0, 0.0]\n[loadi
     assert lines == ["error: mesh.model: 'plane_strain' needs a 2D mesh, bar.geo has 3D cells"]
 
 
+def test_a_3d_model_on_a_2d_mesh_is_that_line_alone(tmp_path, demo):
+    # the 2D cylinder's vectors have 2 components: counted against "3d" they were wrong
+    # too, and said first; the mesh's dimension is the one thing to say
+    text = (CASES / "thick_cylinder.toml").read_text().replace('"plane_strain"', '"3d"')
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    lines = check(demo, tmp_path, text)
+    assert lines == ["error: mesh.model: '3d' needs a 3D mesh, thick_cylinder.geo has 2D "
+                     "cells"]
+
+
 @pytest.mark.parametrize("change,message", [
     (('group = "end"', 'group = "tip"'), "'tip' is not a boundary group of the mesh (it has: "
                                          "end, x0, y0, z0)"),
@@ -1035,3 +1045,28 @@ def test_arc_length_is_advised_only_where_a_case_can_take_it(tmp_path, demo):
     error = [line for line in proc.stderr.splitlines() if line.startswith("error")]
     assert proc.returncode == 2 and len(error) == 1, proc.stderr
     assert "load factor 1 not reached" in error[0] and "arc-length" not in error[0]
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_loads_that_can_do_no_work_are_refused(tmp_path, demo, command):
+    # a pressure on the axis of an axisymmetric model (r = 0: no area), a traction along a
+    # held component, a pressure on a flat group held along its normal: each one line, in
+    # check as in run (before anything is solved)
+    text = (CASES / "inflated_sphere.toml").read_text() + (
+        '\n[[boundary]]\ngroup = "axis"\npressure = 1.0\n'
+        '\n[[boundary]]\ngroup = "equator"\ntraction = [0.5, 1.0]\n'
+        '\n[[boundary]]\ngroup = "equator"\npressure = 1.0\n')
+    (tmp_path / "inflated_sphere.geo").write_text((CASES / "inflated_sphere.geo").read_text())
+    proc = demo.run(["-m fenics_nl", command, write(tmp_path, "idle.toml", text)],
+                    check=False)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert lines == [
+        "error: boundary[4].pressure: 'axis' has no area in the axisymmetric model (r = 0 on "
+        "it): the load can do no work there",
+        "error: boundary[5].traction: 'equator' has u_z prescribed by a displacement "
+        "condition: the traction there can do no work (it would only change that support's "
+        "reaction); remove it or free u_z",
+        "error: boundary[6].pressure: 'equator' has u_z prescribed by a displacement "
+        "condition: the pressure there can do no work (it would only change that support's "
+        "reaction); remove it or free u_z"], lines

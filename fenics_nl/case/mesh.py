@@ -11,7 +11,7 @@ from fenics_nl.case.spec import Case, CaseError
 from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.domain.meshes import start_model
 
-__all__ = ["load_mesh"]
+__all__ = ["geometry_dimension", "load_mesh"]
 
 
 def load_mesh(case: Case, comm: MPI.Comm = MPI.COMM_WORLD) -> gmshio.MeshData:
@@ -28,6 +28,27 @@ def load_mesh(case: Case, comm: MPI.Comm = MPI.COMM_WORLD) -> gmshio.MeshData:
             raise CaseError([f"mesh.model: axisymmetric meshes lie in x >= 0 (x is the "
                              f"radius); {case.mesh_file.name} reaches x = {x_min:g}"])
     return data
+
+
+def geometry_dimension(path, comm: MPI.Comm = MPI.COMM_WORLD) -> int | None:
+    """The dimension of the geometry or mesh in a .geo/.msh file (None if gmsh cannot say).
+
+    Opened on rank 0 without meshing: a file that cannot fit the model is told before the
+    rest of the case is read against it.
+    """
+    dim = None
+    if comm.rank == 0:
+        try:
+            start_model("dimension")
+            gmsh.open(str(path))
+            dim = gmsh.model.getDimension()
+        except Exception:  # said by `load_mesh`, with gmsh's words
+            dim = None
+        finally:
+            if gmsh.model.list():
+                gmsh.model.remove()
+    dim = comm.bcast(dim, root=0)
+    return dim if dim is not None and dim >= 0 else None
 
 
 def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:

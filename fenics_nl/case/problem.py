@@ -76,6 +76,9 @@ class CaseProblem:
             self.material.bind(msh, q)
         self.residual = self._residual(data)
         self.force_scale = self._load_magnitude(data)
+        idle = self._idle_loads(data)
+        if idle:
+            raise CaseError(idle)
         self.bcs, self._prescribed = self._dirichlet()
         self.contact = self._contact()
         self.supports, self.held = self._supports()
@@ -153,6 +156,57 @@ class CaseProblem:
                                      "(in norms and energies) overflows floating point; use "
                                      "other units"])
         return total or None
+
+    def _idle_loads(self, data) -> list[str]:
+        """A line for each traction or pressure that can do no work, and why.
+
+        On a group of zero measure (the axis of an axisymmetric model, where r = 0), or on
+        a component that a displacement condition prescribes on every facet of the group
+        (it would only shift that support's reaction). A pressure acts along the normal:
+        idle where every component is held, or where a flat group's normal is along a held
+        axis. (Facets inside the body are refused with the groups.)
+        """
+        tag = {n: g.tag for n, g in data.physical_groups.items()}
+        comm, names = self.mesh.comm, "rz" if self.model == "axisymmetric" else "xyz"
+        boundary = comm.allreduce(fem.assemble_scalar(fem.form(self.weight * self.ds)))
+        out = []
+        for c in self.case.conditions:
+            if c.kind not in ("traction", "pressure"):
+                continue
+            area = comm.allreduce(fem.assemble_scalar(fem.form(self.weight
+                                                                * self.ds(tag[c.group]))))
+            if not area > 1e-12 * boundary:  # dimensionless: a share of the boundary
+                where = " (r = 0 on it)" if self.model == "axisymmetric" else ""
+                out.append(f"{c.key}: {c.group!r} has no area in the {self.model} model"
+                           f"{where}: the load can do no work there")
+                continue
+            held = self._held_everywhere(c.group)
+            if c.kind == "traction":
+                idle = [i for i, v in enumerate(c.value) if v and i in held]
+            else:
+                _, normal = self.mean_normal(c.group)
+                flat = [i for i, n in enumerate(normal) if abs(n) > 1 - 1e-9]
+                idle = (sorted(held) if len(held) == self.case.dim
+                        else [i for i in flat if i in held])
+            if idle:
+                comps = ", ".join(f"u_{names[i]}" for i in idle)
+                out.append(f"{c.key}: {c.group!r} has {comps} prescribed by a displacement "
+                           f"condition: the {c.kind} there can do no work (it would only "
+                           f"change that support's reaction); remove it or free {comps}")
+        return out
+
+    def _held_everywhere(self, group: str) -> set[int]:
+        """The components that displacement conditions prescribe on every facet of `group`."""
+        comm, facets = self.mesh.comm, self.facets[group]
+        held = set()
+        for i in range(self.case.dim):
+            covered = np.zeros(len(facets), dtype=bool)
+            for c in self.case.conditions:
+                if c.kind == "displacement" and c.value[i] is not None:
+                    covered |= np.isin(facets, self.facets[c.group])
+            if comm.allreduce(int((~covered).sum())) == 0:
+                held.add(i)
+        return held
 
     def _pressure_direction(self, c: Condition):
         """The reference normal N (dead), or J F⁻ᵀ N (follower) of the 2D or 3D model."""

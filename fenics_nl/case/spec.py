@@ -298,6 +298,8 @@ def read_case(path: str | Path) -> Case:
             r.fail("mesh.file", f"{file!r} must be a .msh or a .geo file")
         elif not mesh_file.is_file():
             r.fail("mesh.file", f"{mesh_file} not found")
+        elif model is not None:
+            _require_mesh_fits(mesh_file, model)
         if size is not None and mesh_file.suffix == ".msh":
             r.fail("mesh.size", "applies to a .geo only (a .msh is already meshed)")
     if degree is not None and degree > 3:
@@ -364,6 +366,20 @@ def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
         out.append(("loading.control", f"{law}: the damage is irreversible and the load "
                                        "driven step by step: no arc-length control"))
     return out
+
+
+def _require_mesh_fits(mesh_file: Path, model: str) -> None:
+    """CaseError, alone, if the mesh's dimension does not fit the model.
+
+    Every other line (the components of each vector, the supports) would count against the
+    wrong dimension and mislead: this is the one thing to say.
+    """
+    from fenics_nl.case.mesh import geometry_dimension
+
+    found, want = geometry_dimension(mesh_file), 3 if model == "3d" else 2
+    if found is not None and found != want:
+        raise CaseError([f"mesh.model: {model!r} needs a {want}D mesh, {mesh_file.name} has "
+                         f"{found}D cells"])
 
 
 def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, conditions
