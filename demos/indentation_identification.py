@@ -6,7 +6,7 @@
 # after Constantinescu & Tardieu, 2001). This demo fits the model's curve to a measured one by
 # Levenberg–Marquardt, with the curve's derivatives with respect to the parameters computed
 # through the whole load path by direct differentiation, and says how well the curve
-# determines each parameter.
+# determines each parameter, the fit's own discretisation included.
 #
 # ## Problem definition
 #
@@ -51,7 +51,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.io import cli
-from fenics_nl.io.parameters import Parameters, number, text
+from fenics_nl.io.parameters import Parameters, choice, number, text
 from fenics_nl.scenes import identification_pictures
 from fenics_nl.scenes.identification import (
     MeasuredCurve,
@@ -59,6 +59,7 @@ from fenics_nl.scenes.identification import (
     initial_guess,
     parse_names,
     parse_values,
+    refined_estimate,
     report,
 )
 from fenics_nl.scenes.indentation_test import IndentationTest
@@ -71,9 +72,6 @@ from fenics_nl.scenes.indentation_test import IndentationTest
 # notebook, the defaults: a synthetic experiment.
 
 # +
-FIT_MESH = {"block": 100.0, "quadrature_degree": 1}  # see "The model" below
-
-
 @dataclass
 class Identification(Parameters):
     """Identify J2 parameters (σ0, H; optionally E, C) from an indentation curve by
@@ -93,6 +91,9 @@ class Identification(Parameters):
     radius: float = number(1.0, "the sphere's radius R", unit="length", above=0)
     cone_angle: float | None = number(None, "a cone of this half-angle instead of the sphere "
                                       "(Berkovich: 70.3)", unit="degree", above=0, at_most=89)
+    gap: str = choice("parabola", ["parabola", "sphere"], "the sphere's shape, as in "
+                      "indentation.py: Hertz's parabola, or the exact sphere (a real "
+                      "indenter: give the curve's own)")
     fit: str = text("sigma0,hardening", "the parameters to fit, among sigma0, hardening, E, "
                     "kinematic", metavar="NAMES")
     initial: str | None = text(None, "their starting values, in --fit's order (default: "
@@ -112,9 +113,9 @@ class Identification(Parameters):
                               at_least=0)
     refine: int = number(0, "the fit's mesh: h = a/(20·2^refine) under the indenter (the "
                          "synthetic curve's: refine + 1)", at_least=0, at_most=4)
-    growth: float = number(0.2, "the fit's far field: elements grow by this fraction per "
-                           "element away from the indenter (0.05 for a measured curve: see "
-                           "the model)", unit="-", above=0, at_most=0.5)
+    growth: float = number(0.1, "the fit's far field: elements grow by this fraction per "
+                           "element away from the indenter (its check: half)", unit="-",
+                           above=0, at_most=0.5)
     max_points: int = number(12, "a denser measured curve is resampled to this many depths per "
                              "branch", at_least=3)
     map: int = number(5, "--plot: the misfit map's model runs per axis (0: no map)",
@@ -129,6 +130,8 @@ class Identification(Parameters):
                              "or --curve")
         if self.cone_angle is not None and self.radius != 1.0:
             raise ValueError("--radius is the sphere's: a cone (--cone-angle) has none")
+        if self.cone_angle is not None and self.gap == "sphere":
+            raise ValueError("--gap is the sphere's shape: a cone (--cone-angle) has none")
         self.steps = 6 if self.steps is None else self.steps
         self.noise = 0.01 if self.noise is None else self.noise
         self.seed = 1 if self.seed is None else self.seed
@@ -145,9 +148,10 @@ warnings = []
 # ### The measured curve
 #
 # A user's CSV file (units as they are: the parameters come out in the force's over the
-# depth's squared), or a synthetic experiment: the model's own curve **on a finer mesh**
-# (half the element size under the indenter) at the true parameters, with Gaussian noise of
-# `--noise` times the largest force, so that the fit does not invert its own discretisation.
+# depth's squared), or a synthetic experiment: the curve of `indentation.py`'s physics **on
+# another mesh** than the fit's and than its check's (half the element size under the
+# indenter, the far field graded by 7 % per element) at the true parameters, with Gaussian noise of `--noise` times the largest force, so that the fit does
+# not invert its own discretisation.
 
 # +
 true = None
@@ -164,9 +168,8 @@ else:
                              np.linspace(deepest, 0.5 * deepest, n_load // 2 + 1)[1:]])
     experiment = IndentationTest(E=args.E, nu=args.nu, sigma0=true["sigma0"],
                                  hardening=true["hardening"], max_depth=deepest,
-                                 radius=args.radius, cone_angle=args.cone_angle,
-                                 refine=args.refine + 1, growth=args.growth,
-                                 differentiate=(), **FIT_MESH)
+                                 radius=args.radius, cone_angle=args.cone_angle, gap=args.gap,
+                                 refine=args.refine + 1, growth=0.07, differentiate=())
     exact = experiment.run(depths, sensitivities=False).force
     noise = args.noise * exact.max() * np.random.default_rng(args.seed).standard_normal(
         len(depths))
@@ -178,27 +181,18 @@ else:
 
 # ### The model
 #
-# The block under the indenter on the fit's mesh, with $E$, $\sigma_0$, $H$, $C$ as
-# `fem.Constant`s: one set of compiled forms for every run of the fit. The mesh is a compromise
-# measured for this demo: under the indenter $h = a/20$; the far field grows by 20 % per
-# element (`--growth`) in a block of 100 contact radii, and one quadrature point per
-# triangle. Its curve is stiffer than one on a far field graded by 5 % (what `punch.py`
-# uses): a model error that the fit of such a curve turns into −4 % on σ0 and +20 % on H
-# (`benchmarks/identification.py`), because the two trade along the curve. Against the
-# synthetic curve, made on the same far field, it cancels; for a measured curve, a real
-# half-space, take `--growth 0.05` (about 3 times the run time).
+# `indentation.py`'s block under the indenter — the same shape of the sphere (`--gap`), a
+# block of 1000 contact radii, its quadrature — with $E$, $\sigma_0$, $H$, $C$ as
+# `fem.Constant`s: one set of compiled forms for every run of the fit. Only its mesh is
+# coarser: $h = a/20$ under the indenter (`--refine 0`) and a far field graded by 10 % per
+# element (`--growth`), 2.5 times faster than the forward demo's 5 %.
 
 # +
 measured.check_enough(len(args.names))
 model = IndentationTest(E=args.E, nu=args.nu, sigma0=1.0, hardening=0.0,
                         max_depth=float(measured.depth.max()), radius=args.radius,
-                        cone_angle=args.cone_angle, refine=args.refine,
-                        growth=args.growth, differentiate=tuple(args.names), **FIT_MESH)
-if args.curve is not None and args.growth > 0.05:
-    warnings.append(f"the fit's far field grows by {100 * args.growth:g} % per element: a "
-                    "stiffer model than a half-space (at 20 %, σ0 −4 % and H +20 % against a "
-                    "5 % grading, benchmarks/identification.py); --growth 0.05 for a measured "
-                    "curve")
+                        cone_angle=args.cone_angle, gap=args.gap, refine=args.refine,
+                        growth=args.growth, differentiate=tuple(args.names))
 initial = args.initial_values or (
     {n: (2 * true[n] if n == "sigma0" else 0.5 * true[n]) if n in true else
      {"E": args.E, "kinematic": 0.5 * true["hardening"]}[n] for n in args.names}
@@ -217,20 +211,45 @@ cli.say(f"model: {model.dofs} unknowns; fitting {', '.join(args.names)} from "
 
 fit = fit_curve(model, measured, args.names, initial, progress=cli.say)
 
+# ### The fit's discretisation, measured
+#
+# The fit's mesh has an error of its own. One run of the model on a finer mesh (`finer`:
+# $h$ halved, the far field graded twice as finely) at the fitted parameters $\theta$ gives
+# the finer model's curve $P_f(\theta)$; with the fit's Jacobian $J$, the least-squares
+# solution of $J\,\Delta\theta = P_f(\theta) - P(\theta)$ is how far the fit's model must move
+# to give the finer model's curve. The finer model's parameters are then
+# $\theta - \Delta\theta$ (a Gauss–Newton step of the finer model from the fit), and
+# $|\Delta\theta|$ joins the noise in their standard deviations: what the finer mesh still
+# leaves is smaller than what it corrected.
+
+finer = model.finer()
+refinement = refined_estimate(fit, args.names, measured, finer)
+cli.say(f"finer model: {refinement.dofs} unknowns; shift "
+        + ", ".join(f"{n} {100 * d / x:+.2f} %" for n, d, x in
+                    zip(args.names, refinement.shift, refinement.x, strict=True)))
+del finer
+
 # ## What the fit says
 #
-# The parameters and their standard deviations from $s^2 (J^TJ)^{-1}$, $s$ the residual's
-# noise, and their correlation: $\sigma_0$ and $H$ trade against each other along the curve
-# (a higher yield stress with less hardening gives nearly the same forces), so the correlation
-# is close to $-1$ and $H$ is known less well than $\sigma_0$. These spreads are those of the
-# linearised problem: the valley of $\Phi$ bends, and over 8 noise seeds the truth lay within
-# one of them in 6 fits, but 3.5 of them away in one (a genuine minimum of that noisy curve,
-# lower than the truth's misfit): read them as a scale, not as a guarantee. A parameter whose
-# standard deviation would exceed its value for a noise of 1 % of the largest force is *not
-# identifiable* from this curve: it is reported as such, not as a number.
+# The parameters and their standard deviations: $s^2 (J^TJ)^{-1}$, $s$ the residual's noise,
+# and the discretisation's shift, added in quadrature; their correlation: $\sigma_0$ and $H$
+# trade against each other along the curve (a higher yield stress with less hardening gives
+# nearly the same forces), so the correlation is close to $-1$ and $H$ is known less well than
+# $\sigma_0$. The noise's part is that of the linearised problem: the valley of $\Phi$ bends,
+# so read it as a scale, not as a guarantee (`benchmarks/identification.py` counts how often
+# the truth lies within it over noise seeds). A parameter whose standard deviation would
+# exceed half its value for a noise of 1 % of the largest force (its 95 % interval would reach
+# 0) is *not identifiable* from this curve: it is reported as such, not as a number.
 
 # +
-out = report(fit, args.names, measured)
+out = report(fit, args.names, measured, refinement)
+shifted = [n for i, n in enumerate(args.names)
+           if abs(refinement.shift[i]) > max(out[f"{n}_noise_std"] or 0, 0)
+           and out[n] is not None and abs(refinement.shift[i]) > 0.01 * abs(out[n])]
+if shifted:
+    warnings.append(f"the fit's mesh dominates the uncertainty of {', '.join(shifted)} (its "
+                    "shift to the finer model, in the standard deviation, exceeds the noise's "
+                    f"and 1 %): --refine {args.refine + 1} would narrow it")
 for n in args.names:
     if out[n] is None:
         warnings.append(f"{n} is not identifiable from this curve: 1 % noise would leave it "
@@ -268,6 +287,7 @@ out |= {"iterations": fit.iterations, "forward_solves": fit.evaluations,
                   "initial": (measured.force + fit.initial_residuals).tolist()},
         "synthetic": true is not None, "noise_level": args.noise if true else None,
         "sensitivity_solves": model.sensitivity.work.linear_solves,
+        "finer_model_dofs": refinement.dofs,
         "stress_unit": "stress", "dofs": model.dofs, "ranks": MPI.COMM_WORLD.size,
         "warnings": warnings}
 

@@ -64,7 +64,8 @@ class IndentationTest:
         max_depth: the deepest indentation, for the mesh: the contact radius it is graded
             for is √(R δ) (sphere) or 2 δ tan α / π (cone, Sneddon's), with pile-up room.
         radius: the sphere's radius R; `cone_angle`: a cone of this half-angle (degrees)
-            instead of the sphere.
+            instead of the sphere. `gap`: the sphere's shape, ``parabola`` (Hertz's, as
+            `demos/indentation.py` by default) or ``sphere`` (exact).
         refine, block: the block's mesh (`punch.PunchBlock`: h = a/(20·2^refine) under the
             indenter, the block `block` contact radii deep and wide).
         differentiate: the parameters whose dP/dθ a run with sensitivities carries.
@@ -72,7 +73,8 @@ class IndentationTest:
 
     def __init__(self, *, E: float, nu: float, sigma0: float, hardening: float,
                  kinematic: float = 0.0, max_depth: float, radius: float = 1.0,
-                 cone_angle: float | None = None, refine: int = 0, block: float = 200.0,
+                 cone_angle: float | None = None, gap: str = "parabola",
+                 refine: int = 0, block: float = 1000.0,
                  growth: float | None = None, quadrature_degree: int | None = None,
                  differentiate: tuple[str, ...] = ("sigma0", "hardening"),
                  comm: MPI.Comm = MPI.COMM_WORLD):
@@ -82,6 +84,12 @@ class IndentationTest:
                              f"parameters are {', '.join(PARAMETERS)}")
         if not max_depth > 0:
             raise ValueError(f"the largest depth must be > 0, got {max_depth!r}")
+        # what `finer` builds again, on a finer mesh
+        self._options = {"E": E, "nu": nu, "sigma0": sigma0, "hardening": hardening,
+                         "kinematic": kinematic, "max_depth": max_depth, "radius": radius,
+                         "cone_angle": cone_angle, "gap": gap, "refine": refine,
+                         "block": block, "growth": growth,
+                         "quadrature_degree": quadrature_degree, "comm": comm}
         if cone_angle is None:
             a = math.sqrt(radius * max_depth)
         else:
@@ -98,13 +106,21 @@ class IndentationTest:
         self.material.bind(b.mesh, b.quadrature_degree)
         residual = b.residual(self.material)
         self.punch = Punch(b, self.material, residual, radius,
-                           gap="sphere" if cone_angle is None else "cone",
+                           gap=gap if cone_angle is None else "cone",
                            cone_angle=cone_angle or BERKOVICH)
         self.differentiate = tuple(differentiate)
         self.sensitivity = PathSensitivity(
             residual, b.u, self.punch.contact.newton, self.material.state_functions(),
             self.material.state_update(kinematics.small_strain(b.u, b.kinematics)),
             {k: c[k] for k in self.differentiate}) if differentiate else None
+
+    def finer(self) -> IndentationTest:
+        """The same model on a finer mesh, without sensitivities: h halved under the
+        indenter (refine + 1), the far field graded twice as finely (growth / 2)."""
+        o = dict(self._options)
+        o["growth"] = (o["growth"] or self.block.growth) / 2
+        o["refine"] += 1
+        return IndentationTest(**o, differentiate=())
 
     @property
     def dofs(self) -> int:

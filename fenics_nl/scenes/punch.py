@@ -144,6 +144,7 @@ class PunchBlock:
         # same errors); 3D 10 %
         if growth is None:
             growth = {"axisymmetric": 0.05, "plane_strain": 0.20, "3d": 0.10}[model]
+        self.growth = growth
         L = block * a
         data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth, both_sides=tangential)
         self.tangential = tangential
