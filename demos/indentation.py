@@ -130,7 +130,7 @@ p = material.cumulated_plastic_strain
 plastic_strain = global_max(block.mesh.comm,
                             p.x.array[:p.function_space.dofmap.index_map.size_local])
 cli.say(f"largest cumulated plastic strain {plastic_strain:.4g}")
-drawn = punch_run.pictures(args, punch, load.states, check)
+drawn = punch_run.pictures(args, punch, load.states, check, plastic=True)
 # -
 
 # ### The imprint

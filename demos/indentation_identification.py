@@ -102,7 +102,7 @@ class Identification(Parameters):
                                metavar="VALUES")
     true: str = text(None, "synthetic: the true SIGMA0,H (default 0.02E,0.1E)",
                      metavar="SIGMA0,H")
-    depth: float | None = number(None, "synthetic: the deepest indentation (default 0.05 R; "
+    depth: float | None = number(None, "synthetic: the deepest indentation (default 0.08 R; "
                                  "cone: 0.05)", unit="length", above=0)
     steps: int | None = number(None, "synthetic: loading depths, default 6 (unloading: half "
                                "as many, to half the depth)", at_least=2)
@@ -150,8 +150,9 @@ warnings = []
 # A user's CSV file (units as they are: the parameters come out in the force's over the
 # depth's squared), or a synthetic experiment: the curve of `indentation.py`'s physics **on
 # another mesh** than the fit's and than its check's (half the element size under the
-# indenter, the far field graded by 7 % per element) at the true parameters, with Gaussian noise of `--noise` times the largest force, so that the fit does
-# not invert its own discretisation.
+# indenter, the far field graded by 7 % per element) at the true parameters, with Gaussian
+# noise of `--noise` times the largest force, so that the fit does not invert its own
+# discretisation.
 
 # +
 true = None
@@ -162,7 +163,7 @@ if args.curve is not None:
                         f"{len(measured.depth)} depths (--max-points {args.max_points})")
 else:
     true = args.true_values
-    deepest = args.depth or 0.05 * (args.radius if args.cone_angle is None else 1.0)
+    deepest = args.depth or (0.08 * args.radius if args.cone_angle is None else 0.05)
     n_load = args.steps
     depths = np.concatenate([np.linspace(deepest / n_load, deepest, n_load),
                              np.linspace(deepest, 0.5 * deepest, n_load // 2 + 1)[1:]])

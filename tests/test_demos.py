@@ -621,15 +621,20 @@ def identification_recovers_sigma0_and_hardening_within_their_spread(d):
     """What `demos/indentation_identification.py`'s page run must show (checked on that
     run in `tests/test_notebooks.py`: one run for both).
 
-    The demo's synthetic experiment: a finer model's curve with 1 % noise, the fit started
+    The demo's synthetic experiment: a curve on another mesh with 1 % noise, the fit started
     a factor 2 off; σ0 and H within their standard deviations (the seed is fixed: about two
     seeds in three do so for both, as for any 1σ interval), the curve's fit as good as its
-    noise, H strongly anti-correlated with σ0.
+    noise, H strongly anti-correlated with σ0; the values the finer model's, the deviations
+    the noise's and the shift to it.
     """
     assert d["converged"] and d["synthetic"]
     for name in ("sigma0", "hardening"):
         assert abs(d[f"{name}_error_in_std"]) <= 1, d
         assert 0 < d[f"{name}_std"] < 0.5 * d[name]
+        assert d[name] == pytest.approx(d[f"{name}_fit_model"]
+                                        - d[f"{name}_discretisation_shift"])
+        assert d[f"{name}_std"] == pytest.approx(math.hypot(
+            d[f"{name}_noise_std"], d[f"{name}_discretisation_shift"]))
     assert -1 < d["correlation"] < -0.9
     assert d["noise"] == pytest.approx(0.01 * max(d["curve"]["measured"]), rel=0.5)
     assert d["forward_solves"] <= 12 and d["iterations"] >= 3

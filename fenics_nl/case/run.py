@@ -365,10 +365,10 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                         arrows[f"{c.group} (pressure)"] = (
                             facet_points(problem.mesh, problem.facets[c.group]),
                             -t * c.value * normal)
-            labels = {}  # each probe's σ_eq at its point (the colours are per cell)
+            labels = {}  # each probe's σ_eq at its point: not a cell's mean, as the colours
             if problem.case.probes and out["steps"]:
                 values = out["steps"][-1]["probes"]
-                labels = {f"{p.name}: {values[p.name]['von_mises']:.4g}": p.point
+                labels = {f"{p.name}: {values[p.name]['von_mises']:.4g} at the point": p.point
                           for p in problem.case.probes}
             title = (f"{problem.case.path.name}: load factor {t:.3g}, "
                      f"{problem.case.law}, {problem.case.model}")
@@ -381,9 +381,11 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                 focus = moved[c.owned & c.active][:, : problem.case.dim]
                 obstacle = problem.obstacle_at(float(problem.t.value))
                 title += f", {S.count(c.active)} nodes in contact"
+            names = "rz" if problem.model == "axisymmetric" else "xy"
             deformed_picture(problem.displacement(), vm, png, title, marked, arrows, focus,
-                             obstacle, label="von Mises stress (per cell)", labels=labels,
-                             detail=focus is None)
+                             obstacle, label="von Mises stress (the mean over each cell)",
+                             labels=labels, detail=focus is None,
+                             axes=(f"{names[0]} (length)", f"{names[1]} (length)"))
             say(f"wrote {png}")
         writers.append(picture)
     return writers

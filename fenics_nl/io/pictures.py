@@ -156,7 +156,8 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                      arrows: dict[str, np.ndarray] | None = None,
                      focus: np.ndarray | None = None, obstacle: dict | None = None,
                      label: str = "von Mises stress", labels: dict | None = None,
-                     detail: bool = False, curves: dict | None = None) -> None:
+                     detail: bool = False, curves: dict | None = None,
+                     axes: tuple[str, str] | None = None) -> None:
     """The deformed body (2D or 3D) coloured by σ_eq (or the `label`led cell field `vm`).
 
     `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
@@ -170,7 +171,8 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
     cell of the largest value is a small feature (smaller than 3 % of the body: a hole, a
     notch), a second view beside the first zooms on it. `curves`: name → points of a line
     in the undeformed body (a closed form's boundary, the same on every rank), drawn where
-    the deformation takes them.
+    the deformation takes them. `axes`: a 2D body's axis titles (e.g. "r (length)",
+    "z (length)"), drawn with their ticks.
     The displacement is magnified until the largest motion is 5 % of the body (said in
     the picture). Collective; rank 0 writes `path`.
     """
@@ -254,14 +256,27 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                       render_points_as_spheres=True)
         legend.append("white dots: nodes in contact")
     if obstacle:
-        _draw_obstacle(pl, pv, obstacle, flat, mesh.bounds)
+        _draw_obstacle(pl, pv, obstacle, flat, warped.bounds)  # the body as drawn
         legend.append(f"red: the rigid {obstacle['obstacle']}")
     if legend:
         pl.add_text("\n".join(legend), font_size=10, position="upper_right")
+    if flat and axes:
+        both = np.array([mesh.bounds, warped.bounds])  # the outline's and the body's
+        box = [0.0 if abs(v) < 1e-9 * size else float(v) for v in  # no round-off at 0
+               np.ravel([both[:, ::2].min(axis=0), both[:, 1::2].max(axis=0)], order="F")]
+        pl.show_bounds(bounds=box, xtitle=axes[0], ytitle=axes[1],
+                       show_zaxis=False, show_zlabels=False, location="outer", font_size=12,
+                       color="black", n_xlabels=5, n_ylabels=5, fmt="%.3g")
     if flat:
         pl.view_xy()
     else:
         pl.view_vector((1.0, -1.6, 0.9))
+    if flat and axes:  # the body up a little and smaller: its axes' titles above the bar
+        cam = pl.camera
+        shift = np.array([0.0, 0.12 * (box[3] - box[2]), 0.0])
+        cam.focal_point = np.array(cam.focal_point) - shift
+        cam.position = np.array(cam.position) - shift
+        cam.zoom(0.85)
     pl.add_text(f"{title}\ndeformed x{scale:.3g} (grey: undeformed); largest displacement "
                 f"{u_max:.3g}", font_size=11, position="upper_left")
     pl.screenshot(path)
@@ -329,9 +344,10 @@ def _draw_obstacle(pl, pv, ob: dict, flat: bool, bounds) -> None:
     p0 = _as_3d(np.asarray(ob["point"], dtype=float)[None, :])[0]
     n = _as_3d(np.asarray(ob["normal"], dtype=float)[None, :])[0]
     n /= np.linalg.norm(n)
-    if flat:
+    if flat:  # across the body's width only: a die ends where the body does (the axis)
         d = np.array([-n[1], n[0], 0.0])
-        pl.add_mesh(pv.Line(p0 - span * d, p0 + span * d), color="red", line_width=3)
+        ends = sorted(float((x - p0) @ d) for x in (lo, hi))
+        pl.add_mesh(pv.Line(p0 + ends[0] * d, p0 + ends[1] * d), color="red", line_width=3)
     else:
         pl.add_mesh(pv.Plane(center=p0, direction=n, i_size=2 * span, j_size=2 * span),
                     color="red", opacity=0.35)

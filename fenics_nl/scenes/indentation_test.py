@@ -115,8 +115,11 @@ class IndentationTest:
             {k: c[k] for k in self.differentiate}) if differentiate else None
 
     def finer(self) -> IndentationTest:
-        """The same model on a finer mesh, without sensitivities: h halved under the
-        indenter (refine + 1), the far field graded twice as finely (growth / 2)."""
+        """The same model on a finer mesh, without sensitivities.
+
+        h halved under the indenter (refine + 1), the far field graded twice as finely
+        (growth / 2).
+        """
         o = dict(self._options)
         o["growth"] = (o["growth"] or self.block.growth) / 2
         o["refine"] += 1

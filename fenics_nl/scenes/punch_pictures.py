@@ -38,6 +38,7 @@ class PunchRun:
             radii and the force inside each), computed on every rank.
         stick_radius_exact: Cattaneo–Mindlin's c for the computed load, if known.
         loading_steps: the states that load the punch (those after it unload it).
+        plastic: the block flows (J2): Hertz is the elastic reference, not a check.
     """
 
     punch: object
@@ -53,6 +54,7 @@ class PunchRun:
     traction_profile: tuple | None = None
     stick_radius_exact: float | None = None
     loading_steps: int | None = None
+    plastic: bool = False
     model: str = field(init=False)
     state: object = field(init=False)  # the drawn state: the last one at `snapshot`
     profile: tuple | None = field(init=False, default=None)
@@ -113,6 +115,11 @@ def _checked(run: PunchRun, state) -> str:
         return f"{run.model} punch: no contact (δ = {state.indentation:.3g})"
     a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
     p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
+    if run.plastic and not run.force_controlled:  # Hertz: the elastic reference
+        return (f"{run.model} J2 punch, δ = {state.indentation:.3g}: P = {state.force:.4g}, "
+                f"{state.force / ref['force']:.3f} × elastic Hertz's (the block flows); "
+                f"contact radius {state.contact_radius / ref['contact_radius']:.3f} ×, "
+                f"peak pressure {state.max_pressure / ref['max_pressure']:.3f} ×")
     if run.model == "plane_strain":
         return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
                 f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")

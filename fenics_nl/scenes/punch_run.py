@@ -210,7 +210,7 @@ def summary(args: PunchParameters, punch: Punch, states: list, loading: list, no
 
 
 def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=None,
-             traction=None, stick_radius_exact=None) -> list:
+             traction=None, stick_radius_exact=None, plastic: bool = False) -> list:
     """The writers of --plot and --png, drawing the state at hand (collective).
 
     States added to `states` later (an unloading) join the curve only.
@@ -228,7 +228,7 @@ def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=No
         punch, states, check.ref, args.E, args.nu, args.radius, mixed=args.mixed,
         force_controlled=args.force is not None, friction=friction, traction=traction,
         traction_profile=profile, stick_radius_exact=stick_radius_exact,
-        loading_steps=len(states))
+        loading_steps=len(states), plastic=plastic)
     run.snapshot(section=bool(args.png))
     writers = []
     if args.plot:  # (--output: the fields of every step were written as they converged)

@@ -32,6 +32,7 @@ def billet_picture(up, path: str, title: str) -> None:
     pictures.deformed_picture(
         up.billet.displacement(), up.material.cumulated_plastic_strain_per_cell(), path,
         title, marked=marked, label="cumulated plastic strain p",
+        axes=("r (length)", "z (length)"),
         obstacle={"obstacle": "plane", "point": [0.0, top], "normal": [0.0, 1.0]})
 
 

@@ -475,7 +475,8 @@ class ArcLength:
                     b_old.destroy()
                     b_old = None
                 if not math.isfinite(rnorm) or rnorm > s.divergence_tol * max(norms[0], 1e-300):
-                    raise _StepFailed(f"residual {rnorm:.3e} at iteration {k}")
+                    raise _StepFailed(f"the corrector diverged: |R| = {rnorm:.3e} at "
+                                      f"iteration {k}")
                 self._largest = max(self._largest, norms[0])
                 threshold = max(s.rtol * norms[0], s.atol * c.q_norm)
                 if on_arc and (rnorm <= threshold
@@ -794,7 +795,8 @@ class ArcLength:
                 f"the path could not be followed beyond load factor {lam:.6g}: {err}{back}; "
                 f"arc length cut below {self.min_arc_length:g}",
                 SolveResult(False, "arc", len(norms), norms, work), reached=lam)
-        say(f"  step from λ = {lam:.4g} failed ({err}); arc cut to {ds / 2:.3g}")
+        say(f"  the step from λ = {lam:.4g} is not taken ({err}): retried with the arc "
+            f"halved, {ds / 2:.3g}")
         return ds / 2
 
     def _stability(self, path: ContinuationPath, du: PETSc.Vec | None = None,

@@ -143,7 +143,8 @@ def solve_incrementally(
                                     err.result, reached=t, target=t + dt) from err
             dt /= 2
             if progress:
-                progress(f"  step to t = {t + 2 * dt:.4g} failed ({err}); cut to dt = {dt:.4g}")
+                progress(f"  the step to t = {t + 2 * dt:.4g} is not taken ({err}): retried "
+                         f"as two of dt = {dt:.4g}")
             continue
         t += dt
         if predictor:

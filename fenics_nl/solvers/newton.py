@@ -614,8 +614,8 @@ class NewtonSolver:
                                        f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})"
                                        + _round_off_hint(norms), result(False, "max_it"))
             if rnorm > self.divergence_tol * norms[0]:
-                raise ConvergenceError(f"residual blew up at iteration {k} "
-                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})",
+                raise ConvergenceError(f"Newton diverged: |R| grew from {norms[0]:.3e} to "
+                                       f"{rnorm:.3e} at iteration {k}",
                                        result(False, "diverged"))
             try:
                 self.update_tangent(k, work)
