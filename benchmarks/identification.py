@@ -191,8 +191,8 @@ def table(out):
         lines.append("")
         lines.append(
             f"Over {n} noise seeds (1 %, δ = {REFERENCE}), the truth is within one "
-            f"reported standard deviation for σ0 in {sum(w[0] for w in s['within_1'])} fits and for H in "
-            f"{sum(w[1] for w in s['within_1'])} (68 % expected), within two in "
+            f"reported standard deviation for σ0 in {sum(w[0] for w in s['within_1'])} "
+            f"fits and for H in {sum(w[1] for w in s['within_1'])} (68 % expected), within two in "
             f"{sum(w[0] for w in s['within_2'])} and {sum(w[1] for w in s['within_2'])} "
             f"(95 % expected); the largest errors are {s['largest_in_std'][0]:.2f} and "
             f"{s['largest_in_std'][1]:.2f} standard deviations.")
