@@ -25,7 +25,7 @@ mathjax_path = "mathjax/tex-chtml.js"
 myst_enable_extensions = ["dollarmath", "amsmath"]
 myst_heading_anchors = 3  # [..](#which-method-when) links inside a page
 nb_execution_mode = "off"  # docs/notebooks.py ran them, as a user would
-exclude_patterns = ["_build", "screenshots", "**.ipynb_checkpoints"]
+exclude_patterns = ["_build", "_generated", "screenshots", "**.ipynb_checkpoints"]
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_default_options = {"members": True, "show-inheritance": True}
@@ -50,5 +50,15 @@ def _escape_bars(app, what, name, obj, options, lines):
         lines[i] = "".join(p if p.startswith("`") else p.replace("|", "\\|") for p in parts)
 
 
+def _generate(app):
+    """The pages' tables made from the code: the case format's keys (cases.md)."""
+    from fenics_nl.case.spec import key_table
+
+    out = Path(app.srcdir) / "_generated"
+    out.mkdir(exist_ok=True)
+    (out / "case_keys.md").write_text(key_table())
+
+
 def setup(app):
+    app.connect("builder-inited", _generate)
     app.connect("autodoc-process-docstring", _escape_bars)

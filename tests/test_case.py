@@ -1070,3 +1070,38 @@ def test_loads_that_can_do_no_work_are_refused(tmp_path, demo, command):
         "error: boundary[6].pressure: 'equator' has u_z prescribed by a displacement "
         "condition: the pressure there can do no work (it would only change that support's "
         "reaction); remove it or free u_z"], lines
+
+
+def test_every_key_of_the_format_is_in_the_documented_table_and_the_reader():
+    # the documentation's table (spec.KEYS) and the annotated format (FORMAT, --help) name
+    # the same keys; each key of the table is one a case file may hold
+    import re
+
+    from fenics_nl.case.spec import FORMAT, KEYS, key_table
+
+    written = set(re.findall(r"^\s*#?\s*([a-zA-Z_0-9]+)\s*=", FORMAT, re.M))
+    named = {key for _, key, *_ in KEYS}
+    assert written <= named, written - named
+    for key in named:  # the laws' parameters are named in FORMAT's prose
+        assert re.search(rf"\b{key}\b", FORMAT), key
+    table = key_table().splitlines()
+    assert len(table) == 2 + len(KEYS) and all(line.count("|") == 5 for line in table)
+
+
+def test_a_case_refines_its_mesh_near_named_groups(tmp_path, demo):
+    # cells of 0.3 within 1 of the bore, the mesh's own 1.5 beyond: more unknowns, the same
+    # Lamé answer closer (measured 5e-5 -> below), and a group that is not there named
+    text = (CASES / "thick_cylinder.toml").read_text().replace(
+        "degree = 2", 'degree = 2\nrefine_near = { groups = ["inner"], size = 0.3, '
+                      "distance = 1.0 }")
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    fine = demo.case(write(tmp_path, "near.toml", text))
+    plain = demo.case(CASES / "thick_cylinder.toml")
+    assert fine["dofs"] > 2 * plain["dofs"]
+    exact = lame(10.0)
+    u_fine = fine["probes"]["inner"]["displacement"][0]
+    u_plain = plain["probes"]["inner"]["displacement"][0]
+    assert abs(u_fine / exact - 1) < abs(u_plain / exact - 1)
+    lines = check(demo, tmp_path, text.replace('groups = ["inner"]', 'groups = ["bore"]'))
+    assert lines == ["error: mesh.refine_near.groups: 'bore' is not a boundary group of the "
+                     "geometry (it has: inner, outer, symmetry_x, symmetry_y)"], lines

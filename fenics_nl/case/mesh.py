@@ -51,6 +51,41 @@ def geometry_dimension(path, comm: MPI.Comm = MPI.COMM_WORLD) -> int | None:
     return dim if dim is not None and dim >= 0 else None
 
 
+def _refine_near(refine: dict, dim: int, largest: float | None) -> str | None:
+    """A gmsh size field: `size` within `distance` of the groups, then growing linearly to
+    the mesh's own size over another `distance`; the message if a group is not a boundary
+    group of the geometry (None if it is done).
+
+    The mesh's own size: `largest` (mesh.size) if given, else the largest of the geometry's
+    point sizes, else a tenth of its bounding box.
+    """
+    have = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in
+            gmsh.model.getPhysicalGroups(dim - 1)}
+    missing = [g for g in refine["groups"] if g not in have]
+    if missing:
+        return (f"mesh.refine_near.groups: {', '.join(map(repr, missing))} is not a boundary "
+                f"group of the geometry (it has: {', '.join(sorted(have)) or 'none'})")
+    entities = [e for g in refine["groups"]
+                for e in gmsh.model.getEntitiesForPhysicalGroup(*have[g])]
+    field = gmsh.model.mesh.field
+    distance = field.add("Distance")
+    field.setNumbers(distance, "CurvesList" if dim == 2 else "SurfacesList", entities)
+    field.setNumber(distance, "Sampling", 200)
+    threshold = field.add("Threshold")
+    field.setNumber(threshold, "InField", distance)
+    field.setNumber(threshold, "SizeMin", refine["size"])
+    if largest is None:
+        points = gmsh.model.getEntities(0)
+        sizes = [v for v in gmsh.model.mesh.getSizes(points) if v > 0] if points else []
+        box = np.array(gmsh.model.getBoundingBox(-1, -1))
+        largest = max(sizes) if sizes else 0.1 * float(np.linalg.norm(box[3:] - box[:3]))
+    field.setNumber(threshold, "SizeMax", max(largest, refine["size"]))
+    field.setNumber(threshold, "DistMin", refine["distance"])
+    field.setNumber(threshold, "DistMax", 2 * refine["distance"])
+    field.setAsBackgroundMesh(threshold)
+    return None
+
+
 def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
     """The mesh, built and checked on rank 0, then distributed.
 
@@ -68,10 +103,15 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
             if case.mesh_file.suffix == ".geo" and dim >= 0:
                 if case.mesh_size is not None:
                     gmsh.option.setNumber("Mesh.MeshSizeMax", case.mesh_size)
-                gmsh.model.mesh.generate(dim)
+                if case.refine_near is not None:
+                    error = _refine_near(case.refine_near, dim, case.mesh_size)
+                if error is None:
+                    gmsh.model.mesh.generate(dim)
             logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
             gmsh.logger.stop()
-            if logged or dim < 0:
+            if error is not None:  # said already
+                logged = []
+            elif logged or dim < 0:
                 error = (f"mesh.file: gmsh cannot {action} {name}: "
                          f"{logged[0] if logged else 'no geometry in it'}")
             elif dim != case.dim:

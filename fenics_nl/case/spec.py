@@ -21,12 +21,16 @@ from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.vocabulary import canonical
 
-__all__ = ["Case", "CaseError", "Condition", "Probe", "arc_length_obstacles", "read_case"]
+__all__ = ["KEYS", "Case", "CaseError", "Condition", "Probe", "arc_length_obstacles",
+           "key_table", "read_case"]
 
 FORMAT = """\
 [mesh]
 file = "part.geo"        # .msh, or .geo meshed by gmsh at run time (path relative to the case)
 size = 2.0               # .geo only, optional: largest element size (gmsh Mesh.MeshSizeMax)
+refine_near = { groups = ["inner"], size = 0.2, distance = 1.0 }   # .geo only, optional:
+                         # cells of size 0.2 within 1.0 of these boundary groups, growing
+                         # to the mesh's own size over another 1.0
 model = "plane_strain"   # 3d | plane_strain | plane_stress | axisymmetric (x = r, y = z)
 degree = 2               # Lagrange degree of the displacement (default 1)
 formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Hood u–p: no
@@ -100,6 +104,89 @@ max_iterations = 50      # Newton iterations per step
 name = "tip"
 point = [10.0, 1.0]
 """
+
+# every key of the format: (table, key, meaning, default, unit); the documentation's table
+# (`key_table`), checked against FORMAT and the reader by the tests. Units are the case's
+# own, consistent (N, mm, MPa or N, m, Pa, ...); "—": a number without one, or a word
+KEYS = [
+    ("mesh", "file", "the mesh: a .msh, or a .geo meshed by gmsh at run time (path relative "
+     "to the case)", "required", "—"),
+    ("mesh", "size", ".geo only: the largest element size (gmsh's Mesh.MeshSizeMax)",
+     "the .geo's", "length"),
+    ("mesh", "refine_near", ".geo only: `{ groups = [...], size, distance }`, cells of `size` "
+     "within `distance` of these boundary groups, growing to the mesh's own size over "
+     "another `distance`", "none", "length"),
+    ("mesh", "model", "`3d`, `plane_strain`, `plane_stress` or `axisymmetric` (x = r, y = z)",
+     "required", "—"),
+    ("mesh", "degree", "the displacement's Lagrange degree: 1, 2 or 3", "1", "—"),
+    ("mesh", "formulation", "`displacement`, or `mixed`: Taylor–Hood u–p (degree ≥ 2, not "
+     "plane stress), no locking as ν → 0.5, ν = 0.5 allowed", "displacement", "—"),
+    ("material", "law", "`linear-elastic`, `power-law`, `saint-venant-kirchhoff`, "
+     "`neo-hookean`, `j2`, `j2-finite`, `at1` or `at2`", "required", "—"),
+    ("material", "E", "Young's modulus, > 0", "required", "stress"),
+    ("material", "nu", "Poisson's ratio, −1 < ν ≤ 0.5 (0.5: the mixed formulation)",
+     "required", "—"),
+    ("material", "sigma0", "power-law: its reference stress; j2, j2-finite: the yield stress",
+     "required there", "stress"),
+    ("material", "n", "power-law: its exponent (1: Hooke's law)", "required there", "—"),
+    ("material", "H", "j2, j2-finite: the linear isotropic hardening modulus", "0", "stress"),
+    ("material", "C", "j2: the kinematic hardening modulus", "0", "stress"),
+    ("material", "saturation", "j2-finite: Voce's saturation stress, σ_y = σ0 + H p + "
+     "(saturation − σ0)(1 − e^(−delta p))", "none", "stress"),
+    ("material", "delta", "j2-finite: Voce's rate", "0", "—"),
+    ("material", "Gc", "at1, at2: the toughness (energy per unit crack area)", "required there",
+     "energy / area"),
+    ("material", "ell", "at1, at2: the damage length (cells at most ell/2 where a crack goes)",
+     "required there", "length"),
+    ("material", "residual_stiffness", "at1, at2: what a broken cell keeps", "1e-6", "—"),
+    ("material", "split", "at1, at2: `none`, or `volumetric` (no damage under volumetric "
+     "compression)", "none", "—"),
+    ("boundary", "group", "a boundary physical group of the mesh", "required", "—"),
+    ("boundary", "displacement", "one value per component, or `\"free\"`; scaled by the load "
+     "factor", "—", "length"),
+    ("boundary", "traction", "force per unit area (per unit length in 2D) of the reference "
+     "configuration, dead; scaled by the load factor", "—", "stress"),
+    ("boundary", "pressure", "normal pressure, positive pushing on the body; scaled by the "
+     "load factor", "—", "stress"),
+    ("boundary", "follower", "the pressure follows the deformed normal (finite strain)",
+     "false", "—"),
+    ("boundary", "contact", "one rigid frictionless obstacle: `{ obstacle = \"plane\", point, "
+     "normal }` or `{ obstacle = \"sphere\", center, radius }`, and a `displacement` "
+     "scaled by the load factor", "—", "length"),
+    ("loading", "steps", "load control: n equal steps to the load factor 1, or a list of "
+     "load factors to visit", "required there", "—"),
+    ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
+     "—"),
+    ("loading", "control", "`load`, or `arc-length` (loads only: the load factor an unknown, "
+     "through limit points)", "load", "—"),
+    ("loading", "target", "arc-length: the load factor that ends the run", "1", "—"),
+    ("loading", "arc_length", "arc-length: the first arc (dimensionless: about one load "
+     "step)", "0.1", "—"),
+    ("loading", "max_arc_length", "arc-length: the largest arc", "no bound", "—"),
+    ("loading", "max_steps", "arc-length: the converged steps after which a run that has not "
+     "ended fails", "100", "—"),
+    ("loading", "stop", "arc-length: `{ probe, component, value }`, the run also ends (status "
+     "ok) at the first step where that probe's displacement component has reached `value`",
+     "none", "length"),
+    ("solver", "newton", "`full`, `modified`, `periodic`, `bfgs` or `snes`", "full", "—"),
+    ("solver", "linear", "`lu` (MUMPS) or `gamg` (CG + GAMG)", "lu", "—"),
+    ("solver", "tolerance", "‖R‖ ≤ tolerance × the step's force scale ends Newton", "1e-9",
+     "—"),
+    ("solver", "max_iterations", "Newton iterations per step", "50", "—"),
+    ("probe", "name", "the probe's name in the JSON", "required", "—"),
+    ("probe", "point", "where displacement, von Mises and Cauchy stress are reported, every "
+     "step", "required", "length"),
+]
+
+
+def key_table() -> str:
+    """The format's keys as a Markdown table (the documentation's case page)."""
+    lines = ["| key | meaning | default | unit |", "|---|---|---|---|"]
+    for table, key, meaning, default, unit in KEYS:
+        name = f"[[{table}]]" if table in ("boundary", "probe") else f"[{table}]"
+        lines.append(f"| `{name}` `{key}` | {meaning} | {default} | {unit} |")
+    return "\n".join(lines) + "\n"
+
 
 LAWS: dict[str, type[laws.Material]] = {
     "linear-elastic": laws.LinearElastic,
@@ -177,6 +264,7 @@ class Case:
     max_iterations: int = 50
     probes: list[Probe] = field(default_factory=list)
     formulation: str = "displacement"  # or "mixed": Taylor–Hood (u, p), materials.mixed
+    refine_near: dict | None = None  # .geo: groups, size, distance (`case.mesh`)
 
     @property
     def dim(self) -> int:
@@ -286,7 +374,8 @@ def read_case(path: str | Path) -> Case:
     r = _Reader()
     r.unknown(data, "case", ("mesh", "material", "boundary", "loading", "solver", "probe"))
 
-    m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation"))
+    m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation",
+                               "refine_near"))
     file = r.get(m, "file", "mesh", str, required=True)
     size = r.get(m, "size", "mesh", float, positive=True)
     model = r.get(m, "model", "mesh", str, required=True, choices=MODELS)
@@ -302,6 +391,9 @@ def read_case(path: str | Path) -> Case:
             _require_mesh_fits(mesh_file, model)
         if size is not None and mesh_file.suffix == ".msh":
             r.fail("mesh.size", "applies to a .geo only (a .msh is already meshed)")
+    refine_near = _refine_near(r, m.get("refine_near"))
+    if refine_near is not None and mesh_file is not None and mesh_file.suffix == ".msh":
+        r.fail("mesh.refine_near", "applies to a .geo only (a .msh is already meshed)")
     if degree is not None and degree > 3:
         r.fail("mesh.degree", f"must be 1, 2 or 3, got {degree}")
     formulation = r.get(m, "formulation", "mesh", str, default="displacement",
@@ -344,7 +436,8 @@ def read_case(path: str | Path) -> Case:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
-                adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation)
+                adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
+                refine_near)
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
@@ -580,6 +673,29 @@ def _arc_length(r: _Reader, t: dict) -> dict | None:
     if top is not None and first is not None and top < first:
         r.fail("loading.max_arc_length", f"must be >= arc_length ({first}), got {top}")
     return arc
+
+
+def _refine_near(r: _Reader, table) -> dict | None:
+    """`mesh.refine_near`: cells of `size` within `distance` of named boundary groups.
+
+    The groups are checked against the mesh when it is meshed (`case.mesh`).
+    """
+    if table is None:
+        return None
+    where = "mesh.refine_near"
+    if not isinstance(table, dict):
+        r.fail(where, 'must be a table, e.g. { groups = ["hole"], size = 0.1, distance = 1.0 }')
+        return None
+    r.unknown(table, where, ("groups", "size", "distance"))
+    groups = table.get("groups")
+    if not (isinstance(groups, list) and groups and all(isinstance(g, str) for g in groups)):
+        r.fail(f"{where}.groups", f"must be a non-empty list of group names, got {groups!r}")
+        groups = None
+    size = r.get(table, "size", where, float, required=True, positive=True)
+    distance = r.get(table, "distance", where, float, required=True, positive=True)
+    if None in (groups, size, distance):
+        return None
+    return {"groups": groups, "size": size, "distance": distance}
 
 
 def _stop(r: _Reader, table) -> dict | None:
