@@ -52,11 +52,10 @@ def geometry_dimension(path, comm: MPI.Comm = MPI.COMM_WORLD) -> int | None:
 
 
 def _refine_near(refine: dict, dim: int, largest: float | None) -> str | None:
-    """A gmsh size field: `size` within `distance` of the groups, then growing linearly to
-    the mesh's own size over another `distance`; the message if a group is not a boundary
-    group of the geometry (None if it is done).
+    """A gmsh size field for `mesh.refine_near`; the message of a group not there, or None.
 
-    The mesh's own size: `largest` (mesh.size) if given, else the largest of the geometry's
+    Cells of `size` within `distance` of the groups, then growing linearly to the mesh's
+    own size over another `distance`. The mesh's own size: `largest` (mesh.size) if given, else the largest of the geometry's
     point sizes, else a tenth of its bounding box.
     """
     have = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in
