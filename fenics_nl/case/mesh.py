@@ -55,8 +55,8 @@ def _refine_near(refine: dict, dim: int, largest: float | None) -> str | None:
     """A gmsh size field for `mesh.refine_near`; the message of a group not there, or None.
 
     Cells of `size` within `distance` of the groups, then growing linearly to the mesh's
-    own size over another `distance`. The mesh's own size: `largest` (mesh.size) if given, else the largest of the geometry's
-    point sizes, else a tenth of its bounding box.
+    own size over another `distance`. The mesh's own size: `largest` (mesh.size) if given,
+    else the largest of the geometry's point sizes, else a tenth of its bounding box.
     """
     have = {gmsh.model.getPhysicalName(d, t): (d, t) for d, t in
             gmsh.model.getPhysicalGroups(dim - 1)}
