@@ -951,7 +951,7 @@ def sphere_case(tmp_path, change):
 @pytest.mark.parametrize("change", ["coarse", "fine", "displacement"])
 def test_the_inflated_sphere_passes_its_pressure_maximum_onto_the_falling_branch(
         tmp_path, demo, change):
-    # the incompressible neo-Hookean sphere (formulas.md): arc-length through the limit
+    # the incompressible neo-Hookean sphere (theory.vessels): arc-length through the limit
     # point, down the falling branch until the stop condition u_r(A) = 1 (λ_a = 2). Each
     # step on the closed form p(λ_a): measured 2.6e-5 (coarse), 3.0e-6 (fine), 2.9e-4
     # (displacement, ν = 0.4999: its p is not the incompressible one to 1e-4)
@@ -977,6 +977,8 @@ def test_the_inflated_sphere_passes_its_pressure_maximum_onto_the_falling_branch
 
 @pytest.mark.mpi
 def test_the_inflated_sphere_on_two_ranks_follows_the_serial_path(demo):
+    from fenics_nl.theory.vessels import neo_hookean_sphere_pressure
+
     # the same limit point and the same closed form along the path; the steps themselves
     # agree to the solver's tolerance while both take the same iterations (docs/cases.md)
     s = demo.case(CASES / "inflated_sphere.toml")
@@ -986,6 +988,8 @@ def test_the_inflated_sphere_on_two_ranks_follows_the_serial_path(demo):
         s["critical_points"][0]["load_factor"], rel=1e-8)
     stretch, load = sphere_path(p)
     assert np.all(np.diff(stretch) > 0) and stretch[-1] >= 2.0
+    exact = [neo_hookean_sphere_pressure(s, 1.0, 1.2, 1.0) for s in stretch]
+    assert load == pytest.approx(exact, rel=1e-3)  # on the same curve, wherever the steps
     serial = dict(zip(*sphere_path(s), strict=True))
     for a, b in zip(sphere_path(s)[0], stretch, strict=False):
         if a != pytest.approx(b, rel=1e-8):  # the paths' steps parted: same curve still
@@ -1017,6 +1021,9 @@ def test_a_failed_arc_length_run_keeps_its_critical_points(tmp_path, demo):
      "loading.stop.probe: 'outer' is not a [[probe]] of the case (it has: inner)"),
     ('{ probe = "inner", component = "x", value = 1.0 }',
      "loading.stop.component: 'x' is not a displacement component of the axisymmetric "
+     "model (one of r, z)"),
+    ('{ probe = "inner", component = "rz", value = 1.0 }',
+     "loading.stop.component: 'rz' is not a displacement component of the axisymmetric "
      "model (one of r, z)"),
     ('{ probe = "inner", component = "r", value = 0.0 }', "loading.stop.value: must not be 0"),
     ('{ probe = "inner", component = "r" }', "loading.stop.value: missing"),
@@ -1064,17 +1071,17 @@ def test_loads_that_can_do_no_work_are_refused(tmp_path, demo, command):
     assert lines == [
         "error: boundary[4].pressure: 'axis' has no area in the axisymmetric model (r = 0 on "
         "it): the load can do no work there",
-        "error: boundary[5].traction: 'equator' has u_z prescribed by a displacement "
-        "condition: the traction there can do no work (it would only change that support's "
-        "reaction); remove it or free u_z",
+        "error: boundary[5].traction: its z component on 'equator', where a displacement "
+        "condition holds u_z, can do no work (it would only change that support's "
+        "reaction); set it to 0 or free u_z",
         "error: boundary[6].pressure: 'equator' has u_z prescribed by a displacement "
         "condition: the pressure there can do no work (it would only change that support's "
         "reaction); remove it or free u_z"], lines
 
 
-def test_every_key_of_the_format_is_in_the_documented_table_and_the_reader():
+def test_every_key_of_the_format_is_in_the_documented_table():
     # the documentation's table (spec.KEYS) and the annotated format (FORMAT, --help) name
-    # the same keys; each key of the table is one a case file may hold
+    # the same keys
     import re
 
     from fenics_nl.case.spec import FORMAT, KEYS, key_table
@@ -1105,3 +1112,15 @@ def test_a_case_refines_its_mesh_near_named_groups(tmp_path, demo):
     lines = check(demo, tmp_path, text.replace('groups = ["inner"]', 'groups = ["bore"]'))
     assert lines == ["error: mesh.refine_near.groups: 'bore' is not a boundary group of the "
                      "geometry (it has: inner, outer, symmetry_x, symmetry_y)"], lines
+
+
+def test_loads_that_do_work_beside_a_support_are_accepted(tmp_path, demo):
+    # a traction along the free component of a held group, and a pressure on a curved group
+    # whose facets are held in part: both do work, and the case checks
+    text = (CASES / "thick_cylinder.toml").read_text() + (
+        '\n[[boundary]]\ngroup = "symmetry_y"\ntraction = [1.0, 0.0]\n'
+        '\n[[boundary]]\ngroup = "outer"\ndisplacement = [0.0, "free"]\n'
+        '\n[[boundary]]\ngroup = "outer"\npressure = 1.0\n')
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    proc = demo.run(["-m fenics_nl", "check", write(tmp_path, "working.toml", text)])
+    assert "the case is complete" in proc.stdout

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import functools
+from pathlib import Path
+
 import gmsh
 import numpy as np
 from dolfinx.io import gmsh as gmshio
@@ -33,22 +36,30 @@ def load_mesh(case: Case, comm: MPI.Comm = MPI.COMM_WORLD) -> gmshio.MeshData:
 def geometry_dimension(path, comm: MPI.Comm = MPI.COMM_WORLD) -> int | None:
     """The dimension of the geometry or mesh in a .geo/.msh file (None if gmsh cannot say).
 
-    Opened on rank 0 without meshing: a file that cannot fit the model is told before the
-    rest of the case is read against it.
+    Opened on rank 0 without meshing, once per file's version (the command reads a case
+    twice): a file that cannot fit the model is told before the rest of the case is read
+    against it. Collective on `comm`.
     """
-    dim = None
-    if comm.rank == 0:
-        try:
-            start_model("dimension")
-            gmsh.open(str(path))
-            dim = gmsh.model.getDimension()
-        except Exception:  # said by `load_mesh`, with gmsh's words
-            dim = None
-        finally:
-            if gmsh.model.list():
-                gmsh.model.remove()
+    dim = _dimension_on_rank_0(str(path), Path(path).stat().st_mtime_ns) if (
+        comm.rank == 0) else None
     dim = comm.bcast(dim, root=0)
     return dim if dim is not None and dim >= 0 else None
+
+
+@functools.cache
+def _dimension_on_rank_0(path: str, version: int) -> int | None:
+    try:
+        start_model("dimension")
+        gmsh.open(path)
+        return gmsh.model.getDimension()
+    except Exception:  # said by `load_mesh`, with gmsh's words
+        return None
+    finally:
+        try:
+            if gmsh.model.list():
+                gmsh.model.remove()
+        except Exception:  # nothing to remove: the next model starts anew anyway
+            pass
 
 
 def _refine_near(refine: dict, dim: int, largest: float | None) -> str | None:

@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from fenics_nl.case.damage import DamageSteps
 from fenics_nl.case.mesh import load_mesh
-from fenics_nl.case.spec import Case, CaseError, Condition
+from fenics_nl.case.spec import COMPONENTS, Case, CaseError, Condition
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
@@ -167,7 +167,7 @@ class CaseProblem:
         axis. (Facets inside the body are refused with the groups.)
         """
         tag = {n: g.tag for n, g in data.physical_groups.items()}
-        comm, names = self.mesh.comm, "rz" if self.model == "axisymmetric" else "xyz"
+        comm, names = self.mesh.comm, COMPONENTS[self.model]
         boundary = comm.allreduce(fem.assemble_scalar(fem.form(self.weight * self.ds)))
         out = []
         for c in self.case.conditions:
@@ -188,11 +188,18 @@ class CaseProblem:
                 flat = [i for i, n in enumerate(normal) if abs(n) > 1 - 1e-9]
                 idle = (sorted(held) if len(held) == self.case.dim
                         else [i for i in flat if i in held])
-            if idle:
-                comps = ", ".join(f"u_{names[i]}" for i in idle)
-                out.append(f"{c.key}: {c.group!r} has {comps} prescribed by a displacement "
-                           f"condition: the {c.kind} there can do no work (it would only "
-                           f"change that support's reaction); remove it or free {comps}")
+            if idle and c.kind == "traction":
+                comps = ", ".join(names[i] for i in idle)
+                held_ = ", ".join(f"u_{names[i]}" for i in idle)
+                out.append(f"{c.key}: its {comps} component on {c.group!r}, where a "
+                           f"displacement condition holds {held_}, can do no work (it would "
+                           f"only change that support's reaction); set it to 0 or free "
+                           f"{held_}")
+            elif idle:
+                held_ = ", ".join(f"u_{names[i]}" for i in idle)
+                out.append(f"{c.key}: {c.group!r} has {held_} prescribed by a displacement "
+                           f"condition: the pressure there can do no work (it would only "
+                           f"change that support's reaction); remove it or free {held_}")
         return out
 
     def _held_everywhere(self, group: str) -> set[int]:

@@ -12,7 +12,7 @@ from mpi4py import MPI
 from fenics_nl.case.damage import cell_sizes
 from fenics_nl.case.problem import CaseProblem
 from fenics_nl.case.resume import case_checkpoints
-from fenics_nl.case.spec import arc_length_obstacles
+from fenics_nl.case.spec import COMPONENTS, arc_length_obstacles
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.parallel import global_max
@@ -231,8 +231,6 @@ def _critical_points(path) -> list[dict]:
 
 def _probe_component(record: dict, stop: dict, model: str) -> float:
     """The stop condition's displacement component in a step's record."""
-    from fenics_nl.case.spec import COMPONENTS
-
     i = COMPONENTS[model].index(stop["component"])
     return record["probes"][stop["probe"]]["displacement"][i]
 
@@ -306,7 +304,7 @@ def load_path_plot(out: dict, path: str) -> None:
     t = [0.0] + [s["load_factor"] for s in steps]
     plt = pictures.pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
-    names = "xyz" if out["model"] != "axisymmetric" else "rz"
+    names = COMPONENTS[out["model"]]
     curves = [{}, {}, {}]
     for s in steps:
         for name, probe in s["probes"].items():
@@ -381,7 +379,7 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                 focus = moved[c.owned & c.active][:, : problem.case.dim]
                 obstacle = problem.obstacle_at(float(problem.t.value))
                 title += f", {S.count(c.active)} nodes in contact"
-            names = "rz" if problem.model == "axisymmetric" else "xy"
+            names = COMPONENTS[problem.model]
             deformed_picture(problem.displacement(), vm, png, title, marked, arrows, focus,
                              obstacle, label="von Mises stress (the mean over each cell)",
                              labels=labels, detail=focus is None,

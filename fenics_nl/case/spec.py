@@ -144,8 +144,9 @@ KEYS = [
     ("boundary", "group", "a boundary physical group of the mesh", "required", "—"),
     ("boundary", "displacement", "one value per component, or `\"free\"`; scaled by the load "
      "factor", "—", "length"),
-    ("boundary", "traction", "force per unit area (per unit length in 2D) of the reference "
-     "configuration, dead; scaled by the load factor", "—", "stress"),
+    ("boundary", "traction", "force per unit area of the reference configuration (per unit "
+     "length of a 2D model's boundary, per unit thickness), dead; scaled by the load factor",
+     "—", "force / area"),
     ("boundary", "pressure", "normal pressure, positive pushing on the body; scaled by the "
      "load factor", "—", "stress"),
     ("boundary", "follower", "the pressure follows the deformed normal (finite strain)",
@@ -391,7 +392,7 @@ def read_case(path: str | Path) -> Case:
             _require_mesh_fits(mesh_file, model)
         if size is not None and mesh_file.suffix == ".msh":
             r.fail("mesh.size", "applies to a .geo only (a .msh is already meshed)")
-    refine_near = _refine_near(r, m.get("refine_near"))
+    refine_near = _refine_near_table(r, m.get("refine_near"))
     if refine_near is not None and mesh_file is not None and mesh_file.suffix == ".msh":
         r.fail("mesh.refine_near", "applies to a .geo only (a .msh is already meshed)")
     if degree is not None and degree > 3:
@@ -431,7 +432,10 @@ def read_case(path: str | Path) -> Case:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
     probes = _probes(r, data, dim)
     if arc is not None and arc["stop"] is not None and model is not None:
-        _check_stop(r, arc["stop"], probes, model)
+        tables = data.get("probe", [])
+        names = [t.get("name") for t in tables if isinstance(t, dict)] if isinstance(
+            tables, list) else []
+        _check_stop(r, arc["stop"], [n for n in names if isinstance(n, str)], model)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
@@ -675,7 +679,7 @@ def _arc_length(r: _Reader, t: dict) -> dict | None:
     return arc
 
 
-def _refine_near(r: _Reader, table) -> dict | None:
+def _refine_near_table(r: _Reader, table) -> dict | None:
     """`mesh.refine_near`: cells of `size` within `distance` of named boundary groups.
 
     The groups are checked against the mesh when it is meshed (`case.mesh`).
@@ -719,13 +723,16 @@ def _stop(r: _Reader, table) -> dict | None:
     return None if None in stop.values() or stop["value"] == 0 else stop
 
 
-def _check_stop(r: _Reader, stop: dict, probes: list[Probe], model: str) -> None:
-    """The stop condition's probe is one of the case's, its component one of the model's."""
-    names = [p.name for p in probes]
+def _check_stop(r: _Reader, stop: dict, names: list[str], model: str) -> None:
+    """The stop condition's probe is one of the case's, its component one of the model's.
+
+    `names`: those the [[probe]] tables give, whether or not their points are right (a bad
+    point is said once, by the probe's own check).
+    """
     if stop["probe"] not in names:
         r.fail("loading.stop.probe", f"{stop['probe']!r} is not a [[probe]] of the case "
                                      f"(it has: {', '.join(names) or 'none'})")
-    if stop["component"] not in COMPONENTS[model]:
+    if stop["component"] not in tuple(COMPONENTS[model]):  # a letter, not a substring
         r.fail("loading.stop.component", f"{stop['component']!r} is not a displacement "
                                          f"component of the {model} model (one of "
                                          f"{', '.join(COMPONENTS[model])})")

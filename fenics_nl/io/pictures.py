@@ -346,8 +346,10 @@ def _draw_obstacle(pl, pv, ob: dict, flat: bool, bounds) -> None:
     n /= np.linalg.norm(n)
     if flat:  # across the body's width only: a die ends where the body does (the axis)
         d = np.array([-n[1], n[0], 0.0])
-        ends = sorted(float((x - p0) @ d) for x in (lo, hi))
-        pl.add_mesh(pv.Line(p0 + ends[0] * d, p0 + ends[1] * d), color="red", line_width=3)
+        corners = [np.array([x, y, 0.0]) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])]
+        ends = [float((x - p0) @ d) for x in corners]  # the box's extent along the line
+        pl.add_mesh(pv.Line(p0 + min(ends) * d, p0 + max(ends) * d), color="red",
+                    line_width=3)
     else:
         pl.add_mesh(pv.Plane(center=p0, direction=n, i_size=2 * span, j_size=2 * span),
                     color="red", opacity=0.35)

@@ -40,7 +40,8 @@ __all__ = ["IDENTIFIABLE_SPREAD", "MeasuredCurve", "Refinement", "fit_curve", "i
 # a parameter whose standard deviation, for a noise of 1 % of the largest force, would exceed
 # this fraction of its value is not determined by the curve: reported as not identifiable.
 # At 1/2, its two-standard-deviation interval (95 % for a Gaussian) would reach 0: the curve
-# could not tell it from no such parameter (H at δ = 0.02 R: 0.64, measured)
+# could not tell it from no such parameter (H at δ = 0.02 R: 0.88-1.05, benchmarks/
+# identification.py; 0.41 at 0.08 R)
 IDENTIFIABLE_SPREAD = 0.5
 REFERENCE_NOISE = 0.01
 
@@ -255,7 +256,10 @@ def refined_estimate(fit: FitResult, names: list[str], measured: MeasuredCurve,
     forces = finer.run(measured.depth, sensitivities=False).force
     fitted = measured.force + fit.residuals
     shift = np.linalg.lstsq(fit.jacobian, forces - fitted, rcond=None)[0]
-    return Refinement(fit.x - shift, shift, forces, finer.dofs)
+    # the step is a minimum's (Jᵀr = 0): a parameter the fit left on its bound (H = 0)
+    # stays there, its shift still counted in its deviation
+    x = np.where(fit.x - shift > 0, fit.x - shift, fit.x)
+    return Refinement(x, shift, forces, finer.dofs)
 
 
 def report(fit: FitResult, names: list[str], measured: MeasuredCurve,
