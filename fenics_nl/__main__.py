@@ -85,10 +85,11 @@ def main(argv=None) -> int:
             cli.error(line)
         return 2
     built = time.perf_counter() - t0  # the mesh, the spaces, the forms' UFL
+    n, ranks = len(case.factors), MPI.COMM_WORLD.size
     say(f"{case.path.name}: {case.model}, P{case.degree}, {problem.dofs} unknowns, "
         f"{case.law}, " + (f"arc-length to load factor {case.arc['target']:g}" if case.arc
-                            else f"{len(case.factors)} load factors")
-        + f", {MPI.COMM_WORLD.size} rank(s)")
+                            else f"{n} load factor{'s' * (n != 1)}")
+        + f", {ranks} rank{'s' * (ranks != 1)}")
     if args.command == "check":
         say("check: the case is complete and consistent with its mesh")
         return 0
