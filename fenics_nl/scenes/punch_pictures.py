@@ -116,10 +116,10 @@ def _checked(run: PunchRun, state) -> str:
     a_err = 100 * (state.contact_radius / ref["contact_radius"] - 1)
     p_err = 100 * (state.max_pressure / ref["max_pressure"] - 1)
     if run.plastic and not run.force_controlled:  # Hertz: the elastic reference
-        return (f"{run.model} J2 punch, δ = {state.indentation:.3g}: P = {state.force:.4g}, "
-                f"{state.force / ref['force']:.3f} × elastic Hertz's (the block flows); "
-                f"contact radius {state.contact_radius / ref['contact_radius']:.3f} ×, "
-                f"peak pressure {state.max_pressure / ref['max_pressure']:.3f} ×")
+        return (f"{run.model} J2 punch, δ = {state.indentation:.3g}: P = {state.force:.4g} "
+                f"(the block flows)\nagainst elastic Hertz: P {state.force / ref['force']:.3f} ×,"
+                f" contact radius {state.contact_radius / ref['contact_radius']:.3f} ×, peak "
+                f"pressure {state.max_pressure / ref['max_pressure']:.3f} ×")
     if run.model == "plane_strain":
         return (f"plane-strain cylinder, P = {state.force:.4g} per unit length (not checked): "
                 f"half-width {a_err:+.1f} %, p0 {p_err:+.1f} % from Hertz")
