@@ -27,7 +27,7 @@ $(VENV)/.installed: pyproject.toml
 	  echo "error: no Python >= 3.12 found; install one (e.g. 'pyenv install 3.12') or run 'make PYTHON=/path/to/python3.12'"; exit 1; fi
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	-$(PY) -m pip install --quiet $(UV)
-	$(call install,-e ".[test]")
+	$(call install,-e ".[wheel,test]")
 	@# `import dolfinx` first works in this venv too (see the file)
 	cp fenics_nl/_import_order.pth "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/fenics_nl_import_order.pth"
 	@touch $@

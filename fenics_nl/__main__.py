@@ -11,7 +11,7 @@ import argparse
 import sys
 import time
 
-import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+import fenics_nl  # first: loads the wheel's MPI/PETSc before dolfinx
 
 # isort: split
 
@@ -58,6 +58,7 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """The command; returns the exit status (0, or 1/2 on a failed output/bad input)."""
+    fenics_nl.tune_kernel_flags()  # the command opts in to the faster kernels
     p = parser()
     args, petsc = cli.parse_with_petsc_options(p, argv)
     if args.command == "check" and (args.json or args.output or args.png or args.plot

@@ -8,6 +8,10 @@ named, not `native`: the flags are part of the kernel cache's key, so a cache sh
 different machines never hands one a kernel for instructions it lacks. A CPU without AVX2
 and FMA, another architecture, or a user's own `dolfinx_jit_options.json` (which DOLFINx
 reads after these defaults) keeps its own choice.
+
+Opt-in: `import fenics_nl` leaves DOLFINx's options alone (they are global: they would
+change every other form compiled in a user's process); the demos, the case command, the
+tests and the benchmarks call `tune_kernel_flags()`.
 """
 
 from __future__ import annotations
@@ -27,11 +31,20 @@ def _has_avx2_and_fma() -> bool:
     return bool(cpu.get("AVX2") and cpu.get("FMA3"))
 
 
-def tune_kernel_flags() -> None:
-    """Make FLAGS DOLFINx's default compile flags where the CPU runs them."""
+def tune_kernel_flags() -> bool:
+    """Make FLAGS DOLFINx's default compile flags where the CPU runs them; whether it did.
+
+    Global to the process (`dolfinx.jit.DOLFINX_DEFAULT_JIT_OPTIONS`): every form compiled
+    after the call takes them. Example::
+
+        import fenics_nl
+
+        fenics_nl.tune_kernel_flags()  # before the first form is compiled
+    """
     if platform.machine().lower() not in ("x86_64", "amd64") or not _has_avx2_and_fma():
-        return
+        return False
     from dolfinx import jit
 
     _, doc = jit.DOLFINX_DEFAULT_JIT_OPTIONS["cffi_extra_compile_args"]
     jit.DOLFINX_DEFAULT_JIT_OPTIONS["cffi_extra_compile_args"] = (list(FLAGS), doc)
+    return True

@@ -13,7 +13,7 @@ import fcntl
 import gc
 import hashlib
 
-import fenics_nl  # noqa: F401
+import fenics_nl
 
 # isort: split
 
@@ -30,6 +30,7 @@ from pathlib import Path
 import pytest
 from mpi4py import MPI
 
+fenics_nl.tune_kernel_flags()  # the kernels the demos and the case command compile
 ROOT = Path(__file__).resolve().parents[1]
 DEMOS = ROOT / "demos"
 # the ready-made problems and the contact peers that tests share with the benchmarks

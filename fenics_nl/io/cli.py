@@ -462,8 +462,10 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
     `prefixes` (or a function of the parsed arguments giving them): the PETSc options
     prefixes of the run's solvers, with what reads each; an option outside them is refused.
     """
+    from fenics_nl.compile_flags import tune_kernel_flags
     from fenics_nl.io import parameters
 
+    tune_kernel_flags()  # a demo opts in to the faster kernels (`import fenics_nl` does not)
     declared = isinstance(parser, type) and issubclass(parser, parameters.Parameters)
     cls, parser = (parser, parameters.parser_of(parser)) if declared else (None, parser)
     caller = sys._getframe(1).f_globals
