@@ -22,12 +22,15 @@ $(VENV)/bin/uv pip install --quiet --python $(PY) $(foreach l,$(PIP_FIND_LINKS),
 	  || $(PY) -m pip install --quiet $(1)
 endef
 
+# the PyPI wheel of DOLFINx (the package itself runs on any DOLFINx 0.11) and the tests'
+# tools; a variable, since a comma would split make's `call`
+EXTRAS := wheel,test
 $(VENV)/.installed: pyproject.toml
 	@if [ -z "$(PYTHON)" ]; then \
 	  echo "error: no Python >= 3.12 found; install one (e.g. 'pyenv install 3.12') or run 'make PYTHON=/path/to/python3.12'"; exit 1; fi
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	-$(PY) -m pip install --quiet $(UV)
-	$(call install,-e ".[wheel,test]")
+	$(call install,-e ".[$(EXTRAS)]")
 	@# `import dolfinx` first works in this venv too (see the file)
 	cp fenics_nl/_import_order.pth "$$($(PY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/fenics_nl_import_order.pth"
 	@touch $@
