@@ -22,7 +22,7 @@ $(VENV)/bin/uv pip install --quiet --python $(PY) $(foreach l,$(PIP_FIND_LINKS),
 	  || $(PY) -m pip install --quiet $(1)
 endef
 
-# the PyPI wheel of DOLFINx (the package itself runs on any DOLFINx 0.11) and the tests'
+# the PyPI wheel of DOLFINx (the package itself runs on any DOLFINx 0.11) and the tests
 # tools; a variable, since a comma would split make's `call`
 EXTRAS := wheel,test
 $(VENV)/.installed: pyproject.toml

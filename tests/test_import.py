@@ -81,3 +81,27 @@ def test_importing_the_package_leaves_dolfinx_jit_options_as_they_were():
     unchanged, tuned, still = out.split()
     assert unchanged == "True"
     assert (tuned, still) in (("True", "False"), ("False", "True"))  # a CPU without AVX2
+
+
+def test_the_solvers_import_nothing_of_io_and_the_parameters_not_the_run():
+    # io (the run, its files) builds on solvers, never the other way; io.parameters builds
+    # on io.flags, not on io.cli (which reads a demo's parameters: one direction)
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "fenics_nl"
+
+    def imports(path):
+        out = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                out |= {node.module, *(f"{node.module}.{a.name}" for a in node.names)}
+            elif isinstance(node, ast.Import):
+                out |= {a.name for a in node.names}
+        return {m for m in out if m.startswith("fenics_nl")}
+
+    for path in (root / "solvers").glob("*.py"):
+        assert not {m for m in imports(path) if m.startswith("fenics_nl.io")}, path.name
+    assert not {m for m in imports(root / "io" / "parameters.py") if ".cli" in m}
+    assert imports(root / "io" / "flags.py") <= {"fenics_nl.vocabulary",
+                                                 "fenics_nl.vocabulary.canonical"}

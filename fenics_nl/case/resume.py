@@ -1,4 +1,4 @@
-"""A case's checkpoints: `solvers.restart.PathCheckpoints` of its problem.
+"""A case's checkpoints: `io.restart.PathCheckpoints` of its problem.
 
 The state is the unknown (with the pressure of the mixed form), the internal variables at
 the quadrature points (J2's plastic strain and cumulated plastic strain), the contact's
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import hashlib
 
-from fenics_nl.solvers.restart import PathCheckpoints
+from fenics_nl.io.restart import PathCheckpoints
 
 __all__ = ["case_checkpoints"]
 

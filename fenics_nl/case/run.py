@@ -15,10 +15,10 @@ from fenics_nl.case.resume import case_checkpoints
 from fenics_nl.case.spec import COMPONENTS, arc_length_obstacles
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
+from fenics_nl.io.restart import PathCheckpoints, Resumed
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength, ArcState
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
-from fenics_nl.solvers.restart import PathCheckpoints, Resumed
 from fenics_nl.solvers.result import WorkCounts
 
 __all__ = ["fields", "load_path_plot", "solve_case", "step_record", "warnings", "write_outputs"]

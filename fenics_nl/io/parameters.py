@@ -28,6 +28,8 @@ import math
 from collections.abc import Sequence
 from typing import ClassVar
 
+from fenics_nl.io import flags
+
 __all__ = ["Parameters", "choice", "number", "parser_of", "switch", "text"]
 
 
@@ -109,10 +111,9 @@ def _add(target, f: dataclasses.Field) -> None:
         target.add_argument(flag, dest=f.name, type=_number_type(f), default=f.default,
                             metavar=m["metavar"], help=meaning)
     elif m["kind"] == "choice":
-        from fenics_nl.io.cli import spelling
-
         target.add_argument(flag, dest=f.name, default=f.default, choices=m["options"],
-                            type=spelling(flag) if m["spelling"] else None, help=meaning)
+                            type=flags.spelling(flag) if m["spelling"] else None,
+                            help=meaning)
     elif m["kind"] == "switch":
         target.add_argument(flag, dest=f.name, action="store_true", help=meaning)
     else:
@@ -122,10 +123,8 @@ def _add(target, f: dataclasses.Field) -> None:
 
 def parser_of(cls: type[Parameters]) -> argparse.ArgumentParser:
     """The command line of `cls`: its description, a flag a field, the output flags."""
-    from fenics_nl.io import cli
-
     description = " ".join((cls.__doc__ or "").split("\n\n")[0].split())
-    p = cli.parser(description, epilog=cls.EPILOG)
+    p = flags.parser(description, epilog=cls.EPILOG)
     groups: dict[str, argparse._MutuallyExclusiveGroup] = {}
     for f in dataclasses.fields(cls):
         if "kind" not in f.metadata:
@@ -134,9 +133,9 @@ def parser_of(cls: type[Parameters]) -> argparse.ArgumentParser:
         if group and group not in groups:
             groups[group] = p.add_mutually_exclusive_group()
         _add(groups[group] if group else p, f)
-    cli.add_outputs(p, json=cls.JSON, **cls.OUTPUTS)
+    flags.add_outputs(p, json=cls.JSON, **cls.OUTPUTS)
     if cls.CHECKPOINTS:
-        cli.add_checkpoints(p)
+        flags.add_checkpoints(p)
     return p
 
 

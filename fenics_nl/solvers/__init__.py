@@ -5,7 +5,7 @@
 its own `solve` and arc-length are written; `snes`: `SnesSolver`, the same problem through
 PETSc SNES; `loading`: `solve_incrementally`, load steps with cuts and a secant predictor;
 `arclength`: Crisfield's continuation through limit points, with stability checks and
-branch switching; `restart`: checkpoints of a load path; `supports`: the free-body check;
+branch switching (their checkpoints: `io.restart`); `supports`: the free-body check;
 `buckling`: SLEPc eigenproblems (critical loads, the tangent's inertia); `scalar`: the
 course's scalar Newton, modified Newton and secant, for their orders; `sensitivity`: the
 derivatives of a path-dependent solution with respect to material parameters (direct
@@ -17,11 +17,10 @@ differentiation); `least_squares`: Levenberg–Marquardt with bounds and its sta
 from fenics_nl.solvers.arclength import ArcLength, ArcState, ContinuationError
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, LinearSolveError, NewtonSolver
-from fenics_nl.solvers.restart import PathCheckpoints
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.snes import SnesSolver
 from fenics_nl.solvers.supports import check_supports
 
 __all__ = ["ArcLength", "ArcState", "ContinuationError", "ConvergenceError",
-           "LinearSolveError", "LoadStepError", "NewtonSolver", "PathCheckpoints",
-           "SnesSolver", "SolveResult", "WorkCounts", "check_supports", "solve_incrementally"]
+           "LinearSolveError", "LoadStepError", "NewtonSolver", "SnesSolver", "SolveResult",
+           "WorkCounts", "check_supports", "solve_incrementally"]

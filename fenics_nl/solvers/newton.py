@@ -48,7 +48,6 @@ from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.errors import SolveError
-from fenics_nl.io import output
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
     block_preconditioned_ksp,
@@ -557,7 +556,8 @@ class NewtonSolver:
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns."""
-        return output.dofs(self.u.function_space)
+        imap = self.u.function_space.dofmap.index_map  # scalar unknowns, all ranks
+        return imap.size_global * self.u.function_space.dofmap.index_map_bs
 
     def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False,
                 new_path: bool = False) -> None:
