@@ -348,7 +348,7 @@ steps = 1
     (('group = "left"\ndisplacement = [0.0, 0.0]', 'group = "left"\ntraction = [0.0, 1.0]'),
      "boundary: no displacement or contact condition: nothing holds the body"),
     (('group = "middle"\ntraction = [1.0, 0.0]', 'group = "left"\ndisplacement = [0.5, "free"]'),
-     "boundary[2].displacement: component 0 of group 'left' is already prescribed by "
+     "boundary[2].displacement: u_x of group 'left' is already prescribed by "
      "boundary[1].displacement"),
     (('model = "plane_strain"', 'model = "axisymmetric"'),
      "4 facet(s) of 'middle' are inside the body"),

@@ -577,8 +577,8 @@ def _conditions(r: _Reader, data: dict, dim: int, law: str | None, model: str | 
         if c.kind == "displacement":
             for i, value in enumerate(c.value):
                 if value is not None and (c.group, i) in held:
-                    r.fail(c.key, f"component {i} of group {c.group!r} is already prescribed "
-                                  f"by {held[(c.group, i)]}")
+                    r.fail(c.key, f"u_{COMPONENTS.get(model, 'xyz')[i]} of group {c.group!r} "
+                                  f"is already prescribed by {held[(c.group, i)]}")
                 elif value is not None:
                     held[(c.group, i)] = c.key
     if tables and not held and not contact:
@@ -693,7 +693,8 @@ def _refine_near_table(r: _Reader, table) -> dict | None:
     r.unknown(table, where, ("groups", "size", "distance"))
     groups = table.get("groups")
     if not (isinstance(groups, list) and groups and all(isinstance(g, str) for g in groups)):
-        r.fail(f"{where}.groups", f"must be a non-empty list of group names, got {groups!r}")
+        r.fail(f"{where}.groups", "missing" if groups is None else
+               f"must be a non-empty list of group names, got {groups!r}")
         groups = None
     size = r.get(table, "size", where, float, required=True, positive=True)
     distance = r.get(table, "distance", where, float, required=True, positive=True)
