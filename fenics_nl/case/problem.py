@@ -75,8 +75,9 @@ class CaseProblem:
         if self.material.path_dependent:  # its state on dx's points
             self.material.bind(msh, q)
         self.residual = self._residual(data)
-        self.force_scale = self._load_magnitude(data)
-        idle = self._idle_loads(data)
+        areas = self._loaded_areas(data)
+        self.force_scale = self._load_magnitude(areas)
+        idle = self._idle_loads(areas)
         if idle:
             raise CaseError(idle)
         self.bcs, self._prescribed = self._dirichlet()
@@ -136,20 +137,28 @@ class CaseProblem:
             return 0
         return ufl.replace(self._loads, {self.fields.v: self.u})
 
-    def _load_magnitude(self, data) -> float | None:
+    def _loaded_areas(self, data) -> dict[str, float]:
+        """The weighted area (2πr in the axisymmetric model) of each loaded group (collective).
+
+        What the loads' size (`_load_magnitude`) and the idle loads (`_idle_loads`) read.
+        """
+        tag = {n: g.tag for n, g in data.physical_groups.items()}
+        return {c.group: self.mesh.comm.allreduce(fem.assemble_scalar(fem.form(
+                    self.weight * self.ds(tag[c.group]))))
+                for c in self.case.conditions if c.kind in ("traction", "pressure")}
+
+    def _load_magnitude(self, areas: dict[str, float]) -> float | None:
         """Σ |traction| or |pressure| × area over the loaded groups at load factor 1.
 
         The force Newton's absolute tolerance is relative to (None: displacements or an
         obstacle drive the body, and the first residual sets the scale).
         """
-        tag = {n: g.tag for n, g in data.physical_groups.items()}
         total = 0.0
         for c in self.case.conditions:
             if c.kind in ("traction", "pressure"):
                 # hypot: no overflow warning for a huge component
                 size = math.hypot(*c.value) if c.kind == "traction" else abs(c.value)
-                area = fem.assemble_scalar(fem.form(self.weight * self.ds(tag[c.group])))
-                total += size * self.mesh.comm.allreduce(area)
+                total += size * areas[c.group]
                 if not total < FLOAT_RANGE:  # inf and NaN too
                     raise CaseError([f"{c.key}: the load it gives (its size {size:.3g} × the "
                                      f"group's area) is beyond {FLOAT_RANGE:.0e}: its square "
@@ -157,7 +166,7 @@ class CaseProblem:
                                      "other units"])
         return total or None
 
-    def _idle_loads(self, data) -> list[str]:
+    def _idle_loads(self, areas: dict[str, float]) -> list[str]:
         """A line for each traction or pressure that can do no work, and why.
 
         On a group of zero measure (the axis of an axisymmetric model, where r = 0), or on
@@ -166,16 +175,13 @@ class CaseProblem:
         idle where every component is held, or where a flat group's normal is along a held
         axis. (Facets inside the body are refused with the groups.)
         """
-        tag = {n: g.tag for n, g in data.physical_groups.items()}
         comm, names = self.mesh.comm, COMPONENTS[self.model]
         boundary = comm.allreduce(fem.assemble_scalar(fem.form(self.weight * self.ds)))
         out = []
         for c in self.case.conditions:
             if c.kind not in ("traction", "pressure"):
                 continue
-            area = comm.allreduce(fem.assemble_scalar(fem.form(self.weight
-                                                                * self.ds(tag[c.group]))))
-            if not area > 1e-12 * boundary:  # dimensionless: a share of the boundary
+            if not areas[c.group] > 1e-12 * boundary:  # dimensionless: a share of the boundary
                 where = " (r = 0 on it)" if self.model == "axisymmetric" else ""
                 out.append(f"{c.key}: {c.group!r} has no area in the {self.model} model"
                            f"{where}: the load can do no work there")
