@@ -59,7 +59,7 @@ def identification_figure(out: dict, path: str, grid=None, *, labels: tuple[str,
     ax = axes[0, 0]
     c = out["curve"]
     ax.plot(c["depth"], c["initial"], "--", color="0.6", label="initial guess")
-    ax.plot(c["depth"], c["fitted"], "-", color="C0", lw=2, label="identified")
+    ax.plot(c["depth"], c["fitted"], "-", color="C0", lw=2, label="fitted (the fit's mesh)")
     ax.plot(c["depth"], c["measured"], "o", color="C3", ms=5, label="measured")
     ax.set_xlabel(labels[0])
     ax.set_ylabel(labels[1])
@@ -86,7 +86,11 @@ def identification_figure(out: dict, path: str, grid=None, *, labels: tuple[str,
         ax.plot(path_[:, 0], path_[:, 1], "o-", color="w", ms=4, lw=1.2,
                 label="Levenberg–Marquardt iterates")
         ax.plot(*path_[0], "s", color="w", ms=7)
-        ax.plot(*path_[-1], "*", color="C3", ms=14, label="identified")
+        ax.plot(*path_[-1], "*", color="C3", ms=14, label="the fit's minimum (its mesh)")
+        if out.get("sigma0_fit_model") is not None and None not in (out.get("sigma0"),
+                                                                    out.get("hardening")):
+            ax.plot(out["sigma0"], out["hardening"], "D", color="C1", ms=8,
+                    label="reported (the finer mesh's)")
         if out.get("true_sigma0") is not None:
             ax.plot(out["true_sigma0"], out["true_hardening"], "+", color="k", ms=14, mew=2,
                     label="true (synthetic)")
