@@ -2,9 +2,9 @@
 #
 # A rigid sphere of radius $R$ is pressed by $\delta$ into an elastic block, without
 # friction. Where the two touch is not known in advance: the course's active-set algorithm
-# finds it. Hertz's theory gives the answer for a half-space and a parabolic gap, and this
-# demo checks the computation against it. (With friction: `punch_friction.py`; a plastic
-# block, loaded and unloaded: `indentation.py`.)
+# finds it, and this demo writes its loop out. Hertz's theory gives the answer for a
+# half-space and a parabolic gap, and the computation is checked against it. (With
+# friction: `punch_friction.py`; a plastic block, loaded and unloaded: `indentation.py`.)
 #
 # ## Problem definition
 #
@@ -13,10 +13,13 @@
 #
 # $$ u_n - \gamma \le 0, \qquad T_n \le 0, \qquad (u_n - \gamma)\, T_n = 0 .$$
 #
-# Iteration $k$ of the active-set loop solves linear elasticity with $u_n = \gamma$ on the
-# active nodes and $T = 0$ elsewhere; then an active node in tension ($T_n > 0$) leaves the
-# set and an inactive node that penetrates ($u_n - \gamma > 0$) joins it. The set has
-# converged when nothing changes. Hertz's solution, with $E^* = E/(1-\nu^2)$:
+# Iteration $k$ of the active-set loop solves the equilibrium with $u_n = \gamma$ on the
+# active nodes $S_C^{(k)}$ and $T = 0$ on the rest of $S_C$; then
+#
+# * an active node in tension ($T_n > 0$) leaves the set,
+# * an inactive node that penetrates ($u_n - \gamma > 0$) joins it,
+#
+# and the loop stops when the set repeats. Hertz's solution, with $E^* = E/(1-\nu^2)$:
 #
 # $$ a = \sqrt{R\delta}, \qquad P = \tfrac43 E^* \sqrt{R}\, \delta^{3/2}, \qquad
 #    p_0 = \frac{3P}{2\pi a^2}, \qquad p(r) = p_0\sqrt{1 - r^2/a^2}. $$
@@ -28,33 +31,77 @@
 # ## Implementation
 
 # +
+import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
 # isort: split
 
-from fenics_nl.io import cli
-from fenics_nl.io.parameters import choice, number
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.contact import ContactError, ContactSurface, EliminationSystem, MultiplierSystem
+from fenics_nl.contact.surface import check_contact_resolution
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import graded_block
+from fenics_nl.io import cli, indentation_pictures, output
+from fenics_nl.io.parameters import Parameters, choice, number, switch
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes import punch_run
-from fenics_nl.scenes.punch import Punch, PunchLoad, check_contact_resolution
-from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.parallel import global_max
+from fenics_nl.theory import hertz
 
 # -
 
 # ### Parameters
 #
 # From the command line (`python demos/punch.py --help` lists them); in a notebook, the
-# defaults. The flags every punch demo has (the block, the load, the solver) are
-# `punch_run.PunchParameters`; this one adds the material.
+# defaults (R = 1, δ = 0.01 R, E = 1, ν = 0.3, axisymmetric, one load step).
 
 # +
+MODELS = ("axisymmetric", "3d", "plane_strain")
+
+
 @dataclass
-class Hertz(punch_run.PunchParameters):
+class Hertz(Parameters):
     """Rigid spherical punch on an elastic block (Hertz contact, the course's active set).
     Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa)."""
 
+    EPILOG = ("PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
+              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
+              "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
+              "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
+    OUTPUTS: ClassVar = {
+        "output": "displacement, von Mises stress, contact pressure and active set",
+        "png": "the deformed contact zone (von Mises stress) beside the contact pressure, "
+               "against Hertz",
+        "plot": "force-indentation and pressure against Hertz"}
+
+    model: str = choice("axisymmetric", MODELS, "axisymmetric (r,z), 3D quarter, plane "
+                        "strain", spelling=True)
+    E: float = number(1.0, "Young's modulus", unit="stress", above=0)
+    nu: float = number(0.3, "Poisson's ratio", unit="-")
+    radius: float = number(1.0, "punch radius R", unit="length", above=0)
+    indentation: float | None = number(None, "displacement control: indentation δ, non-zero "
+                                       "(default 0.01 R; negative: the punch stays clear)",
+                                       unit="length", group="load")
+    force: float | None = number(None, "force control: total force P (per unit length in "
+                                 "plane strain)", unit="force", above=0, group="load")
+    steps: int = number(1, "load steps from 0 to the load", at_least=1)
+    formulation: str = choice("elimination", ["elimination", "multiplier"], "active normal "
+                              "displacements as Dirichlet rows, or Lagrange multipliers")
+    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements: no locking as "
+                         "ν → 1/2, and ν = 0.5 exactly (with the elimination)")
+    gap: str = choice("parabola", ["parabola", "sphere"], "punch shape: Hertz's parabola or "
+                      "the exact sphere")
+    refine: int = number(1, "element size under the punch a/(20·2^refine) (3D: "
+                         "a/(6·2^refine))", at_least=0, at_most=6)
+    block: float | None = number(None, "block size in contact radii, >= 10 (default 1000, 3D "
+                                 "100)", above=0)
     material: str = choice("linear", ["linear", "power-law"], "linear elastic (Hertz "
                            "applies), or the power law (a Newton loop inside every "
                            "active-set iteration)")
@@ -63,25 +110,82 @@ class Hertz(punch_run.PunchParameters):
     n: float | None = number(None, "power law exponent (default 0.3)", unit="-", above=0)
 
     def check(self):
-        super().check()
+        if self.mixed and self.formulation == "multiplier" and self.model == "3d":
+            raise ValueError("--mixed --formulation multiplier is 2D and axisymmetric only (no "
+                             "nodal rule with positive weights on P2 triangles): use "
+                             "--formulation elimination in 3d")
+        if self.indentation is not None and self.indentation == 0:
+            raise ValueError("--indentation must be non-zero (negative: the punch stays clear)")
+        if self.block is not None and self.block < 10:
+            raise ValueError("--block must be >= 10 (block size in contact radii)")
+        if self.indentation is None and self.force is None:
+            self.indentation = 0.01 * self.radius
         cli.material_flags(self, power_law={"sigma0": 0.01, "n": 0.3})
 
 
-args = cli.arguments(Hertz, prefixes=punch_run.prefixes)
+args = cli.arguments(Hertz, prefixes=lambda a: {
+    f"punch_{a.model}_{a.formulation[:4]}_": "KSP" if a.formulation == "elimination"
+    else "SNES and KSP"})
+R, model = args.radius, args.model
 # -
 
-# ### The block
+# ### The mesh and its tags
 #
-# It must behave like Hertz's half-space: it is 1000 contact radii wide and deep (100 in
-# 3D), with elements of a/40 under the punch (axisymmetric; plane strain a/80, 3D a/12)
-# within 1.5 a of the axis, growing by 5 % of the distance away from it (3D: 10 %). On the
-# axisymmetric model this keeps the block-size and far-field error near 0.15 %, below the
-# 0.5 % asked of the force (measured in `fenics_nl/scenes/punch.py`). Its bottom slides on
-# a rigid base, the symmetry planes carry their symmetry conditions, its top is $S_C$. The
-# mesh is made for Hertz's contact radius of the load.
+# The block must behave like Hertz's half-space: it is 1000 contact radii wide and deep
+# (100 in 3D), with elements of a/40 under the punch (plane strain a/80, 3D a/12) within
+# 1.5 a of the axis, growing by 5 % of the distance away from it (plane strain 20 %, 3D
+# 10 %). On the axisymmetric model this keeps the block-size and far-field error near
+# 0.15 %, below the 0.5 % asked of the force (measured in `benchmarks/contact.py`). The
+# mesh is made for Hertz's contact radius of the load. gmsh tags its facets: `contact`
+# (the top, $S_C$), `bottom`, `symmetry_x`, `symmetry_y` (3D) and `side`.
 
-a = punch_run.contact_radius_for(args)
-block = punch_run.block_for(args)
+# +
+if args.force is None:
+    a = math.sqrt(R * abs(args.indentation))
+else:
+    law = hertz.cylinder_from_force if model == "plane_strain" else hertz.sphere_from_force
+    a = law(args.E, args.nu, R, args.force)["contact_radius"]
+dim = 3 if model == "3d" else 2
+vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
+h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
+growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
+size = args.block or (100.0 if model == "3d" else 1000.0)
+cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
+mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth)
+msh = mesh_data.mesh
+
+
+def tagged(name):
+    """The facets of the physical group `name`."""
+    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+
+# the modelled part's share of the whole body (2πr is in the axisymmetric residual)
+symmetry = {"axisymmetric": 1.0, "3d": 4.0, "plane_strain": 2.0}[model]
+# -
+
+# ### The function space and the boundary conditions
+#
+# P1 displacements (with `--mixed`, Taylor–Hood: P2 displacements and a P1 pressure $p$
+# as a second unknown). The bottom slides on a rigid base ($u_z = 0$), the symmetry planes
+# hold their normal component. The contact conditions on $S_C$ come with the active set.
+
+# +
+degree = 2 if args.mixed else 1
+if args.mixed:
+    W = mixed.taylor_hood(msh, degree)
+    w = fem.Function(W, name="displacement_pressure")
+    (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(W)
+    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+else:
+    V = fem.functionspace(msh, ("Lagrange", degree, (dim,)))
+    w = u = fem.Function(V, name="displacement")
+    v = ufl.TestFunction(V)
+bcs = [boundary.component(V, vertical, tagged("bottom")),
+       boundary.component(V, 0, tagged("symmetry_x"))]
+if dim == 3:
+    bcs.append(boundary.component(V, 1, tagged("symmetry_y")))
+# -
 
 # ### The material and the residual
 #
@@ -92,34 +196,205 @@ block = punch_run.block_for(args)
 #
 # with no external load: the punch acts only through the contact conditions. In the
 # axisymmetric model $\varepsilon$ has the hoop strain $u_r/r$ and the weight is $2\pi r$,
-# so that $R$ is the whole body's. With `--mixed` the pressure $p$ is an unknown too and
-# $R$ is the variation of $\Pi(u, p) = \int \tilde\varphi(\varepsilon) + p\,\mathrm{tr}\,
-# \varepsilon - p^2/(2\kappa)$, which holds at $\kappa = \infty$ ($\nu = 1/2$).
-
-material = (LinearElastic(args.E, args.nu) if args.material == "linear"
-            else PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n))
-residual = block.residual(material)
-
-# ### The active-set loop, in load steps
-#
-# `Punch` hands the residual, the supports and the gap $\gamma$ to
-# `fenics_nl.contact.active_set.ActiveSetContact`, which runs the course's loop: solve with
-# $u_n = \gamma$ on the active nodes (their rows eliminated, or Lagrange multipliers), then
-# update the set, until it stops changing. The load (δ, or the force P by a secant
-# iteration on δ) grows in equal steps, each started from the last active set.
+# so that $R$ is the whole body's. With `--mixed`, $R$ is the variation of
+# $\Pi(u, p) = \int \tilde\varphi(\varepsilon) + p\,\mathrm{tr}\,\varepsilon - p^2/(2\kappa)$,
+# which holds at $\kappa = \infty$ ($\nu = 1/2$).
 
 # +
-punch = Punch(block, material, residual, args.radius, formulation=args.formulation,
-              gap=args.gap)
-cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
-load = PunchLoad(punch, indentation=args.indentation, force=args.force,
-                 first_guess=a * a / args.radius)
-report = punch_run.StepReport(load.states, args.steps, args.steps, punch.output_fields)
-# --restart: the displacement, the contact statuses and the states back; --checkpoint:
-# saved after each converged step
-checkpoints = punch_run.checkpointing(punch, load)
-solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
-                    on_step=report, **checkpoints.options)
+material = (LinearElastic(args.E, args.nu) if args.material == "linear"
+            else PowerLaw(args.E, args.nu, sigma0=args.sigma0, n=args.n))
+kinematic = "3d" if dim == 3 else model  # the strain model: hoop strain if axisymmetric
+dx = kinematics.quadrature_measure("dx", msh, 2 * degree)  # exact for Hooke's law
+
+
+def eps(z):
+    return kinematics.small_strain(z, kinematic)
+
+
+weight = kinematics.measure_weight(msh, kinematic)  # 2πr, or 1
+if args.mixed:
+    residual = mixed.internal_work(material, u, p, v, q, kinematic) * dx
+else:
+    residual = ufl.inner(material.stress(eps(u)), eps(v)) * weight * dx
+# -
+
+# ### The contact surface and one active-set iteration
+#
+# `ContactSurface` holds the nodes of $S_C$ (the normal component's dofs on the `contact`
+# facets), their gap $\gamma$ and their areas. A *system* solves one iteration for a given
+# set: `set_active(active)` prescribes $u_n = \gamma$ on the active nodes (as Dirichlet
+# rows, or with `--formulation multiplier` through Lagrange multipliers on a facet
+# submesh, the course's saddle point $[K\ {-A};\ {-A^T}\ 0]$), `solve()` runs Newton on the
+# residual (one linear solve for the linear material; after the first iteration, a
+# factorization updated by the rows that changed), `normal_forces()` gives $T_n$ at the
+# nodes. Newton's absolute tolerance is scaled by Hertz's force for the expected $a$.
+
+
+# +
+def gap(delta):
+    """γ(x): the punch's height above the undeformed surface, less δ."""
+    def at(x):
+        r = np.hypot(x[0], x[1]) if dim == 3 else np.abs(x[0])
+        if args.gap == "parabola":
+            return r**2 / (2 * R) - delta
+        return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
+    return at
+
+
+def radius_of(x):
+    """Distance of the points x (n × 3) from the punch's axis."""
+    return np.hypot(x[:, 0], x[:, 1]) if dim == 3 else np.abs(x[:, 0])
+
+
+surface = ContactSurface(V, tagged("contact"), gap(0.0), normal_axis=vertical,
+                         unknown_space=w.function_space)
+E_star = hertz.effective_modulus(args.E, args.nu)
+P_scale = (np.pi / 4 * E_star * a * a / R if model == "plane_strain"
+           else 4 / 3 * E_star * a**3 / R)
+newton = {"rtol": 1e-10, "max_it": 50, "line_search": not material.is_linear,
+          "force_scale": P_scale / symmetry}
+if args.mixed and args.formulation == "elimination":  # a symmetric saddle point: LDLᵀ
+    newton.update(linear_solver="cholesky", saddle_point=True)
+System = EliminationSystem if args.formulation == "elimination" else MultiplierSystem
+system = System(residual, w, bcs, surface, prefix=f"punch_{model}_{args.formulation[:4]}_",
+                **newton)
+cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unknowns, "
+        f"h = {h:.3g}")
+# -
+
+# ### The active-set loop
+#
+# The course's loop, at a given position of the punch: solve with the current set, apply
+# the two rules, stop when the set repeats. The thresholds of the rules are round-off
+# levels of the problem's own scales (the largest contact force, the larger of the gap and
+# the displacement). A set that comes back after it changed would make the loop cycle: it
+# is an error, not a result. The set is kept as a boolean array over the nodes of $S_C$,
+# equal on the ranks that share a node (`surface.sync`), and shown as DOLFINx meshtags of
+# the active facets at the end.
+
+
+# +
+def active_set_loop(active, verbose):
+    """The settled set from `active`, its forces T_n, and the work it took."""
+    work, seen, changes = {"iterations": 0, "newton": 0, "factorizations": 0}, set(), None
+    for k in range(1, 51):
+        system.set_active(active, changes)  # u_n = γ on S_C^(k), T = 0 elsewhere
+        result = system.solve()
+        work["iterations"], work["newton"] = k, work["newton"] + result.iterations
+        work["factorizations"] += result.work.factorizations
+        T_n, penetration = system.normal_forces(), surface.normal_gap(w)
+        scale_u = max(global_max(msh.comm, np.abs(surface.gamma)),
+                      surface.displacement_scale(w))
+        leave = active & (T_n > 1e-10 * global_max(msh.comm, np.abs(T_n)))  # in tension
+        join = ~active & (penetration > 1e-10 * scale_u)  # penetrating
+        if verbose:
+            cli.say(f"    S_C^({k}): {surface.count(active)} active nodes; "
+                    f"{surface.count(leave)} leave (T_n > 0), {surface.count(join)} join "
+                    f"(u_n > γ)")
+        new = surface.sync((active & ~leave) | join)
+        changes = surface.count(new != active)
+        if changes == 0:
+            return active, T_n, work
+        if surface.fingerprint(new) in seen:
+            raise ContactError(f"the active set cycles (iteration {k})")
+        seen.add(surface.fingerprint(active))
+        active = new
+    raise ContactError("the active set did not settle in 50 iterations")
+
+
+# -
+
+# ### The load steps
+#
+# The punch goes down in equal steps of δ; each step starts from the last step's set plus
+# every node that now penetrates. The state of a step: the force $P = -\sum T_n$ (the
+# whole body's), the radius of the outermost active node and the largest nodal pressure
+# $p_j = -T_{n,j}/m_j$ ($m_j$ the node's area). With `--force`, the δ of each step's force
+# is found by secant steps on $\ln P(\ln\delta)$ (Hertz: a slope of 3/2), each an
+# active-set loop.
+
+# +
+@dataclass
+class State:
+    indentation: float
+    force: float
+    contact_radius: float
+    max_pressure: float
+    active_set_iterations: int
+    newton_iterations: int
+    factorizations: int
+
+
+active = surface.sync(surface.normal_gap(w) >= 0)  # S_C^(0): what touches already
+areas = surface.nodal_areas(weight)
+
+
+def press(delta, verbose=True):
+    """The converged state of the punch pressed by δ (from the last state's set).
+
+    The set and its nodal forces T_n stay in `active` and `T_n` for the outputs.
+    """
+    global active, T_n
+    surface.set_gap(gap(delta))
+    active = surface.sync(active | (surface.normal_gap(w) > 0))
+    active, T_n, work = active_set_loop(active, verbose)
+    r = radius_of(surface.x[active])
+    return State(delta, -symmetry * surface.total(T_n), global_max(msh.comm, r),
+                 global_max(msh.comm, (-T_n / areas)[active]), work["iterations"],
+                 work["newton"], work["factorizations"])
+
+
+def push(force, delta):
+    """Force control: δ with P(δ) = force, secant steps on (ln δ, ln P) from `delta`."""
+    s0 = press(delta, verbose=False)
+    d1 = delta * (force / s0.force) ** (2 / 3) if s0.force > 0 else 2 * delta
+    for _ in range(30):
+        s1 = press(d1, verbose=False)
+        if abs(s1.force / force - 1) < 1e-10:
+            return s1
+        if s1.force <= 0 or s0.force <= 0 or s1.force == s0.force:  # not touching yet
+            s0, d1 = s1, 1.5 * d1
+            continue
+        slope = math.log(s1.force / s0.force) / math.log(d1 / s0.indentation)
+        s0, d1 = s1, d1 * (force / s1.force) ** (1 / slope)
+    raise ContactError(f"force {force:g} not reached in 30 indentations")
+
+
+def fields():
+    """What --output writes: u (and p), the contact pressure and set, σ_eq."""
+    u_out = w.sub(0).collapse() if args.mixed else w
+    u_out.name = "displacement"
+    return [u_out, *([w.sub(1).collapse()] if args.mixed else []),
+            surface.nodal_field(-T_n / areas, "contact_pressure"),
+            surface.nodal_field(active.astype(float), "active_set"), von_mises()]
+
+
+def von_mises():
+    """σ_eq per cell (DG0)."""
+    if args.mixed:
+        return mixed.von_mises(material, u, p, kinematic, msh)
+    return material.von_mises(u, kinematic)
+
+
+states = []
+for step in range(1, args.steps + 1):
+    t = step / args.steps
+    if args.force is None:
+        s = press(t * args.indentation)
+    else:  # Hertz's δ ∝ P^(2/3) from the last step (the first: from a² / R)
+        guess = (states[-1].indentation * (step / (step - 1)) ** (2 / 3) if states
+                 else a * a / R * t ** (2 / 3))
+        s = push(t * args.force, guess)
+    states.append(s)
+    cli.converged_step({"load_factor": t, "indentation": s.indentation, "force": s.force,
+                        "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
+                        "active_set_iterations": s.active_set_iterations}, fields=fields)
+    cli.say(f"step {step}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, a = "
+            f"{s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, {s.active_set_iterations} "
+            "active-set iterations")
+facets = surface.facet_tags(active)  # S_C's facets: 1 active, 0 not
+cli.say(f"the active part of S_C: {msh.comm.allreduce(int(np.sum(facets.values)))} facets "
+        "(meshtags, value 1)")
 # -
 
 # ## Against Hertz
@@ -130,20 +405,75 @@ solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=F
 # $P \propto \delta^m$ (Hertz: 1.5). A contact zone the mesh cannot resolve (fewer than 4
 # nodes) is refused.
 
-nodes = punch.nodes_in_contact()
-warnings = check_contact_resolution(nodes, block.h, load.states[-1])
-check = punch_run.compare_with_hertz(punch, load.states)
+# +
+last = states[-1]
+nodes = surface.count(active)
+warnings = check_contact_resolution(nodes, h, last)
+out = {"model": model, "formulation": args.formulation, "material": args.material,
+       "mixed": args.mixed, "elements": "P2-P1 (Taylor-Hood)" if args.mixed else "P1",
+       **{k: getattr(last, k) for k in ("force", "indentation", "contact_radius",
+                                        "max_pressure")},
+       "element_size": h, "nodes_in_contact": nodes,
+       **{k: sum(getattr(s, k) for s in states) for k in ("active_set_iterations",
+                                                          "newton_iterations",
+                                                          "factorizations")},
+       "indentation_history": [s.indentation for s in states],
+       "force_history": [s.force for s in states]}
+ref = None
+if last.force > 0:
+    if model == "plane_strain":  # Hertz's a and p0 for the computed P per unit length
+        ref = hertz.cylinder_from_force(args.E, args.nu, R, last.force)
+        warnings.append("plane strain: the force is not checked (a cylinder's indentation "
+                        "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
+                        "checked against Hertz for the computed P")
+    else:
+        ref = hertz.sphere_from_indentation(args.E, args.nu, R, last.indentation)
+    for k in ("force", "contact_radius", "max_pressure"):
+        if k in ref:
+            out[f"hertz_{k}"], out[f"{k}_rel_error"] = ref[k], getattr(last, k) / ref[k] - 1
+    said = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
+            f"{100 * out[f'{k}_rel_error']:+.3f} %)" for k in ("force", "contact_radius",
+                                                               "max_pressure") if k in ref]
+    if model == "plane_strain":
+        said.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
+    cli.say("; ".join(said) + f"; h = {h:.2g}")
+else:
+    cli.say("the punch does not touch the block: zero contact force")
+if len(states) >= 2 and all(s.force > 0 for s in states):
+    out["fitted_exponent"] = float(np.polyfit(np.log(out["indentation_history"]),
+                                              np.log(out["force_history"]), 1)[0])
+    cli.say(f"P ∝ δ^{out['fitted_exponent']:.4f} over the steps (Hertz: 1.5)")
 if args.material != "linear":
     warnings.append(f"{args.material} material: Hertz's values are the linear reference, "
                     "not a check")
+# -
 
 # ## Outputs
 #
-# The JSON (every quantity above, the reactions of the supports), and when asked the
-# fields for ParaView (written at every step as it converged), the force–indentation curve
-# beside the pressure profile, and the deformed contact zone coloured by the von Mises
-# stress.
+# The JSON (every quantity above, the reactions of the supports: the bottom holds what
+# the punch pushes), and when asked the fields for ParaView (written at every step as it
+# converged), the force–indentation curve beside the pressure profile, and the deformed
+# contact zone coloured by the von Mises stress.
 
-out = punch_run.summary(args, punch, load.states, load.states, nodes, check, args.material,
-                        warnings)
-cli.results(out, punch_run.pictures(args, punch, load.states, check))
+# +
+groups = {name: tagged(name) for name in ("contact", "bottom", "symmetry_x")
+          + (("symmetry_y",) if dim == 3 else ())}
+out.update(
+    steps=[{k: getattr(s, k) for k in ("indentation", "force", "contact_radius",
+                                       "active_set_iterations")} for s in states],
+    reactions=boundary.reactions(residual, w, groups, space=V if args.mixed else None),
+    reactions_of={"axisymmetric": "the whole body (2πr in the residual)",
+                  "3d": "the modelled quarter",
+                  "plane_strain": "the modelled half, per unit length"}[model],
+    dofs=output.dofs(w.function_space), ranks=msh.comm.size, warnings=warnings)
+drawn = indentation_pictures.PunchRun(
+    model, states, ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
+    profile=surface.gathered(radius_of(surface.x), -T_n / areas, active),
+    section=(output.section(w.sub(0).collapse() if args.mixed else w, von_mises(),
+                            normal_axis=1 if dim == 3 else None) if args.png else None),
+    gap_at=lambda r, d: gap(d)(np.array([r, 0 * r, 0 * r])), h=h, mixed=args.mixed,
+    force_controlled=args.force is not None)
+cli.results(out, [*([lambda: indentation_pictures.curves(drawn, args.plot)] if args.plot
+                    else []),
+                  *([lambda: indentation_pictures.section_picture(drawn, args.png)]
+                    if args.png else [])])

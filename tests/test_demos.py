@@ -170,7 +170,7 @@ def test_punch_refuses_a_contact_zone_the_mesh_cannot_resolve():
     # --refine bound keeps a default run far from it)
     from types import SimpleNamespace
 
-    from fenics_nl.scenes.punch import check_contact_resolution
+    from fenics_nl.contact.surface import check_contact_resolution
 
     state = SimpleNamespace(force=1.0, contact_radius=0.1)
     with pytest.raises(ValueError, match=r"only 3 node.* cannot resolve the contact zone"):
@@ -587,17 +587,13 @@ def restarted_one_step_short(run, tmp_path, args, steps):
     return whole, run(*args, "--steps", str(steps), "--restart", tmp_path / "ck")
 
 
-@pytest.mark.parametrize("story,args", [
-    # the slip history, then the tangential load redone
-    ("punch_friction", ["--nu", "0.3", "--block", "10", "--tangential-ratio", "0.5"]),
-    ("punch", ["--force", "0.01", "--formulation", "multiplier"])])  # the secant on δ
-def test_a_punch_restarts_on_the_same_path(tmp_path, demo, story, args):
-    # the same JSON, key by key, to 1e-10 (the multiplier form's SNES starts from zero
-    # multipliers: round-off apart)
+def test_a_frictional_punch_restarts_on_the_same_path(tmp_path, demo):
+    # the slip history, then the tangential load redone: the same JSON, key by key, to
+    # 1e-10 (the frictionless elastic punch has no history: it takes no --checkpoint)
     from test_vessel import same_run
 
-    same_run(*restarted_one_step_short(getattr(demo, story), tmp_path,
-                                       [*args, "--refine", "0"], 2))
+    args = ["--nu", "0.3", "--block", "10", "--tangential-ratio", "0.5", "--refine", "0"]
+    same_run(*restarted_one_step_short(demo.punch_friction, tmp_path, args, 2))
 
 
 def test_punch_j2_load_unload_leaves_an_imprint(tmp_path, demo):
@@ -662,3 +658,16 @@ def test_indentation_identification_bad_input_one_clear_line(args, message, demo
     proc = demo.run(["indentation_identification.py", *args], check=False)
     assert proc.returncode != 0
     assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_punch_demos_loop_is_the_librarys_active_set(demo):
+    # the demo writes the course's loop out; `ActiveSetContact.solve` (the friction, case
+    # and identification runs' loop) must settle on the same set, force and iterations
+    from fenics_nl.materials.laws import LinearElastic
+    from fenics_nl.scenes.punch import build_punch
+
+    d = demo.punch("--refine", "0")
+    state = build_punch("axisymmetric", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0).indent(0.01)
+    assert state.force == pytest.approx(d["force"], rel=1e-12)
+    assert state.contact_radius == d["contact_radius"]
+    assert state.active_set_iterations == d["active_set_iterations"]

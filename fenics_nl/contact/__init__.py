@@ -9,8 +9,10 @@ eliminated) or `multiplier.MultiplierSystem` (Lagrange multipliers on a facet su
     from fenics_nl.contact import ActiveSetContact, FrictionalContact
 """
 
-from fenics_nl.contact.active_set import ActiveSetContact, ContactError
+from fenics_nl.contact.active_set import ActiveSetContact, ContactError, EliminationSystem
 from fenics_nl.contact.friction import FrictionalContact
+from fenics_nl.contact.multiplier import MultiplierSystem
 from fenics_nl.contact.surface import ContactSurface
 
-__all__ = ["ActiveSetContact", "ContactError", "ContactSurface", "FrictionalContact"]
+__all__ = ["ActiveSetContact", "ContactError", "ContactSurface", "EliminationSystem",
+           "FrictionalContact", "MultiplierSystem"]

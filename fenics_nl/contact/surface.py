@@ -20,8 +20,12 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_nl.materials.mixed import collapsed
+from fenics_nl.parallel import gather_rows
 
-__all__ = ["ContactSurface", "nodal_quadrature", "vertex_of_dof"]
+__all__ = ["ContactSurface", "check_contact_resolution", "nodal_quadrature", "vertex_of_dof"]
+
+MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
+FEW_NODES = 10  # below this, a and p0 are coarse: say so
 
 
 class ContactSurface:
@@ -82,6 +86,17 @@ class ContactSurface:
     def total(self, values: np.ndarray) -> float:
         """Σ values over the nodes, every rank's owned ones."""
         return self.comm.allreduce(float(np.sum(values[self.owned])))
+
+    def gathered(self, *columns: np.ndarray) -> tuple[np.ndarray, ...] | None:
+        """Nodal arrays gathered on rank 0 (each node once), sorted by the first; else None.
+
+        For a profile along the surface: `gathered(r, p, active)`. Collective.
+        """
+        rows = gather_rows(self.comm, *(np.asarray(c)[self.owned] for c in columns))
+        if rows is None:
+            return None
+        order = np.argsort(rows[0], kind="stable")
+        return tuple(c[order] for c in rows)
 
     def fingerprint(self, mask: np.ndarray) -> tuple[int, int]:
         """Global signature of a node set: its size and the sum of its global indices."""
@@ -220,6 +235,25 @@ class ContactSurface:
         values = np.array([in_mask[f2v.links(f)].all() for f in self.facets], dtype=np.int32)
         order = np.argsort(self.facets)
         return mesh.meshtags(self.mesh, fdim, self.facets[order], values[order])
+
+
+def check_contact_resolution(nodes: int, h: float, state) -> list[str]:
+    """Refuse a contact zone of fewer than MIN_NODES nodes (ValueError).
+
+    `nodes`: the active nodes; `h`: the element size there; `state`: a converged state
+    with its total `force` and `contact_radius`.
+
+    Returns the warnings: one below FEW_NODES, none when the zone is resolved or there is
+    no contact.
+    """
+    if state.force > 0 and nodes < MIN_NODES:
+        raise ValueError(f"only {nodes} node(s) of the surface are in contact (h = {h:.3g}, "
+                         f"contact radius {state.contact_radius:.3g}): the mesh cannot "
+                         f"resolve the contact zone; raise --refine or check the load")
+    if state.force > 0 and nodes < FEW_NODES:
+        return [f"only {nodes} nodes in contact: contact radius and p0 are resolved to about "
+                f"h = {h:.3g} only"]
+    return []
 
 
 def nodal_quadrature(degree: int, facet_dim: int) -> dict:

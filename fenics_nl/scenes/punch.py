@@ -31,6 +31,7 @@ from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.friction import FrictionalContact
+from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
 from fenics_nl.errors import SolveError
@@ -55,24 +56,6 @@ __all__ = [
 MODELS = ("axisymmetric", "3d", "plane_strain")
 SHAPES = ("parabola", "sphere", "cone")
 BERKOVICH = 70.3  # the half-angle of the cone of the Berkovich tip's area function (degrees)
-MIN_NODES = 4  # S_C nodes in contact below which a, p0 and P mean nothing
-FEW_NODES = 10  # below this, a and p0 are coarse: say so
-
-
-def check_contact_resolution(nodes: int, h: float, state: Indentation) -> list[str]:
-    """Refuse a contact zone of fewer than MIN_NODES nodes (ValueError).
-
-    Returns the warnings: one below FEW_NODES, none when the zone is resolved or there is
-    no contact.
-    """
-    if state.force > 0 and nodes < MIN_NODES:
-        raise ValueError(f"only {nodes} node(s) of the surface are in contact (h = {h:.3g}, "
-                         f"contact radius {state.contact_radius:.3g}): the mesh cannot "
-                         f"resolve the contact zone; lower --refine or check the load")
-    if state.force > 0 and nodes < FEW_NODES:
-        return [f"only {nodes} nodes in contact: contact radius and p0 are resolved to about "
-                f"h = {h:.3g} only"]
-    return []
 
 
 @dataclass
@@ -410,14 +393,8 @@ class Punch:
         axis (the half-width coordinate in plane strain).
         """
         c = self.contact
-        owned = c.owned
-        rows = gather_rows(self.mesh.comm, self.block.radius_of(c.x[owned].T),
-                           c.pressure(self.block.weight)[owned], c.active[owned])
-        if rows is None:
-            return None
-        r, p, active = rows
-        order = np.argsort(r)
-        return r[order], p[order], active[order]
+        return c.surface.gathered(self.block.radius_of(c.x.T), c.pressure(self.block.weight),
+                                  c.active)
 
     def traction_profile(self):
         """(x, p, q, status) of the S_C nodes on y = 0 (3D) or all (2D), on rank 0 sorted by x.

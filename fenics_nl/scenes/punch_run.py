@@ -14,10 +14,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from fenics_nl.io import cli
+from fenics_nl.io import cli, indentation_pictures, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
-from fenics_nl.scenes import punch_pictures
 from fenics_nl.scenes.punch import Punch, PunchBlock
 from fenics_nl.theory import hertz, mindlin
 
@@ -224,17 +223,22 @@ def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=No
             profile = (rings, punch.tangential_force_within(rings))
         else:
             profile = punch.traction_profile()
-    run = punch_pictures.PunchRun(
-        punch, states, check.ref, args.E, args.nu, args.radius, mixed=args.mixed,
+    block = punch.block
+    section = (output.section(block.displacement(), punch.von_mises(),
+                              normal_axis=1 if block.vertical == 2 else None)
+               if args.png else None)
+    run = indentation_pictures.PunchRun(
+        punch.model, states, check.ref, args.E, args.nu, args.radius,
+        rank0=punch.mesh.comm.rank == 0, profile=punch.surface_profile(), section=section,
+        gap_at=punch.gap_at, h=block.h, tangential=block.tangential, mixed=args.mixed,
         force_controlled=args.force is not None, friction=friction, traction=traction,
         traction_profile=profile, stick_radius_exact=stick_radius_exact,
         loading_steps=len(states), plastic=plastic)
-    run.snapshot(section=bool(args.png))
     writers = []
     if args.plot:  # (--output: the fields of every step were written as they converged)
-        writers.append(lambda: punch_pictures.curves(run, args.plot))
+        writers.append(lambda: indentation_pictures.curves(run, args.plot))
     if args.png:
-        writers.append(lambda: punch_pictures.section_picture(run, args.png))
+        writers.append(lambda: indentation_pictures.section_picture(run, args.png))
     return writers
 
 

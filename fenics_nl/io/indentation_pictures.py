@@ -1,21 +1,22 @@
-"""The punch's pictures, against the closed forms of Hertz and Cattaneo–Mindlin.
+"""Pictures of a rigid punch pressed into a block, against Hertz and Cattaneo–Mindlin.
 
 The force–indentation curve, the deformed contact zone in section, and the contact
-pressure (or, with friction, the tangential traction) along the surface.
-
-`PunchRun.snapshot` gathers on rank 0 what they draw of the state at hand (collective);
-`curves` and `section_picture` then draw on rank 0, the whole load path on the curve
-(loading, and an unloading after it) and the snapshot's state on the rest: a run that is
-unloaded is drawn at its largest load.
+pressure (or, with friction, the tangential traction) along the surface. They read plain
+values (`PunchRun`): the converged states, the surface profile and the section gathered on
+rank 0 (`ContactSurface.gathered`, `output.section`), the punch's shape as a function.
+`curves` and `section_picture` draw on rank 0, the whole load path on the curve (loading,
+and an unloading after it) and the drawn state on the rest: a run that is unloaded is drawn
+at its largest load.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from fenics_nl.io import output, pictures
+from fenics_nl.io import pictures
 from fenics_nl.theory import hertz, mindlin
 
 __all__ = ["PunchRun", "curves", "section_picture"]
@@ -23,13 +24,20 @@ __all__ = ["PunchRun", "curves", "section_picture"]
 
 @dataclass
 class PunchRun:
-    """What the pictures read of a punch run.
+    """What the pictures read of a punch run: plain values, gathered on rank 0.
 
     Args:
-        punch: the solved `Punch`.
-        states: the converged load steps (`Indentation` records), loading then unloading.
-        ref: Hertz's values for the last step (None: no contact).
+        model: ``axisymmetric``, ``3d`` or ``plane_strain``.
+        states: the converged load steps (records with `indentation`, `force`,
+            `contact_radius`, `max_pressure`), loading then unloading; the last is drawn.
+        ref: Hertz's values for the drawn state (None: no contact).
         E, nu, radius: the material and the punch radius.
+        rank0: this rank draws (the others pass None profiles).
+        profile: (r, p, active) of the surface nodes sorted by r, the drawn state's.
+        section: `output.section` of the drawn state (σ_eq per cell), for `section_picture`.
+        gap_at: γ(r, δ), the punch's height above the surface at r less δ.
+        h: the element size under the punch (the zoom's smallest window).
+        tangential: the block spans both sides of the punch (a tangential load).
         mixed: Taylor–Hood elements (for the title).
         force_controlled: the force was prescribed (the check is then on δ).
         friction: Coulomb's f, or None.
@@ -41,12 +49,18 @@ class PunchRun:
         plastic: the block flows (J2): Hertz is the elastic reference, not a check.
     """
 
-    punch: object
+    model: str
     states: list
     ref: dict | None
     E: float
     nu: float
     radius: float
+    rank0: bool
+    profile: tuple | None
+    section: tuple | None = None
+    gap_at: Callable | None = None
+    h: float = 0.0
+    tangential: bool = False
     mixed: bool = False
     force_controlled: bool = False
     friction: float | None = None
@@ -55,30 +69,15 @@ class PunchRun:
     stick_radius_exact: float | None = None
     loading_steps: int | None = None
     plastic: bool = False
-    model: str = field(init=False)
-    state: object = field(init=False)  # the drawn state: the last one at `snapshot`
-    profile: tuple | None = field(init=False, default=None)
-    section: tuple | None = field(init=False, default=None)
+    state: object = field(init=False)  # the drawn state: the last one given
 
     def __post_init__(self):
-        self.model = self.punch.model
-
-    def snapshot(self, *, section: bool) -> None:
-        """Gather what is drawn of the current state on rank 0, to draw later (collective).
-
-        Its surface profile, and with `section` the deformed section coloured by σ_eq.
-        """
         self.state = self.states[-1]
-        self.profile = self.punch.surface_profile()
-        if section:
-            block = self.punch.block
-            self.section = output.section(block.displacement(), self.punch.von_mises(),
-                                          normal_axis=1 if block.vertical == 2 else None)
 
 
 def curves(run: PunchRun, path: str) -> None:
     """P(δ) of every step against Hertz, beside the pressure (or traction) panel."""
-    if run.punch.mesh.comm.rank != 0:
+    if not run.rank0:
         return
     plt = pictures.pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
@@ -220,12 +219,12 @@ def pressure_panel(ax, profile, state, ref) -> None:
 
 def section_picture(run: PunchRun, path: str) -> None:
     """The snapshot's deformed contact zone in section, coloured by σ_eq / p0, beside p(r)."""
-    punch, block, state, ref = run.punch, run.punch.block, run.state, run.ref
-    if punch.mesh.comm.rank != 0:
+    state, ref = run.state, run.ref
+    if not run.rank0:
         return
     plt = pictures.pyplot()
     x, z, u_x, u_z, triangles, vm = run.section
-    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * block.h)
+    a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * run.h)
     window = 2.5 * a
     # the rigid drop of the block is removed (the surface at the window's edge stays put),
     # and the dent is drawn about a/4 deep
@@ -240,9 +239,9 @@ def section_picture(run: PunchRun, path: str) -> None:
     tpc = ax.tripcolor(xd, zd, triangles, facecolors=vm / p0, cmap="viridis",
                        edgecolors="face", vmin=0)
     ax.triplot(xd, zd, triangles, color="white", lw=0.15, alpha=0.4)
-    left = -window if block.tangential else 0
+    left = -window if run.tangential else 0
     rr = np.linspace(left, window, 600)
-    gap = punch.gap_at(np.abs(rr), state.indentation)
+    gap = run.gap_at(np.abs(rr), state.indentation)
     ax.plot(rr, scale * (gap - drop), color="C3", lw=2, label="punch surface")
     ax.plot([state.contact_radius] * 2, [-0.15 * a, 0.15 * a], color="C3", lw=1)
     ax.annotate("a (FE)", (state.contact_radius, 0.17 * a), color="C3", ha="center", fontsize=8)
