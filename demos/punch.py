@@ -53,6 +53,7 @@ from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.parallel import global_max
+from fenics_nl.solvers.force_control import reach_force
 from fenics_nl.theory import hertz
 
 # -
@@ -310,8 +311,8 @@ def active_set_loop(active, verbose):
 # every node that now penetrates. The state of a step: the force $P = -\sum T_n$ (the
 # whole body's), the radius of the outermost active node and the largest nodal pressure
 # $p_j = -T_{n,j}/m_j$ ($m_j$ the node's area). With `--force`, the δ of each step's force
-# is found by secant steps on $\ln P(\ln\delta)$ (Hertz: a slope of 3/2), each an
-# active-set loop.
+# is found by secant steps on $\ln P(\ln\delta)$ (`reach_force`; Hertz: a slope of 3/2),
+# each an active-set loop.
 
 # +
 @dataclass
@@ -344,22 +345,6 @@ def press(delta, verbose=True):
                  work["newton"], work["factorizations"])
 
 
-def push(force, delta):
-    """Force control: δ with P(δ) = force, secant steps on (ln δ, ln P) from `delta`."""
-    s0 = press(delta, verbose=False)
-    d1 = delta * (force / s0.force) ** (2 / 3) if s0.force > 0 else 2 * delta
-    for _ in range(30):
-        s1 = press(d1, verbose=False)
-        if abs(s1.force / force - 1) < 1e-10:
-            return s1
-        if s1.force <= 0 or s0.force <= 0 or s1.force == s0.force:  # not touching yet
-            s0, d1 = s1, 1.5 * d1
-            continue
-        slope = math.log(s1.force / s0.force) / math.log(d1 / s0.indentation)
-        s0, d1 = s1, d1 * (force / s1.force) ** (1 / slope)
-    raise ContactError(f"force {force:g} not reached in 30 indentations")
-
-
 def fields():
     """What --output writes: u (and p), the contact pressure and set, σ_eq."""
     u_out = w.sub(0).collapse() if args.mixed else w
@@ -384,7 +369,7 @@ for step in range(1, args.steps + 1):
     else:  # Hertz's δ ∝ P^(2/3) from the last step (the first: from a² / R)
         guess = (states[-1].indentation * (step / (step - 1)) ** (2 / 3) if states
                  else a * a / R * t ** (2 / 3))
-        s = push(t * args.force, guess)
+        s, _ = reach_force(lambda d: press(d, verbose=False), t * args.force, guess)
     states.append(s)
     cli.converged_step({"load_factor": t, "indentation": s.indentation, "force": s.force,
                         "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
@@ -392,9 +377,10 @@ for step in range(1, args.steps + 1):
     cli.say(f"step {step}/{args.steps}: δ = {s.indentation:.5g}, P = {s.force:.6g}, a = "
             f"{s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, {s.active_set_iterations} "
             "active-set iterations")
-facets = surface.facet_tags(active)  # S_C's facets: 1 active, 0 not
-cli.say(f"the active part of S_C: {msh.comm.allreduce(int(np.sum(facets.values)))} facets "
-        "(meshtags, value 1)")
+active_facets = surface.facet_tags(active).find(1)  # meshtags of S_C: 1 active, 0 not
+owned = active_facets < msh.topology.index_map(dim - 1).size_local
+cli.say(f"the active part of S_C: {msh.comm.allreduce(int(owned.sum()))} facets (meshtags, "
+        "value 1)")
 # -
 
 # ## Against Hertz

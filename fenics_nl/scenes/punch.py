@@ -40,6 +40,7 @@ from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import gather_rows, global_max
+from fenics_nl.solvers.force_control import reach_force
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
 
@@ -367,24 +368,9 @@ class Punch:
         r = self.block.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
         return global_max(self.mesh.comm, r)
 
-    def push(self, force: float, delta0: float, rtol: float = 1e-10, max_it: int = 30
-             ) -> tuple[Indentation, int]:
-        """Force control: find δ with P(δ) = force by a secant iteration on (ln δ, ln P)."""
-        if not force > 0:
-            raise ValueError(f"force must be > 0, got {force}")
-        d0, s0 = delta0, self.indent(delta0)
-        d1 = d0 * (force / s0.force) ** (2 / 3) if s0.force > 0 else 2 * d0
-        for k in range(max_it):
-            s1 = self.indent(d1)
-            if abs(s1.force / force - 1) < rtol:
-                return s1, k + 2
-            if s1.force <= 0 or s0.force <= 0 or s1.force == s0.force:
-                d0, s0, d1 = d1, s1, d1 * 1.5
-                continue
-            slope = math.log(s1.force / s0.force) / math.log(d1 / d0)
-            d0, s0 = d1, s1
-            d1 = d1 * (force / s1.force) ** (1 / slope)
-        raise SolveError(f"force {force:g} not reached in {max_it} indentations")
+    def push(self, force: float, delta0: float) -> tuple[Indentation, int]:
+        """Force control: δ with P(δ) = force (`solvers.force_control.reach_force`)."""
+        return reach_force(self.indent, force, delta0)
 
     def surface_profile(self):
         """(r, p, active) of every S_C node, gathered on rank 0 and sorted by r (else None).

@@ -1,0 +1,52 @@
+"""Force control of a problem driven by a prescribed displacement: the displacement of a force.
+
+A rigid punch, a die, a grip: the solver prescribes the displacement d and the force P(d)
+is the result. To reach a given force, d is found by secant steps on (ln d, ln P): exact in
+one step for a power law P ∝ d^m (Hertz's m = 3/2), and quick for laws close to one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from fenics_nl.errors import SolveError
+
+__all__ = ["reach_force"]
+
+
+def reach_force(state_at: Callable[[float], object], force: float, guess: float, *,
+                exponent: float = 1.5, rtol: float = 1e-10, max_it: int = 30
+                ) -> tuple[object, int]:
+    """The state whose `force` is `force`, and the number of states it took.
+
+    Args:
+        state_at: the converged state at a prescribed displacement d (a record with its
+            total `force`, positive, growing with d).
+        force: the force to reach, > 0.
+        guess: the first displacement tried.
+        exponent: the m of P ∝ d^m expected, for the second displacement tried.
+        rtol: the relative tolerance on the force.
+        max_it: the states tried at most.
+
+    Returns:
+        (the state at P = force within rtol, the number of `state_at` calls).
+
+    Raises:
+        SolveError: the force is not reached in `max_it` states.
+    """
+    if not force > 0:
+        raise ValueError(f"force must be > 0, got {force}")
+    d0, s0 = guess, state_at(guess)
+    d1 = d0 * (force / s0.force) ** (1 / exponent) if s0.force > 0 else 2 * d0
+    for k in range(max_it - 1):
+        s1 = state_at(d1)
+        if abs(s1.force / force - 1) < rtol:
+            return s1, k + 2
+        if s1.force <= 0 or s0.force <= 0 or s1.force == s0.force:  # not touching yet
+            d0, s0, d1 = d1, s1, 1.5 * d1
+            continue
+        slope = math.log(s1.force / s0.force) / math.log(d1 / d0)
+        d0, s0 = d1, s1
+        d1 = d1 * (force / s1.force) ** (1 / slope)
+    raise SolveError(f"force {force:g} not reached in {max_it} positions")
