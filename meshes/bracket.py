@@ -1,4 +1,4 @@
-"""Write the bracket of `fenics_nl.scenes.bracket_geometry` (dimensions in mm) to a .msh file.
+"""Write the bracket of `fenics_nl.domain.bracket` (dimensions in mm) to a .msh file.
 
 python meshes/bracket.py --size 4 -o bracket.msh
 """
@@ -7,7 +7,7 @@ import argparse
 
 import gmsh
 
-from fenics_nl.scenes.bracket_geometry import build
+from fenics_nl.domain.bracket import build
 
 
 def main():

@@ -59,26 +59,38 @@ def facet_points(msh, facets: np.ndarray) -> np.ndarray:
     return msh.geometry.x[np.unique(nodes.ravel())]
 
 
-def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: float,
+def bracket_picture(u: fem.Function, field: fem.Function, path: str, *,
+                    clamped: np.ndarray, loaded: np.ndarray, load_motion: np.ndarray,
+                    units: str, force: float, support: str,
+                    floor: tuple[np.ndarray, np.ndarray] | None = None,
                     label: str | None = None, unloaded: bool = False) -> None:
     """The deformed bracket in two views, coloured by a cell field (σ_eq by default).
 
-    The field is clipped at its 99th percentile (said so); `label` names it. The load arrow
-    on the loaded hole (`unloaded`: the load was removed, the shape is the permanent one),
-    the clamped bolt holes, and with a floor support the floor and a view from below with
-    each base node's contact status. Collective; rank 0 writes `path`.
+    Args:
+        u: the displacement.
+        field: a cell field (DG0), clipped at its 99th percentile (said so).
+        path: the picture (rank 0 writes it).
+        clamped: the facets of the clamped bolt holes.
+        loaded: the facets of the loaded hole.
+        load_motion: the loaded hole's mean displacement (the arrow starts there).
+        units: the length unit, for the labels.
+        force: the load, for its label.
+        support: ``clamped`` or ``contact``, for the title.
+        floor: with a floor, this rank's owned base nodes: their coordinates and contact
+            status (True: in contact); a third view from below shows them.
+        label: the field's name.
+        unloaded: the load was removed (the shape is the permanent one).
+
+    Collective.
     """
     bar_title = label or f"von Mises stress [N/{units}²]"
-    comm = b.mesh.comm
-    u1 = vertex_interpolant(b.part.displacement())
+    msh = u.function_space.mesh
+    comm = msh.comm
+    u1 = vertex_interpolant(u)
     grid = gather_grid(u1.function_space, {"u": u1}, {"vm": owned_cell_values(field)})
-    bolts = gather_rows(comm, facet_points(b.mesh, b.part.groups["bolts"]))
-    load = gather_rows(comm, facet_points(b.mesh, b.part.load_facets))
-    load_motion = b.load_point_motion()
-    status = None
-    if b.support == "contact":
-        c = b.solver
-        status = gather_rows(comm, c.x[c.owned], c.active[c.owned])
+    bolts = gather_rows(comm, facet_points(msh, clamped))
+    load = gather_rows(comm, facet_points(msh, loaded))
+    status = gather_rows(comm, *floor) if floor is not None else None
     if comm.rank != 0:
         return
     pv = off_screen()
@@ -129,7 +141,7 @@ def bracket_picture(b, field: fem.Function, path: str, *, units: str, force: flo
             state = (f"unloaded from F = {force / 1e3:.3g} kN: permanent load-point "
                      f"displacement" if unloaded else
                      f"F = {force / 1e3:.3g} kN: load-point displacement")
-            label = (f"bracket, {b.support} support, {state} "
+            label = (f"bracket, {support} support, {state} "
                      f"{np.linalg.norm(load_motion):.3g} {units}\n{label}")
         pl.add_text(label, font_size=12 if i == 0 else 10, position="upper_left")
     pl.subplot(0, 0)

@@ -10,61 +10,27 @@ with Coulomb friction).
 from __future__ import annotations
 
 from functools import partial
-from pathlib import Path
 
-import gmsh
 import numpy as np
 import ufl
 from dolfinx import fem
-from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.domain import boundary
-from fenics_nl.domain.mesh_check import check_cells
+from fenics_nl.domain.bracket import THICK, bracket_mesh
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
-from fenics_nl.scenes import bracket_geometry
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
 
-__all__ = ["Bracket", "BracketPart", "build_bracket", "load_mesh"]
+__all__ = ["Bracket", "BracketPart", "build_bracket"]
 
-GROUPS = ("bolts", "load", "base")
-THICKNESS_MM = bracket_geometry.THICK  # the base plate's thickness
-
-
-def load_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None,
-              length_scale: float = 1.0):
-    """MeshData from `bracket_geometry` (element size `size` in mm) or from a .msh file.
-
-    The built geometry is in mm; `length_scale` (the length of 1 mm in the user's unit,
-    1e-3 for metres) scales its coordinates. A file is read in its own units.
-    """
-    if path is not None:
-        if not Path(path).is_file():
-            raise ValueError(f"mesh file not found: {path}")
-        try:
-            data = gmshio.read_from_msh(path, comm, 0, gdim=3)
-        except Exception as err:  # gmsh/dolfinx raise various types on corrupt files
-            raise ValueError(f"cannot read mesh file {path}: {err}") from None
-        check_cells(data.mesh, name=path)  # a file may hold anything: inverted cells too
-    else:
-        if comm.rank == 0:
-            bracket_geometry.build(size)
-        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-        if comm.rank == 0:
-            gmsh.model.remove()
-        data.mesh.geometry.x[:] *= length_scale
-    missing = [g for g in GROUPS if g not in data.physical_groups]
-    if missing:
-        raise ValueError(f"the mesh has no physical group {', '.join(missing)} "
-                         f"(needs {', '.join(GROUPS)})")
-    return data
+THICKNESS_MM = THICK  # the base plate's thickness
 
 
 # Newton iterations allowed in one load step. Full Newton that has not converged in 50 is
@@ -89,7 +55,7 @@ class BracketPart:
         if support not in ("clamped", "contact"):
             raise ValueError(f"support must be clamped or contact, got {support!r}")
         self.support = support
-        data = load_mesh(comm, size, mesh_file, length_scale)
+        data = bracket_mesh(comm, size, mesh_file, length_scale)
         self.mesh = data.mesh
         tags = data.facet_tags
 

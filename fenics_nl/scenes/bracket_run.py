@@ -203,12 +203,18 @@ def picture(b, vm, args) -> None:
 
     Coloured by σ_eq; in J2 by the cumulated plastic strain.
     """
+    floor = None
+    if b.support == "contact":
+        c = b.solver
+        floor = (c.x[c.owned], c.active[c.owned])
+    where = dict(clamped=b.part.groups["bolts"], loaded=b.part.load_facets,
+                 load_motion=b.load_point_motion(), units=args.units, force=args.force,
+                 support=b.support, floor=floor, unloaded=args.unload)
     if isinstance(b.material, J2Plasticity):  # where it yielded, and how much
-        pictures.bracket_picture(b, b.material.cumulated_plastic_strain_per_cell(), args.png,
-                                 units=args.units, force=args.force,
+        pictures.bracket_picture(b.part.displacement(),
+                                 b.material.cumulated_plastic_strain_per_cell(), args.png,
                                  label="cumulated plastic strain p (largest of each cell)",
-                                 unloaded=args.unload)
+                                 **where)
     else:
-        pictures.bracket_picture(b, vm, args.png, units=args.units, force=args.force,
-                                 unloaded=args.unload)
+        pictures.bracket_picture(b.part.displacement(), vm, args.png, **where)
     say(f"wrote {args.png}")

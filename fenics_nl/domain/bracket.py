@@ -1,4 +1,4 @@
-"""An L-shaped bracket in gmsh (OpenCASCADE), dimensions in mm.
+"""An L-shaped bracket in gmsh (OpenCASCADE), dimensions in mm: the mesh and its tags.
 
 Base plate 100 x 60 x 10 on z = 0 with two bolt holes (Ø12) at x = 70; a vertical arm
 10 x 60 x 80 at x = 0 with a loaded hole (Ø16) through it at z = 60; an 8 mm fillet
@@ -7,17 +7,24 @@ between them, where the stress concentrates. Physical groups:
     bolts (the two hole surfaces), load (the arm's hole surface), base (the bottom face
     z = 0), solid (the volume).
 
-`meshes/bracket.py` writes it to a file you can open in gmsh:
+`bracket_mesh` gives DOLFINx's mesh with its cell and facet tags (the groups above), built
+or read from a user's .msh file with the same groups. `meshes/bracket.py` writes it to a
+file you can open in gmsh:
     python meshes/bracket.py --size 4 -o bracket.msh
 """
 
 from __future__ import annotations
 
-import gmsh
+from pathlib import Path
 
+import gmsh
+from dolfinx.io import gmsh as gmshio
+from mpi4py import MPI
+
+from fenics_nl.domain.mesh_check import check_cells
 from fenics_nl.domain.meshes import start_model
 
-__all__ = ["build"]
+__all__ = ["THICK", "bracket_mesh", "build"]
 
 LENGTH, WIDTH, THICK, HEIGHT = 100.0, 60.0, 10.0, 80.0
 FILLET, BOLT_R, BOLT_X, LOAD_R, LOAD_Z = 8.0, 6.0, 70.0, 8.0, 60.0
@@ -63,3 +70,43 @@ def build(size: float) -> None:
 
 def _is_line_at(c, x, z):
     return abs(c[0] - x) < 1e-6 and abs(c[2] - z) < 1e-6
+
+
+def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = None,
+                 length_scale: float = 1.0) -> gmshio.MeshData:
+    """The bracket's mesh and tags: built (element size `size` in mm) or read from `path`.
+
+    Args:
+        comm: the communicator of the mesh (gmsh works on rank 0).
+        size: the largest element size in mm, when the geometry is built.
+        path: a .msh file with the groups ``bolts``, ``load`` and ``base``, read in its own
+            units (the cells checked: a file may hold inverted ones).
+        length_scale: the length of 1 mm in the user's unit (1e-3 for metres), for the
+            built geometry.
+
+    Returns:
+        DOLFINx's MeshData: `mesh`, `facet_tags`, `physical_groups` (name → tag).
+
+    Raises:
+        ValueError: the file is missing, unreadable, or lacks a group.
+    """
+    if path is not None:
+        if not Path(path).is_file():
+            raise ValueError(f"mesh file not found: {path}")
+        try:
+            data = gmshio.read_from_msh(path, comm, 0, gdim=3)
+        except Exception as err:  # gmsh/dolfinx raise various types on corrupt files
+            raise ValueError(f"cannot read mesh file {path}: {err}") from None
+        check_cells(data.mesh, name=path)
+    else:
+        if comm.rank == 0:
+            build(size)
+        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+        if comm.rank == 0:
+            gmsh.model.remove()
+        data.mesh.geometry.x[:] *= length_scale
+    missing = [g for g in GROUPS if g not in data.physical_groups]
+    if missing:
+        raise ValueError(f"the mesh has no physical group {', '.join(missing)} "
+                         f"(needs {', '.join(GROUPS)})")
+    return data
