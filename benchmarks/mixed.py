@@ -123,7 +123,7 @@ def linear_solvers(nu: float, linear: str, h: float) -> dict:
     dx = kinematics.quadrature_measure("dx", body.mesh, 4)
     R = (mixed.internal_work(law, m.u, m.p, m.v, m.q, body.model) * dx
          + 1e-3 * ufl.dot(body.normal, m.v) * body.ds_inner)
-    extra = ({"preconditioner": mixed.preconditioner(law, m, body.model, dx)}
+    extra = ({"preconditioner": mixed.preconditioner(law, m.W, body.model, dx)}
              if linear == "gamg" else {})
     solver = NewtonSolver(R, body.unknown, body.supports, linear_solver=linear, rtol=1e-10,
                           atol=1e-10, force_scale=law.mu * A, prefix=f"mixed_{linear}_",

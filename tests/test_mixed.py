@@ -232,7 +232,7 @@ def minres_iterations(nu, h=0.05):
          + p_in * ufl.dot(body.normal, m.v) * body.ds_inner)
     solver = NewtonSolver(R, m.w, body.supports, linear_solver="gamg", rtol=1e-10,
                           atol=1e-10, force_scale=law.mu * A, prefix=f"minres{nu}_",
-                          preconditioner=mixed.preconditioner(law, m, body.model, dx))
+                          preconditioner=mixed.preconditioner(law, m.W, body.model, dx))
     result = solver.solve()
     exact = p_in * vessels.elastic_inner_compliance("cylinder", A, B, E, nu)
     return result.work.krylov_iterations, body.inner_displacement() / exact - 1

@@ -361,7 +361,7 @@ class CaseProblem:
         opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
                 "line_search": self.line_search(), "force_scale": self.force_scale}
         if linear == "gamg" and self.mixed:  # MINRES with the block preconditioner
-            opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed,
+            opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed.W,
                                                                self.model, self.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
             opts["constant_tangent"] = self.fields.constant_tangent(self.material, self.model,

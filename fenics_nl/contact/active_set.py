@@ -268,6 +268,15 @@ class ActiveSetContact:
         return [self.nodal_field(self.pressure(weight), "contact_pressure"),
                 self.nodal_field(self.active.astype(float), "active_set")]
 
+    def contact_areas(self, weight=1.0) -> tuple[float, float]:
+        """Areas of S_C open (lifted off) and in contact, from `active_facets` (collective).
+
+        A facet is in contact when all its vertices are active; the two add up to S_C's.
+        """
+        ds = ufl.Measure("ds", domain=self.surface.mesh, subdomain_data=self.active_facets())
+        return tuple(self.comm.allreduce(fem.assemble_scalar(fem.form(weight * ds(tag))))
+                     for tag in (0, 1))
+
     def active_vertices(self) -> mesh.MeshTags:
         """Vertex meshtags of the active nodes (value 1)."""
         return self.surface.vertex_tags(self.active)

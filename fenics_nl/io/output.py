@@ -23,6 +23,7 @@ __all__ = [
     "dofs",
     "gather_grid",
     "owned_cell_values",
+    "peak_memory_mb",
     "section",
     "vertex_interpolant",
     "write_fields",
@@ -32,6 +33,15 @@ __all__ = [
 def dofs(V: fem.FunctionSpace) -> int:
     """Global number of scalar unknowns of V (what the scenes report as `dofs`)."""
     return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+
+
+def peak_memory_mb(comm) -> float:
+    """The largest resident memory of the ranks so far, in MiB (collective)."""
+    import resource
+
+    from mpi4py import MPI
+
+    return comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, op=MPI.MAX)
 
 
 def write_fields(folder: str | Path, functions: list[fem.Function]) -> list[Path]:

@@ -269,6 +269,16 @@ class PowerLaw(Isotropic, SmallStrain):
         """Reference strain ε0 = σ0 / (3μ), where the law turns non-linear."""
         return self.sigma0 / (3 * self.mu)
 
+    def strain_ratio(self, sigma_eq: float) -> float:
+        """ε_eq/ε0 at the equivalent stress σ_eq, inverting σ_eq/σ0 = x (1 + x²)^((n−1)/2).
+
+        The strain a computed peak stress means (a number, not UFL).
+        """
+        from scipy.optimize import brentq
+
+        s, n = sigma_eq / self.sigma0, self.n
+        return brentq(lambda x: x * (1 + x * x) ** ((n - 1) / 2) - s, 0.0, 1e9) if s > 0 else 0.0
+
     def energy(self, eps):
         """φ(ε)."""
         self.require_compressible()

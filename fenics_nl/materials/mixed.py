@@ -127,30 +127,29 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
     return f
 
 
-def modified_newton_tangent(material, unknown: MixedUnknown, model: str, dx):
+def modified_newton_tangent(material, w: fem.Function, model: str, dx):
     """The mixed counterpart of `Material.modified_newton_tangent`.
 
     For a path-dependent law at small strain: the tangent of the same mixed form with
     Hooke's law (E, ν); at finite strain, the tangent each solve starts from, as in the
-    displacement formulation.
+    displacement formulation. `w`: the mixed unknown (u, p).
     """
     if not material.path_dependent or material.finite_strain:
         return "initial"
     from fenics_nl.materials.laws import LinearElastic
 
-    m = unknown
     elastic = LinearElastic(material.E, material.nu)
-    return ufl.derivative(internal_work(elastic, m.u, m.p, m.v, m.q, model) * dx, m.w)
+    (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(w.function_space)
+    return ufl.derivative(internal_work(elastic, u, p, v, q, model) * dx, w)
 
 
-def preconditioner(material, unknown: MixedUnknown, model: str, dx):
+def preconditioner(material, W: fem.FunctionSpace, model: str, dx):
     """diag(2μ ε:ε, (1/μ + 1/k) mass): the block preconditioner of the mixed tangent.
 
     Spectrally equivalent to it for any bulk modulus (Silvester–Wathen), so MINRES needs
     about as many iterations at ν = 1/2 as at 0.3 (`NewtonSolver`, ``gamg``). The material's
     initial shear modulus: a softening law (plastic flow) weakens it, as it does GAMG's.
     """
-    W = unknown.W
     (du, dp), (v, q) = ufl.TrialFunctions(W), ufl.TestFunctions(W)
     eps = kinematics.small_strain
     k = material.volumetric_modulus  # the k of every law's `volumetric_split`
@@ -232,7 +231,7 @@ class MixedUnknown:
 
     def constant_tangent(self, material, model: str, dx):
         """What modified Newton and BFGS keep (`modified_newton_tangent` of this module)."""
-        return modified_newton_tangent(material, self, model, dx)
+        return modified_newton_tangent(material, self.w, model, dx)
 
 
 def unknowns(mesh, degree: int = 2, mixed: bool = False

@@ -171,6 +171,22 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         eps_p, p, _ = self.return_map(strain)
         return {"plastic_strain": eps_p, "cumulated_plastic_strain": p}
 
+    def plastic_zone(self, dx) -> dict:
+        """The largest cumulated plastic strain, and the plastic fraction of the volume.
+
+        `dx`: the measure of the residual (the state's quadrature rule). Collective.
+        """
+        from dolfinx import fem
+        from mpi4py import MPI
+
+        p = self.cumulated_plastic_strain
+        comm, n = p.function_space.mesh.comm, p.function_space.dofmap.index_map.size_local
+        volume, plastic = (comm.allreduce(fem.assemble_scalar(fem.form(f * dx)))
+                           for f in (1.0, ufl.conditional(ufl.gt(p, 0), 1.0, 0.0)))
+        return {"max_cumulated_plastic_strain": comm.allreduce(
+                    float(p.x.array[:n].max(initial=0.0)), op=MPI.MAX),
+                "plastic_volume_fraction": plastic / volume}
+
     def output_fields(self) -> list:
         """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0."""
         return [self.cumulated_plastic_strain_per_cell(), self.plastic_strain_per_cell()]

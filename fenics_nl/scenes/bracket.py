@@ -168,7 +168,7 @@ class Bracket:
                 "max_it": MAX_IT.get(method, 50),
                 "linear_solver": linear_solver, "period": period, "saddle_point": part.mixed}
         if linear_solver == "gamg" and part.mixed:  # MINRES, block preconditioner
-            opts["preconditioner"] = mixed_form.preconditioner(material, part.mixed, "3d",
+            opts["preconditioner"] = mixed_form.preconditioner(material, part.mixed.W, "3d",
                                                                part.dx)
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
             opts["constant_tangent"] = part.fields.constant_tangent(material, "3d", part.dx)
