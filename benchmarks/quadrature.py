@@ -14,11 +14,11 @@ import time
 import fenics_nl  # noqa: F401
 
 # isort: split
+from bracket_model import build_bracket
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
 from fenics_nl.materials.laws import PowerLaw
-from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.loading import solve_incrementally
 
 p = argparse.ArgumentParser()

@@ -21,11 +21,11 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 import ufl
+from bracket_model import build_bracket
 from common import options, publish, timed_linear_solve
 from petsc4py import PETSc
 
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
-from fenics_nl.scenes.bracket import build_bracket
 from fenics_nl.solvers.acceleration import Anderson
 from fenics_nl.solvers.result import WorkCounts
 

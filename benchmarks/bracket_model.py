@@ -1,4 +1,7 @@
-"""The bracket scene: a 3D gmsh part, a power-law material, bolts and a rigid floor.
+"""The bracket of `demos/bracket.py` in one call, for the benchmarks that time its solves.
+
+(The demo writes the same steps out: the mesh and tags, the space, the residual, a solver
+per Newton variant.)
 
 The mesh comes from `bracket_geometry` (built on rank 0, distributed) or from a user's
 .msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
