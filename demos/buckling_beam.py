@@ -44,14 +44,18 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
+from dolfinx import fem, mesh
 from mpi4py import MPI
 
+from fenics_nl.domain import boundary
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes import beam_pictures
-from fenics_nl.scenes.beam import MATERIALS, Beam, Cantilever
+from fenics_nl.scenes.beam import MATERIALS, Beam
 from fenics_nl.theory import elastica
 
 comm = MPI.COMM_WORLD
@@ -108,6 +112,9 @@ class Buckling(Parameters):
             raise ValueError(f"--imperfection must be in [0, 0.1), got {self.imperfection}")
         if self.material == "neo-hookean" and self.plane == "stress":
             raise ValueError("neo-hookean is implemented in plane strain only (--plane strain)")
+        if self.thickness > self.length / 5:
+            raise ValueError(f"the beam must be slender: --thickness <= --length/5, got L/h = "
+                             f"{self.length / self.thickness:.3g}")
         if self.mixed and self.plane == "stress":
             raise ValueError("--mixed needs --plane strain (in plane stress the out-of-plane "
                              "strain takes the volume change: nothing locks)")
@@ -118,34 +125,124 @@ args = cli.arguments(Buckling, prefixes={"beam_": "Newton, SLEPc and pre-stress 
 
 # -
 
-# ### The cantilever
+# ### The mesh and its tags
 #
-# Q2 quadrilaterals (square, 2·2^refine through the height), clamped at $x = 0$, a dead
-# traction $(-P, \varepsilon P)/h$ on the end face. With `--mixed`, the unknown is the
-# Q2–Q1 pair $(u, p)$.
+# Q2 quadrilaterals, square, 2·2^refine through the height; the facets of the clamped end
+# x = 0 and of the loaded end x = L are tagged 1 and 2.
 
-cantilever = Cantilever(args.length, args.thickness, plane=args.plane,
-                        refine=args.refine, imperfection=args.imperfection, mixed=args.mixed)
+# +
+L, h = args.length, args.thickness
+ny = 2 * 2**args.refine
+nx = max(4, round(L / h * ny / 2))
+msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, ny],
+                            mesh.CellType.quadrilateral)
+clamped = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], 0.0))
+end = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], L))
+facets = np.concatenate([clamped, end])
+order = np.argsort(facets)
+facet_tags = mesh.meshtags(msh, 1, facets[order],
+                           np.hstack([np.full_like(clamped, 1), np.full_like(end, 2)])[order])
+# -
 
-# ### The material
+# ### The function space and the boundary conditions
 #
-# A free energy of the Green–Lagrange strain $e = (F^TF - I)/2$; the second
-# Piola–Kirchhoff stress $S = \partial\varphi/\partial e$ is derived by UFL.
+# Q2 displacements (with `--mixed`, the Q2–Q1 Taylor–Hood pair $(u, p)$). The end $x = 0$
+# is clamped; the end $x = L$ carries the dead traction $t = (-P, \varepsilon P)/h$, a
+# `fem.Constant` the load steps set.
 
-material = MATERIALS[args.material](args.E, args.nu)
+# +
+if args.mixed:
+    W = mixed.taylor_hood(msh, 2)
+    w = fem.Function(W, name="displacement_pressure")
+    (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(W)
+    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+else:
+    V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    w = u = fem.Function(V, name="displacement")
+    v = ufl.TestFunction(V)
+bcs = [boundary.fixed(V, facet_tags.find(1))]
+ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+t = fem.Constant(msh, np.zeros(2))
+
+
+def set_load(P):
+    """The dead end load: axial compression P and the lateral imperfection ε P."""
+    t.value[:] = [-P / h, args.imperfection * P / h]
+
+
+# -
+
+# ### The material: a free energy of the Green–Lagrange strain
+#
+# St Venant–Kirchhoff, the course's finite-strain law, in $e = \frac12(F^TF - I)$:
+#
+# $$ \varphi(e) = \frac{\lambda}{2} (\mathrm{tr}\,e)^2 + \mu\, e : e, $$
+#
+# written below in UFL (in plane stress $\lambda$ becomes $2\lambda\mu/(\lambda + 2\mu)$,
+# the out-of-plane stress being zero). The second Piola–Kirchhoff stress
+# $S = \partial\varphi/\partial e$ is UFL's derivative of it. `--material neo-hookean`
+# takes the library's compressible neo-Hookean energy instead (`NeoHookean.energy`).
+
+# +
+model = "plane_stress" if args.plane == "stress" else "plane_strain"
+material = MATERIALS[args.material](args.E, args.nu)  # E, ν checked; the neo-Hookean's φ
+mu, lmbda = material.mu, material.lmbda  # Lamé's constants (λ = ∞ at ν = 1/2)
+if model == "plane_stress":  # σ_zz = 0: λ* = 2λμ/(λ + 2μ), 2μ at ν = 1/2
+    lmbda = 2 * mu if math.isinf(lmbda) else 2 * lmbda * mu / (lmbda + 2 * mu)
+elif not args.mixed:
+    material.require_compressible()  # ν = 1/2 needs the pressure as an unknown
+
+
+def svk_energy(e):
+    """φ(e) of St Venant–Kirchhoff."""
+    return lmbda / 2 * ufl.tr(e) ** 2 + mu * ufl.inner(e, e)
+
+
+phi = svk_energy if args.material == "svk" else material.energy
+# -
 
 # ### The residual
 #
-# Total Lagrangian: $R(u; v) = \int_{\Omega_0} P(u) : \nabla v\,d\Omega_0 -
-# \int_{end} t \cdot v\,dS_0$ with $P = F S$ the first Piola–Kirchhoff stress and $t$
-# the dead traction. With `--mixed` the first term is the variation of the perturbed
-# Lagrangian $\Pi(u, p) = \int \tilde\varphi(e) + p\,g(e) - p^2/(2k)$
-# (`fenics_nl.materials.mixed`).
+# Total Lagrangian: $R(u; v) = \int_{\Omega_0} F S(e) : \nabla v\,d\Omega_0 -
+# \int_{end} t \cdot v\,dS_0$, $F S$ the first Piola–Kirchhoff stress. In plane strain the
+# gradients are 3×3 with a zero third row and column (`kinematics.displacement_gradient`).
+# With `--mixed` the first term is the variation of the perturbed Lagrangian
+# $\Pi(u, p) = \int \tilde\varphi(e) + p\,g(e) - p^2/(2k)$ (`fenics_nl.materials.mixed`).
 
-residual = cantilever.residual(material)  # fields.internal_work(material, model) * dx − t·v ds
-beam = Beam(cantilever, material, residual)
-say(f"beam L/h = {args.length / args.thickness:g}, {beam.dofs} unknowns, "
-    f"{args.material}, plane {args.plane}{', mixed Q2-Q1' if args.mixed else ''}")
+# +
+dx = kinematics.quadrature_measure("dx", msh, 4)
+if args.mixed:
+    internal = mixed.internal_work(material, u, p, v, q, model)
+else:
+    H = kinematics.displacement_gradient(u, model)
+    F = ufl.Identity(H.ufl_shape[0]) + H
+    e = ufl.variable((H + H.T + H.T * H) / 2)  # Green–Lagrange
+    S = ufl.diff(phi(e), e)
+    internal = ufl.inner(F * S, kinematics.displacement_gradient(v, model))
+residual = internal * dx - ufl.dot(t, v) * ds(2)
+# -
+
+# ### What is measured: the tip
+#
+# Means over the end face: the axial and lateral displacement, and the rotation α of the
+# end section from its deformed tangent $F e_y$.
+
+# +
+F_plane = ufl.Identity(2) + ufl.grad(u)  # the in-plane F: the end's tangent F e_y
+tip_forms = [fem.form(f * ds(2)) for f in (u[0] / h, u[1] / h, F_plane[0, 1], F_plane[1, 1])]
+
+
+def tip():
+    """{"axial", "lateral", "rotation"} of the end face."""
+    ux, uy, t0, t1 = (comm.allreduce(fem.assemble_scalar(f)) for f in tip_forms)
+    return {"axial": ux, "lateral": uy, "rotation": math.atan2(-t0, t1)}
+
+
+beam = Beam(residual, mixed.unknown_of(w), bcs, material=material, model=model, length=L,
+            thickness=h, dx=dx, ds_end=ds(2), set_load=set_load, tip=tip, clamp=clamped)
+say(f"beam L/h = {L / h:g}, {beam.dofs} unknowns, {args.material}, plane {args.plane}"
+    f"{', mixed Q2-Q1' if args.mixed else ''}")
+# -
 
 # ### Linear buckling (SLEPc) against Euler
 #

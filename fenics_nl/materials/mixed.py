@@ -42,6 +42,7 @@ __all__ = [
     "modified_newton_tangent",
     "preconditioner",
     "taylor_hood",
+    "unknown_of",
     "unknowns",
     "von_mises",
     "von_mises_expression",
@@ -171,9 +172,12 @@ class DisplacementUnknown:
 
     mixed = False
 
-    def __init__(self, mesh, degree: int = 2):
-        self.W = self.V = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
-        self.w = self.u = fem.Function(self.V, name="displacement")
+    def __init__(self, mesh, degree: int = 2, *, function: fem.Function | None = None):
+        if function is None:
+            V = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
+            function = fem.Function(V, name="displacement")
+        self.W = self.V = function.function_space
+        self.w = self.u = function
         self.v, self.p, self.q = ufl.TestFunction(self.V), None, None
         self.pressure_dofs = 0
         self.displacement_space = self.V
@@ -203,9 +207,9 @@ class MixedUnknown:
 
     mixed = True
 
-    def __init__(self, mesh, degree: int = 2):
-        self.W = taylor_hood(mesh, degree)
-        self.w = fem.Function(self.W, name="displacement_pressure")
+    def __init__(self, mesh, degree: int = 2, *, function: fem.Function | None = None):
+        self.W = taylor_hood(mesh, degree) if function is None else function.function_space
+        self.w = function or fem.Function(self.W, name="displacement_pressure")
         self.V, self.Q = self.W.sub(0), self.W.sub(1)
         self.u, self.p = ufl.split(self.w)
         self.v, self.q = ufl.TestFunctions(self.W)
@@ -238,3 +242,14 @@ def unknowns(mesh, degree: int = 2, mixed: bool = False
              ) -> DisplacementUnknown | MixedUnknown:
     """The unknown of either formulation: P`degree` displacement, or Taylor–Hood (u, p)."""
     return MixedUnknown(mesh, degree) if mixed else DisplacementUnknown(mesh, degree)
+
+
+def unknown_of(w: fem.Function) -> DisplacementUnknown | MixedUnknown:
+    """The unknown whose Function is `w`, made by the caller (a demo's `fem.Function`).
+
+    Mixed if `w`'s space is (a Taylor–Hood pair, as `taylor_hood` makes).
+    """
+    mesh = w.function_space.mesh
+    if w.function_space.num_sub_spaces and w.ufl_element().is_mixed:
+        return MixedUnknown(mesh, function=w)
+    return DisplacementUnknown(mesh, function=w)

@@ -114,35 +114,48 @@ class Cantilever:
 
 def build_beam(length: float, thickness: float, E: float, nu: float, *,
                material: str = "svk", **options) -> Beam:
-    """The beam scene in one call (as `demos/buckling_beam.py` composes it).
+    """The beam in one call, for tests and benchmarks (the demo writes these steps out).
 
     `options` go to `Cantilever` (plane, refine, imperfection, degree, comm).
     """
     if material not in MATERIALS:
         raise ValueError(f"material must be one of {', '.join(MATERIALS)}, got {material!r}")
-    cantilever = Cantilever(length, thickness, **options)
+    c = Cantilever(length, thickness, **options)
     law = MATERIALS[material](E, nu)
-    return Beam(cantilever, law, cantilever.residual(law))
+    return Beam(c.residual(law), c.fields, c.bcs, material=law, model=c.model, length=c.L,
+                thickness=c.h, dx=c.dx, ds_end=c.ds_end, set_load=c.set_load, tip=c.tip,
+                clamp=c.groups["clamp"])
 
 
 class Beam:
-    """The buckling analysis and the load path of a cantilever's residual.
+    """Linear buckling, the post-buckling path and its stability, of a cantilever's residual.
 
     Args:
-        cantilever: mesh, space and conditions (`Cantilever`).
-        material: a finite-strain law; its E, ν give Euler's load.
-        residual: R(u; v) of the cantilever under its end traction (UFL form).
+        residual: R(u; v) under the end's dead traction (UFL form), in `fields.w`.
+        fields: the unknown (`materials.mixed.unknown_of`): u, or Taylor–Hood (u, p).
+        bcs: the clamp's Dirichlet conditions.
+        material: the residual's finite-strain law: its E and ν give Euler's load and
+            Hooke's tangent of the linear buckling analysis.
+        model: ``plane_stress`` or ``plane_strain``.
+        length: L (Euler's load; the end face x = L, where a branch switch is scaled).
+        thickness: h (Euler's load, I = h³/12).
+        dx: the residual's volume measure.
+        ds_end: the loaded end's measure.
+        set_load: the end traction for an axial load P: `set_load(P)`.
+        tip: the end's mean axial and lateral displacement and rotation: `tip()` gives
+            {"axial", "lateral", "rotation"}.
+        clamp: the clamped facets (their reaction).
     """
 
-    def __init__(self, cantilever: Cantilever, material, residual):
-        self.cantilever, self.material, self.residual = cantilever, material, residual
-        self.L, self.h, self.model = cantilever.L, cantilever.h, cantilever.model
+    def __init__(self, residual, fields, bcs, *, material, model: str, length: float,
+                 thickness: float, dx, ds_end, set_load, tip, clamp):
+        self.material, self.residual, self.fields = material, residual, fields
+        self.L, self.h, self.model = length, thickness, model
         # `u`: what the solvers update (the mixed unknown (u, p) if mixed)
-        self.mesh, self.V, self.u, self.bcs = (cantilever.mesh, cantilever.V,
-                                               cantilever.unknown, cantilever.bcs)
-        self.fields = cantilever.fields
-        self.dx, self.ds_end = cantilever.dx, cantilever.ds_end
-        self.set_load, self.tip = cantilever.set_load, cantilever.tip
+        self.V, self.u, self.bcs = fields.V, fields.w, list(bcs)
+        self.mesh = self.u.function_space.mesh
+        self.dx, self.ds_end, self.set_load, self.tip = dx, ds_end, set_load, tip
+        self.groups = {"clamp": clamp}
         E, nu = material.E, material.nu
         self.E_bending = E if self.model == "plane_stress" else E / (1 - nu**2)
         self.P_euler = euler_load(self.E_bending, self.h**3 / 12, self.L)
@@ -150,7 +163,7 @@ class Beam:
     @property
     def dofs(self) -> int:
         """Global number of scalar unknowns (with the pressure's, if mixed)."""
-        return self.cantilever.dofs
+        return output.dofs(self.u.function_space)
 
     def _split(self, w):
         """(displacement, pressure or None) of a Function or argument of the unknown's space."""
@@ -282,7 +295,7 @@ class Beam:
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force of the clamp on the beam (per unit width), see `boundary`."""
         space = self.V if self.fields.mixed else None
-        return boundary.reactions(self.residual, self.u, self.cantilever.groups, space=space)
+        return boundary.reactions(self.residual, self.u, self.groups, space=space)
 
     def kick_along(self, mode: fem.Function, deflection: float) -> None:
         """u += η φ with η such that φ's mean end-face lateral displacement is `deflection`.
