@@ -9,7 +9,8 @@ between them, where the stress concentrates. Physical groups:
 
 `bracket_mesh` gives DOLFINx's mesh with its cell and facet tags (the groups above), built
 or read from a user's .msh file with the same groups. `meshes/bracket.py` writes it to a
-file you can open in gmsh:
+file you can open in gmsh::
+
     python meshes/bracket.py --size 4 -o bracket.msh
 """
 
