@@ -27,12 +27,12 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import ufl
+from arch_model import ShallowArch
 from common import machine, options, publish
 from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
-from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength, ContinuationError
 from fenics_nl.solvers.linear_solver import create_ksp, rigid_body_modes
 from fenics_nl.solvers.newton import NewtonSolver

@@ -1,6 +1,6 @@
 """Path following: arc-length continuation against load control with cut-back.
 
-A. The shallow arch (snap-through at a limit point, `scenes.arch`, the closed form of
+A. The shallow arch (snap-through at a limit point, `arch_model.py`, the closed form of
    `theory.arch`): to 1.5 times the limit load, on the inverted branch. Arc-length with
    each Newton variant; load control with step cut-back, which has no state beyond the
    limit point to go to.
@@ -21,11 +21,11 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
+from arch_model import ShallowArch
 from common import machine, options, publish
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
-from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.scenes.beam import build_beam
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.loading import solve_incrementally

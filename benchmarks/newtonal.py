@@ -1,6 +1,6 @@
 """Arc-length continuation: ours (`solvers.arclength.ArcLength`) against PETSc's SNESNEWTONAL.
 
-The shallow arch (`scenes.arch`, e/r = 3, its closed form in `theory.arch`) to 1.5 times its
+The shallow arch (`arch_model.py`, e/r = 3, its closed form in `theory.arch`) to 1.5 times its
 limit load, through the snap-through. Both walk the same residual on the same mesh with full
 Newton corrections and MUMPS; both stop at |R| <= tol |q|, q the target load vector,
 tol = 1e-6 and 1e-7.
@@ -27,13 +27,13 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import ufl
+from arch_model import ShallowArch
 from common import machine, options, publish
 from dolfinx import fem
 from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as arch_theory

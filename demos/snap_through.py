@@ -37,13 +37,19 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
+from dolfinx import fem, mesh
+from dolfinx.fem import petsc
 from mpi4py import MPI
+from petsc4py import PETSc
 
-from fenics_nl.io import cli
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import StVenantKirchhoff
+from fenics_nl.parallel import gather_rows
 from fenics_nl.scenes import arch_pictures
-from fenics_nl.scenes.arch import ShallowArch
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as theory
@@ -113,17 +119,102 @@ class Arch(Parameters):
 args = cli.arguments(Arch, prefixes={"arch_": "Newton and the stability checks"})
 # -
 
-# ### The arch
+# ### The mesh and its tags
 #
-# Q2 quadrilaterals on the strip around $y_0$, pinned at the centreline of each end; the
-# load on the top face, per unit span.
+# Q2 quadrilaterals on the strip around $y_0$: a rectangle whose points are moved up by
+# $e \sin(\pi x/L)$ (each section shifted vertically: the arch is shallow), `--elements`
+# through the thickness and `--aspect` times as long along the span. The top face is
+# tagged 1: it carries the load.
 
-arch = ShallowArch(args.span, args.span / args.slenderness, args.rise, args.E, args.nu,
-                   elements=args.elements, aspect=args.aspect)
-q_limit = theory.limit_load(args.rise)  # in units of EI k⁴ r, the scene's load factor
-say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {arch.dofs} unknowns; limit "
+# +
+L, h = args.span, args.span / args.slenderness
+r = h / math.sqrt(12)  # the section's radius of gyration
+e = args.rise * r  # the rise
+nx = max(8, 2 * round(L / (args.aspect * h / args.elements) / 2))  # even: a midspan node
+msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, args.elements],
+                            mesh.CellType.quadrilateral)
+msh.geometry.x[:, 1] += e * np.sin(np.pi * msh.geometry.x[:, 0] / L)
+top = mesh.locate_entities_boundary(
+    msh, 1, lambda x: np.isclose(x[1], h / 2 + e * np.sin(np.pi * x[0] / L)))
+facet_tags = mesh.meshtags(msh, 1, top, np.ones(len(top), dtype=np.int32))
+# -
+
+# ### The function space and the boundary conditions
+#
+# Q2 displacements; each end is pinned at its centreline node (both components held, free
+# to rotate).
+
+# +
+V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+u, v = fem.Function(V, name="displacement"), ufl.TestFunction(V)
+pins = {name: fem.locate_dofs_geometrical(V, lambda x, x0=x0: np.isclose(x[0], x0)
+                                          & np.isclose(x[1], 0.0))
+        for name, x0 in (("left pin", 0.0), ("right pin", L))}
+bcs = [fem.dirichletbc(np.zeros(2), dofs, V) for dofs in pins.values()]
+# -
+
+# ### The material and the residual
+#
+# St Venant–Kirchhoff in plane stress: $\varphi(e) = \frac{\lambda^*}{2}(\mathrm{tr}\,e)^2
+# + \mu\, e : e$ in the Green–Lagrange strain, $\lambda^* = 2\lambda\mu/(\lambda + 2\mu)$
+# (`StVenantKirchhoff`: $S = \partial\varphi/\partial e$ and $P = F S$ derived by UFL). The
+# dead load $\lambda\, q_0 \sin(\pi x/L)$ per unit span acts downwards on the top face:
+# per unit length of the face it is that times $|n_y|$. The load factor $\lambda$ is a
+# `fem.Constant`, in the theory's unit $EI k^4 r$:
+#
+# $$ R(u; v) = \int_{\Omega_0} F S : \nabla v\,d\Omega_0
+#    + \int_{top} \lambda\, EI k^4 r \sin(\pi x/L)\, |n_y|\, v_y\,dS_0 . $$
+
+# +
+material = StVenantKirchhoff(args.E, args.nu)
+EI = args.E * h**3 / 12
+k = np.pi / L
+load_unit = EI * k**4 * r  # q0 per unit load factor, in force/length²
+load_factor = fem.Constant(msh, 0.0)
+X, n = ufl.SpatialCoordinate(msh), ufl.FacetNormal(msh)
+q = load_factor * load_unit * ufl.sin(k * X[0]) * abs(n[1])
+dx = kinematics.quadrature_measure("dx", msh, 4)
+ds_top = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)(1)
+P = material.first_piola(u, "plane_stress")
+residual = ufl.inner(P, ufl.grad(v)) * dx + q * v[1] * ds_top
+
+
+def set_load(lam):
+    """q0 = λ EI k⁴ r: λ is the theory's dimensionless load."""
+    load_factor.value = lam
+
+
+# -
+
+# ### What is measured: the midspan rise and the centreline
+#
+# $\bar a = (e + w_{mid})/r$ at the midspan centreline node; the deformed centreline for
+# the pictures, gathered on rank 0.
+
+# +
+owned = V.dofmap.index_map.size_local
+X_dofs = V.tabulate_dof_coordinates()[:owned]
+mid = np.flatnonzero(np.isclose(X_dofs[:, 0], L / 2) & np.isclose(X_dofs[:, 1], e))
+on_centreline = np.isclose(X_dofs[:, 1], e * np.sin(np.pi * X_dofs[:, 0] / L))
+
+
+def midspan_rise():
+    """ā = (e + w_mid)/r, the centreline's midspan rise in radii of gyration."""
+    return (e + comm.allreduce(float(u.x.array[2 * mid + 1].sum()))) / r
+
+
+def centreline():
+    """Deformed centreline points (x + u), gathered on rank 0 and sorted by x."""
+    moved = X_dofs[on_centreline, :2] + u.x.array[: 2 * owned].reshape(-1, 2)[on_centreline]
+    rows = gather_rows(comm, X_dofs[on_centreline, 0], moved)
+    return None if rows is None else rows[1][np.argsort(rows[0])]
+
+
+q_limit = theory.limit_load(args.rise)  # in units of EI k⁴ r
+say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {output.dofs(V)} unknowns; limit "
     f"load (closed form) q0 = {q_limit:.5g} EI k^4 r (k = π/L) at rise a/r = "
     f"{theory.limit_rise(args.rise):.4g}")
+# -
 
 # ### The path
 #
@@ -149,21 +240,21 @@ say(f"arch L/h = {args.slenderness:g}, e/r = {args.rise:g}, {arch.dofs} unknowns
 # +
 # atol 1e-8: the arch's membrane forces are ~1e5 times its load, and their round-off is
 # what the residual can reach
-solver = NewtonSolver(arch.residual, arch.u, arch.bcs, method=args.newton, rtol=1e-8,
+solver = NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-8,
                       atol=1e-8, max_it=30 if args.newton == "full" else 300,
                       prefix=f"arch_{args.newton}_")
-continuation = ArcLength(solver, arch.set_load, arc_length=args.arc_length, psi=args.psi,
+continuation = ArcLength(solver, set_load, arc_length=args.arc_length, psi=args.psi,
                          max_arc_length=args.max_arc_length, prefix="arch_continuation_")
 history = [(0.0, args.rise)]  # (q0 / (EI k⁴ r), a/r)
 # the shapes the picture draws (kept without --png too: a restart may ask for the picture)
-shapes = [(0.0, arch.centreline())]
+shapes = [(0.0, centreline())]
 
 
 def record(lam, result):
-    history.append((lam, arch.midspan_rise()))
+    history.append((lam, midspan_rise()))
     cli.converged_step({"load_factor": lam, "midspan_rise": history[-1][1],
-                        "newton_iterations": result.iterations}, fields=lambda: [arch.u])
-    shapes.append((lam, arch.centreline()))
+                        "newton_iterations": result.iterations}, fields=lambda: [u])
+    shapes.append((lam, centreline()))
 
 
 def progress(message):
@@ -174,7 +265,7 @@ def progress(message):
 # the last increment), the states so far and their shapes back; --checkpoint: saved after
 # each converged step
 checkpoints = cli.checkpointing(
-    {"unknown": arch.u}, newton=solver,
+    {"unknown": u}, newton=solver,
     kept=lambda: {"shapes": [(lam, None if x is None else x.tolist()) for lam, x in shapes]})
 history += [(s["load_factor"], s["midspan_rise"]) for s in checkpoints.steps]
 if checkpoints.kept is not None:
@@ -193,13 +284,13 @@ path = continuation.run(target, args.max_steps, on_step=record, progress=progres
 
 # +
 limits = [c for c in path.critical_points if c.kind == "limit"]
-h = np.array(history)
-reference = np.array([theory.load(a, args.rise) for a in h[:, 1]])
-path_error = float(np.max(np.abs(h[:, 0] - reference)) / q_limit)
+states = np.array(history)  # (λ, ā) of every converged state
+reference = np.array([theory.load(a, args.rise) for a in states[:, 1]])
+path_error = float(np.max(np.abs(states[:, 0] - reference)) / q_limit)
 a_limit = theory.limit_rise(args.rise)
 # the cubic's maximum, then its minimum: the limit points in the order the path meets them
 limits_reference = [q_limit, theory.load(-a_limit, args.rise)]
-unstable = int(np.sum(np.abs(h[:, 1]) < a_limit))  # states between the limit points
+unstable = int(np.sum(np.abs(states[:, 1]) < a_limit))  # states between the limit points
 warnings = []
 if args.slenderness < 100:
     warnings.append("the closed form is a thin-arch theory: at L/h < 100 the continuum "
@@ -217,7 +308,10 @@ say(f"{len(path.factors)} steps ({unstable} between the limit points), {path.ite
     f"iterations, {path.work.factorizations} factorizations (+{path.inertia_factorizations} "
     f"for the stability checks), {path.failures} cuts; largest gap to the closed form along "
     f"the path {100 * path_error:.2f} % of the limit load")
-load_unit = arch.q0  # q0 per unit load factor, in force/length²
+b = petsc.assemble_vector(fem.form(residual))  # R(u) without its rows: the pins' forces
+b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+reactions = {name: [comm.allreduce(float(b.array_r[2 * dofs[dofs < owned] + i].sum()))
+                    for i in range(2)] for name, dofs in pins.items()}
 out = {
     "limit_load": first * load_unit if first is not None else None,
     "limit_load_reference": q_limit * load_unit,
@@ -236,8 +330,8 @@ out = {
     "factorizations": path.work.factorizations,
     "inertia_factorizations": path.inertia_factorizations, "step_cuts": path.failures,
     "final_load_factor": path.factors[-1], "final_rise": history[-1][1],
-    "reactions": arch.reactions(),
-    "reactions_of": "the pins on the arch, per unit width", "dofs": arch.dofs,
+    "reactions": reactions,
+    "reactions_of": "the pins on the arch, per unit width", "dofs": output.dofs(V),
     "ranks": comm.size,
     "path": [{"load_factor": x, "rise": a, "negative_eigenvalues": n}
              for (x, a), n in zip(history, [0, *path.unstable], strict=True)],

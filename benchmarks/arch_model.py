@@ -1,4 +1,7 @@
-"""The shallow arch as a 2D continuum: a curved strip that snaps through.
+"""The shallow arch of `demos/snap_through.py` in one object, for the benchmarks.
+
+(The demo writes the same steps out: the mesh and its tags, the space, the pins, the
+residual.) The arch as a 2D continuum: a curved strip that snaps through.
 
 The strip of span L and thickness h follows y₀ = e sin(πx/L) (each section shifted
 vertically: the arch is shallow), Q2 quadrilaterals, plane stress, unit width, St
