@@ -1,7 +1,9 @@
-"""The scenes, composed from the pieces above: each a body and the solver of a residual on it.
+"""What is left of the scenes: bodies and solvers that some demos still hand their residual to.
 
-`punch` (Hertz contact, friction, indentation), `bracket` (the 3D gmsh part; its geometry in
-`bracket_geometry`), `beam` (the buckling cantilever in finite strain), `arch` (the shallow
-arch's snap-through), `vessel` (thick sphere and cylinder in J2), `truss` (von Mises truss,
-for the scalar orders).
+Being dissolved (issue 56): the punch, bracket, buckling beam and snap-through demos write
+their mesh, space, conditions, residual and solver themselves. Left: `punch` (the frictional,
+J2 and identification punches), `beam` (linear buckling, the path and its stability, on the
+pieces the buckling demo writes), `vessel` (thick sphere and cylinder in J2), `upsetting`,
+the damage and crack scenes, `truss` (von Mises truss, for the scalar orders), and the
+pictures of their demos.
 """
