@@ -148,7 +148,7 @@ def parallel(size) -> dict:
 
 def iterative(size) -> dict:
     """CG + GAMG, one load step, 1 rank: which Newton variant suits a Krylov solver."""
-    common = ["--size", size, "--solver", "gamg", "--steps", 1, *GAMG]
+    common = ["--size", size, "--linear-solver", "gamg", "--steps", 1, *GAMG]
     lin = record(run(*common, "--material", "linear"))
     out = {"linear": lin, "variants": {}}
     # full Newton keeps a step's first AMG hierarchy while CG needs at most twice its count
@@ -165,7 +165,7 @@ def iterative(size) -> dict:
 
 
 def large(size) -> dict:
-    common = ["--size", size, "--solver", "gamg", *GAMG]
+    common = ["--size", size, "--linear-solver", "gamg", *GAMG]
     lin = record(run(*common, "--material", "linear", "--steps", 1, ranks=2))
     full = record(run(*common, "--newton", "full", "--steps", 1, ranks=2))
     out = {"linear": lin, "full, 1 step": full,

@@ -29,7 +29,7 @@ RUNS = {  # name: the demo and its arguments (small meshes, every path the demo 
     "bracket_compare": ["bracket.py", "--compare", "--size", "20", "--steps", "2"],
     "bracket_j2_floor": ["bracket.py", "--material", "j2", "--support", "contact", "--size",
                          "20", "--steps", "2"],
-    "bracket_iterative": ["bracket.py", "--solver", "gamg", "--size", "20"],
+    "bracket_iterative": ["bracket.py", "--linear-solver", "gamg", "--size", "20"],
     "beam": ["buckling_beam.py"],
     "vessel": ["pressure_vessel.py", "--steps", "6", "--unload"],
     "vessel_modified": ["pressure_vessel.py", "--newton", "modified", "--steps", "4"],

@@ -1,6 +1,6 @@
 """Every capability of the bracket on the iterative path (CG + GAMG), under refinement.
 
-The bracket (`demos/bracket.py --solver gamg`, 2 ranks) in the power law (full Newton, one
+The bracket (`demos/bracket.py --linear-solver gamg`, 2 ranks) in the power law (full Newton, one
 step), in J2 (two steps and the unloading), on its floor (frictionless active set, two
 steps), on a rough floor (Coulomb, f = 0.3) and mixed (Taylor–Hood u–p, MINRES with the
 block preconditioner, one step), each on meshes halved twice. Per run: Newton iterations,
@@ -45,7 +45,7 @@ CAPABILITIES = {
 
 def gamg(prefix: str) -> list[str]:
     """CG + GAMG, its drop threshold 0.02 (25 % fewer CG iterations, benchmarks/bracket.py)."""
-    return ["--solver", "gamg", f"-{prefix}pc_gamg_threshold", "0.02"]
+    return ["--linear-solver", "gamg", f"-{prefix}pc_gamg_threshold", "0.02"]
 
 
 KEYS = ("dofs", "newton_iterations", "krylov_iterations", "factorizations", "solve_time_s",

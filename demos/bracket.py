@@ -99,13 +99,13 @@ class BracketParameters(Parameters):
     degree: int = number(2, "Lagrange degree, 1 or 2 (P1 is far too stiff here: see the "
                          "benchmarks)", at_least=1, at_most=2)
     mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements (ν up to 0.5; "
-                         "--solver gamg: MINRES with a block preconditioner)")
+                         "--linear-solver gamg: MINRES with a block preconditioner)")
     mesh: str | None = text(None, "a .msh file with groups bolts, load, base (in --units; not "
                             "with --size)", metavar="MSH")
-    solver: str = choice("lu", ["lu", "gamg"], "MUMPS LU, or CG + GAMG with rigid-body "
-                         "near-nullspace (every support and material; a Newton solve keeps its "
-                         "first AMG hierarchy while CG keeps up, the mixed form excepted)",
-                         spelling=True)
+    linear_solver: str = choice("lu", ["lu", "gamg"], "MUMPS LU, or CG + GAMG with "
+                                "rigid-body near-nullspace (every support and material; a "
+                                "Newton solve keeps its first AMG hierarchy while CG keeps up, "
+                                "the mixed form excepted)", spelling=True)
     material: str = choice("power-law", ["power-law", "j2", "linear"], "the power law below; "
                            "j2: von Mises plasticity (sigma0, --hardening), path-dependent; or "
                            "linear elasticity (E, nu)")
@@ -276,7 +276,7 @@ residual = internal * dx - ufl.dot(t, v) * ds_load
 # What each variant costs per iteration is what decides between them: with MUMPS a full
 # iteration of the default P2 mesh (assembly and factorization) costs about 14 modified
 # ones (0.52 s against 0.037 s at 22k unknowns), so the frozen tangents win here, BFGS by
-# 2.6x; with CG + GAMG (`--solver gamg`) nothing is factorized and the ranking turns over
+# 2.6x; with CG + GAMG (`--linear-solver gamg`) nothing is factorized and the ranking turns over
 # (the benchmarks page has both).
 
 # +
@@ -290,10 +290,11 @@ def solver_for(variant):
     if variant == "snes":
         return SnesSolver(residual, w, bcs, prefix="bracket_snes_", rtol=1e-10,
                           atol=args.tolerance, force_scale=args.force, max_it=MAX_IT[variant],
-                          linear_solver=args.solver)
+                          linear_solver=args.linear_solver)
     options = dict(method=variant, rtol=1e-10, atol=args.tolerance, force_scale=args.force,
-                   max_it=MAX_IT[variant], linear_solver=args.solver, saddle_point=args.mixed)
-    if args.solver == "gamg" and args.mixed:  # MINRES, a block preconditioner
+                   max_it=MAX_IT[variant], linear_solver=args.linear_solver,
+                   saddle_point=args.mixed)
+    if args.linear_solver == "gamg" and args.mixed:  # MINRES, a block preconditioner
         options["preconditioner"] = mixed.preconditioner(material, W, "3d", dx)
     if variant in ("modified", "bfgs"):  # what they keep: for J2, Hooke's tangent
         options["constant_tangent"] = (mixed.modified_newton_tangent(material, w, "3d", dx)

@@ -90,7 +90,7 @@ class Orders(Parameters):
     slope: float | None = number(None, "constant slope K of modified Newton (default: r'(u0))")
     digits: int = number(60, "decimal digits of the arithmetic (16 = double precision "
                          "floats)", at_least=16, at_most=1000)
-    maxit: int = number(500, "iteration limit per method", at_least=1)
+    max_it: int = number(500, "iteration limit per method", at_least=1)
 
     def check(self):
         if self.slope is not None and self.slope == 0:
@@ -138,7 +138,7 @@ results, failures = {}, {}
 for method in scalar.METHODS:
     k = num(args.slope) if args.slope is not None else None
     try:
-        results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, maxit=args.maxit)
+        results[method] = scalar.solve(r, num(u0), method, k=k, tol=tol, max_it=args.max_it)
     except scalar.ScalarSolveError as err:
         results[method], failures[method] = err.result, str(err)
 

@@ -155,15 +155,16 @@ bcs = [fem.dirichletbc(np.zeros(2), dofs, V) for dofs in pins.values()]
 
 # ### The material and the residual
 #
-# St Venant–Kirchhoff in plane stress: $\varphi(e) = \frac{\lambda^*}{2}(\mathrm{tr}\,e)^2
-# + \mu\, e : e$ in the Green–Lagrange strain, $\lambda^* = 2\lambda\mu/(\lambda + 2\mu)$
+# St Venant–Kirchhoff in plane stress,
+# $\varphi(e) = \frac{\lambda^*}{2}(\mathrm{tr}\,e)^2 + \mu\, e : e$ in the Green–Lagrange
+# strain, $\lambda^* = 2\lambda\mu/(\lambda + 2\mu)$
 # (`StVenantKirchhoff`: $S = \partial\varphi/\partial e$ and $P = F S$ derived by UFL). The
 # dead load $\lambda\, q_0 \sin(\pi x/L)$ per unit span acts downwards on the top face:
 # per unit length of the face it is that times $|n_y|$. The load factor $\lambda$ is a
 # `fem.Constant`, in the theory's unit $EI k^4 r$:
 #
-# $$ R(u; v) = \int_{\Omega_0} F S : \nabla v\,d\Omega_0
-#    + \int_{top} \lambda\, EI k^4 r \sin(\pi x/L)\, |n_y|\, v_y\,dS_0 . $$
+# $$ R(u; v) = \int_{\Omega_0} F S : \nabla v\,d\Omega_0 +
+#    \int_{top} \lambda\, EI k^4 r \sin(\pi x/L)\, |n_y|\, v_y\,dS_0 . $$
 
 # +
 material = StVenantKirchhoff(args.E, args.nu)

@@ -1,8 +1,10 @@
 """One spelling for each concept: in the library, the command lines, the case files, the JSON.
 
-`bfgs` (the quasi-Newton variant), `plane_strain` and `plane_stress` (the 2D models), `lu`
-and `gamg` (MUMPS LU and CG + GAMG). Older spellings are still read, with one line that
-says the new one, and never written.
+Words: `bfgs` (the quasi-Newton variant), `plane_strain` and `plane_stress` (the 2D models),
+`lu` and `gamg` (MUMPS LU and CG + GAMG). Names: `max_it` (an iteration limit: PETSc's own
+name, as in `-snes_max_it`; the flag `--max-it`) and `linear_solver` (the flag
+`--linear-solver`). Older spellings are still read, with one line that says the new one,
+and never written.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import sys
 
 from mpi4py import MPI
 
-__all__ = ["OLD_SPELLINGS", "canonical"]
+__all__ = ["OLD_NAMES", "OLD_SPELLINGS", "canonical", "renamed", "say_renamed"]
 
 OLD_SPELLINGS = {
     "quasi-newton": "bfgs",
@@ -20,6 +22,37 @@ OLD_SPELLINGS = {
     "direct": "lu",
     "iterative": "gamg",
 }
+
+
+# old name -> the one name (a case file's key, a demo's flag with its dashes as underscores)
+OLD_NAMES = {
+    "max_iterations": "max_it",
+    "maxit": "max_it",
+    "linear": "linear_solver",
+    "solver": "linear_solver",
+}
+
+
+def say_renamed(old: str, new: str) -> None:
+    """The one line that says an old name was read (stderr, rank 0)."""
+    if MPI.COMM_WORLD.rank == 0:
+        print(f"note: {old} is now spelt {new} (the old spelling is still read)",
+              file=sys.stderr, flush=True)
+
+
+def renamed(table: dict, where: str, names) -> dict:
+    """`table` with its keys in the one spelling, for the `names` it may hold.
+
+    Each old key read is said (`where`: the table's name in that line).
+    """
+    out = {}
+    for key, value in table.items():
+        new = OLD_NAMES.get(key)
+        if new in names and new not in table:
+            say_renamed(f"{where}.{key}", f"{where}.{new}")
+            key = new
+        out[key] = value
+    return out
 
 
 def canonical(word, where: str):

@@ -154,7 +154,7 @@ def test_incompressible_thick_cylinder_in_the_mixed_formulation(tmp_path, demo):
     for name, r in (("inner", 10.0), ("outer", 20.0)):
         assert d["probes"][name]["displacement"][0] == pytest.approx(lame(r, nu=0.5), rel=3e-4)
     # and iteratively (MINRES, block preconditioner): the same answer
-    iterative = mixed.replace("[loading]", '[solver]\nlinear = "gamg"\n\n[loading]')
+    iterative = mixed.replace("[loading]", '[solver]\nlinear_solver = "gamg"\n\n[loading]')
     i = demo.case(write(tmp_path, "i.toml", iterative))
     assert i["probes"]["inner"]["displacement"][0] == pytest.approx(
         d["probes"]["inner"]["displacement"][0], rel=1e-7)
@@ -884,10 +884,21 @@ def test_a_case_file_in_the_old_spellings_reads_in_the_new_ones(tmp_path):
     from fenics_nl.case.spec import read_case
 
     text = (CASES / "thick_cylinder.toml").read_text().replace('"plane_strain"', '"plane-strain"')
-    text += '\n[solver]\nnewton = "quasi-newton"\nlinear = "iterative"\n'
+    text += '\n[solver]\nnewton = "quasi-newton"\nlinear = "iterative"\nmax_iterations = 9\n'
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
     case = read_case(write(tmp_path, "old.toml", text))
-    assert (case.model, case.newton, case.linear) == ("plane_strain", "bfgs", "gamg")
+    assert (case.model, case.newton, case.linear_solver, case.max_it) == (
+        "plane_strain", "bfgs", "gamg", 9)
+
+
+def test_old_flag_names_are_read_and_said(demo):
+    # --maxit (newton_scalar) and --solver (bracket) are now --max-it and --linear-solver
+    proc = demo.run(["newton_scalar.py", "--maxit", "0"], check=False)
+    assert proc.returncode == 2 and "--maxit: must be >= 1" in proc.stderr
+    proc = demo.run(["newton_scalar.py", "--maxit", "40", "--help"])
+    assert "--maxit" not in proc.stdout and "--max-it" in proc.stdout  # hidden from --help
+    proc = demo.run(["newton_scalar.py", "--maxit", "400"])
+    assert "note: --maxit is now spelt --max-it" in proc.stderr
 
 
 def test_a_damage_case_follows_the_homogeneous_closed_form(demo):
@@ -1045,7 +1056,7 @@ def test_arc_length_is_advised_only_where_a_case_can_take_it(tmp_path, demo):
     text = text.replace("group = \"inner\"\npressure = 100.0",
                         "group = \"inner\"\ndisplacement = [1.0, \"free\"]")
     text = text.replace("steps = 1", "steps = 1\nadaptive = false") + (
-        "\n[solver]\nmax_iterations = 1\n")
+        "\n[solver]\nmax_it = 1\n")
     (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
     proc = demo.run(["-m fenics_nl", "run", write(tmp_path, "pulled.toml", text)],
                     check=False)

@@ -29,7 +29,7 @@ def test_newton_scalar_plot_in_double_precision(tmp_path, demo):
     (["--digits", "3"], "--digits"),
     (["--function", "nope"], "invalid choice"),
     (["--slope", "0"], "--slope"),
-    (["--maxit", "0"], "--maxit: must be >= 1"),
+    (["--max-it", "0"], "--max-it: must be >= 1"),
     (["--u0", "nan"], "--u0: must be a finite number"),
 ])
 def test_newton_scalar_bad_input(args, message, demo):
@@ -471,12 +471,12 @@ def test_bracket_iterative_solver_matches_direct(demo):
     # mesh, whose direct run the suite makes anyway: 11.6k unknowns, three GAMG levels)
     args = tuple(SMALL["bracket.py"])
     d = demo.bracket(*args)
-    g = demo.bracket(*args, "--solver", "gamg")
+    g = demo.bracket(*args, "--linear-solver", "gamg")
     assert d["krylov_iterations"] == 0 and g["krylov_iterations"] > g["newton_iterations"]
     assert g["load_point_displacement"] == pytest.approx(d["load_point_displacement"], rel=1e-7)
 
 
-BRACKET_ON_FLOOR_GAMG = (*BRACKET_ON_FLOOR, "--solver", "gamg")
+BRACKET_ON_FLOOR_GAMG = (*BRACKET_ON_FLOOR, "--linear-solver", "gamg")
 
 
 def test_bracket_on_its_floor_on_the_iterative_path_gives_the_direct_answer(demo):

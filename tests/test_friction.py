@@ -310,7 +310,7 @@ def test_bracket_on_a_rough_floor(demo):
     # longer hold exactly the pull), within Coulomb's cone as a whole, and holds the base
     # back: the arm moves less (measured at 10 mm: 5.284 mm against 5.292 mm)
     free = demo.bracket(*BRACKET_ON_FLOOR)
-    smooth = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0", "--solver", "gamg")
+    smooth = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0", "--linear-solver", "gamg")
     rough = demo.bracket(*BRACKET_ON_FLOOR, "--friction", "0.3")
     assert smooth["load_point_displacement"] == pytest.approx(free["load_point_displacement"],
                                                               rel=1e-9)

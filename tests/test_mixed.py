@@ -216,7 +216,7 @@ def test_mixed_bracket_removes_most_of_the_coarse_mesh_error(demo):
 
 def test_mixed_bracket_bad_combinations_are_one_line(demo):
     for args, words in ((["--mixed", "--degree", "1"], "P2"),
-                        (["--mixed", "--newton", "snes", "--solver", "gamg"], "SNES")):
+                        (["--mixed", "--newton", "snes", "--linear-solver", "gamg"], "SNES")):
         proc = demo.run(["bracket.py", "--size", "14", *args], check=False)
         lines = proc.stderr.strip().splitlines()
         assert proc.returncode == 2 and len(lines) == 1 and words in lines[0], proc.stderr
@@ -253,7 +253,7 @@ def test_incompressible_bracket_iterative_equals_direct(demo):
     # the direct solve's |u_load| to its tolerance
     args = ("--mixed", "--size", "14", "--material", "linear", "--nu", "0.5", "--steps", "1")
     direct = demo.bracket(*args)
-    iterative = demo.bracket(*args, "--solver", "gamg")
+    iterative = demo.bracket(*args, "--linear-solver", "gamg")
     assert iterative["krylov_iterations"] > 0
     assert iterative["load_point_displacement"] == pytest.approx(
         direct["load_point_displacement"], rel=1e-8)

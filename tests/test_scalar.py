@@ -19,7 +19,7 @@ EQUATIONS = [  # r, u0: each root is simple and each start within Newton's basin
 def test_observed_orders(r, u0, method, order):
     # 60 digits leave enough iterates above round-off for the order to settle.
     mpmath.mp.dps = 60
-    res = scalar.solve(r, mpmath.mpf(u0), method, tol=mpmath.mpf(10) ** -55, maxit=500)
+    res = scalar.solve(r, mpmath.mpf(u0), method, tol=mpmath.mpf(10) ** -55, max_it=500)
     assert res.converged
     assert abs(r(res.root)) < 1e-50
     assert abs(res.orders[-1] - order) < 0.15
@@ -43,9 +43,9 @@ def test_errors_are_clear():
     with pytest.raises(scalar.ScalarSolveError, match="slope"):
         scalar.solve(lambda u: u * u + 1, 0.0, "newton", dr=lambda u: 2 * u)
     with pytest.raises(scalar.ScalarSolveError, match="no convergence in 2 iterations"):
-        scalar.solve(lambda u: u**3 - 2 * u - 5, 2.0, "newton", maxit=2)
+        scalar.solve(lambda u: u**3 - 2 * u - 5, 2.0, "newton", max_it=2)
     with pytest.raises(scalar.ScalarSolveError, match="diverges") as err:
-        scalar.solve(lambda u: u * u + 1, 1.0, "newton", maxit=20)  # no real root
+        scalar.solve(lambda u: u * u + 1, 1.0, "newton", max_it=20)  # no real root
     assert not err.value.result.converged and len(err.value.result.iterates) > 2
     with pytest.raises(scalar.ScalarSolveError, match="r\\(u\\) failed"):
         scalar.solve(lambda u: math.exp(u) - 2, 0.0, "modified", k=1e-300)  # exp overflows

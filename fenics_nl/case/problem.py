@@ -357,8 +357,8 @@ class CaseProblem:
         case = self.case
         if self.damage:
             return DamageSteps(self, PREFIX + "damage_")
-        method, linear = case.newton, case.linear
-        opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_iterations,
+        method, linear = case.newton, case.linear_solver
+        opts = {"rtol": 1e-10, "atol": case.tolerance, "max_it": case.max_it,
                 "line_search": self.line_search(), "force_scale": self.force_scale}
         if linear == "gamg" and self.mixed:  # MINRES with the block preconditioner
             opts["preconditioner"] = mixed_form.preconditioner(self.material, self.mixed.W,
@@ -377,7 +377,7 @@ class CaseProblem:
         if case.newton == "snes":
             return SnesSolver(self.residual, self.unknown, self.bcs, prefix=PREFIX + "snes_",
                               rtol=opts["rtol"], atol=case.tolerance,
-                              force_scale=self.force_scale, max_it=case.max_iterations,
+                              force_scale=self.force_scale, max_it=case.max_it,
                               linear_solver=linear)
         return NewtonSolver(self.residual, self.unknown, self.bcs, method=method, prefix=PREFIX,
                             linear_solver=linear, **opts)

@@ -19,7 +19,7 @@ from fenics_nl.materials import laws
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.vocabulary import canonical
+from fenics_nl.vocabulary import canonical, renamed
 
 __all__ = ["KEYS", "Case", "CaseError", "Condition", "Probe", "arc_length_obstacles",
            "key_table", "read_case"]
@@ -94,9 +94,9 @@ adaptive = true          # optional: false stops at the first failed step instea
 
 [solver]                 # every key optional
 newton = "full"          # full | modified | periodic | bfgs | snes
-linear = "lu"            # lu (MUMPS) | gamg (CG + GAMG)
+linear_solver = "lu"     # lu (MUMPS) | gamg (CG + GAMG)
 tolerance = 1e-9         # |R| <= tolerance x the force scale of the step ends Newton
-max_iterations = 50      # Newton iterations per step
+max_it = 50              # Newton iterations per step
 
 [[probe]]                # optional: displacement, von Mises and Cauchy stress (key stress, the
                          # model's components: (x, y, z), plane stress (x, y), axisymmetric
@@ -170,10 +170,11 @@ KEYS = [
      "ok) at the first step where that probe's displacement component has reached `value`",
      "none", "length"),
     ("solver", "newton", "`full`, `modified`, `periodic`, `bfgs` or `snes`", "full", "—"),
-    ("solver", "linear", "`lu` (MUMPS) or `gamg` (CG + GAMG)", "lu", "—"),
+    ("solver", "linear_solver", "`lu` (MUMPS) or `gamg` (CG + GAMG)", "lu", "—"),
     ("solver", "tolerance", "‖R‖ ≤ tolerance × the step's force scale ends Newton", "1e-9",
      "—"),
-    ("solver", "max_iterations", "Newton iterations per step", "50", "—"),
+    ("solver", "max_it", "Newton iterations per step (PETSc's name, as in `-snes_max_it`)",
+     "50", "—"),
     ("probe", "name", "the probe's name in the JSON", "required", "—"),
     ("probe", "point", "where displacement, von Mises and Cauchy stress are reported, every "
      "step", "required", "length"),
@@ -260,9 +261,9 @@ class Case:
     arc: dict | None = None  # control = "arc-length": target, arc_length, max_arc_length,
     # max_steps
     newton: str = "full"
-    linear: str = "lu"
+    linear_solver: str = "lu"
     tolerance: float = 1e-9
-    max_iterations: int = 50
+    max_it: int = 50
     probes: list[Probe] = field(default_factory=list)
     formulation: str = "displacement"  # or "mixed": Taylor–Hood (u, p), materials.mixed
     refine_near: dict | None = None  # .geo: groups, size, distance (`case.mesh`)
@@ -295,6 +296,7 @@ class _Reader:
         if not isinstance(value, dict):
             self.fail(name, "must be a table [" + name + "]")
             return {}
+        value = renamed(value, name, allowed)  # an old key is read, and said
         self.unknown(value, name, allowed)
         return value
 
@@ -414,14 +416,14 @@ def read_case(path: str | Path) -> Case:
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
-    s = r.table(data, "solver", ("newton", "linear", "tolerance", "max_iterations"),
+    s = r.table(data, "solver", ("newton", "linear_solver", "tolerance", "max_it"),
                 required=False)
     newton = r.get(s, "newton", "solver", str, default="full", choices=NEWTON)
-    linear = r.get(s, "linear", "solver", str, default="lu", choices=LINEAR)
+    linear = r.get(s, "linear_solver", "solver", str, default="lu", choices=LINEAR)
     tolerance = r.get(s, "tolerance", "solver", float, default=1e-9, positive=True)
     if tolerance is not None and tolerance >= 1:
         r.fail("solver.tolerance", f"must be < 1 (relative to the force scale), got {tolerance}")
-    max_it = r.get(s, "max_iterations", "solver", int, default=50, minimum=1)
+    max_it = r.get(s, "max_it", "solver", int, default=50, minimum=1)
     if newton == "snes" and any(c.kind == "contact" for c in conditions):
         r.fail("solver.newton", '"snes" cannot run the contact active-set loop: use full, '
                                 "modified, periodic or bfgs")
@@ -488,9 +490,9 @@ def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, con
     if formulation == "mixed":
         r.fail("mesh.formulation", f"{law} is in the displacement formulation only")
     if newton != "full" or linear != "lu":
-        r.fail("solver.newton" if newton != "full" else "solver.linear",
+        r.fail("solver.newton" if newton != "full" else "solver.linear_solver",
                f"{law} is solved by alternate minimization, its u-solves by full Newton with "
-               "LU: newton = \"full\", linear = \"lu\"")
+               "LU: newton = \"full\", linear_solver = \"lu\"")
     for c in conditions:
         if c.kind == "contact":
             r.fail(f"{c.key}", f"{law}: no contact (the damage case has no active set)")

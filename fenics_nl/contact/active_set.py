@@ -168,7 +168,7 @@ class ActiveSetContact:
         normal_sign: int = 1,
         formulation: str = "elimination",
         initial: str = "all",
-        max_iterations: int = 50,
+        max_it: int = 50,
         newton_options: dict | None = None,
         prefix: str = "contact_",
         displacement_space: fem.FunctionSpace | None = None,
@@ -179,7 +179,7 @@ class ActiveSetContact:
         if initial not in ("all", "none", "penetrating"):
             raise ValueError(f"initial must be all, none or penetrating, got {initial!r}")
         V = displacement_space or u.function_space
-        self.u, self.formulation, self.max_iterations = u, formulation, max_iterations
+        self.u, self.formulation, self.max_it = u, formulation, max_it
         self.surface = ContactSurface(V, facets, gap, normal_axis=normal_axis,
                                       normal_sign=normal_sign,
                                       unknown_space=u.function_space)
@@ -342,7 +342,7 @@ class ActiveSetContact:
         with contextlib.ExitStack() as cleanup:
             cleanup.enter_context(self.reusing_residual())
             cleanup.callback(loose.off)
-            for k in range(1, self.max_iterations + 1):
+            for k in range(1, self.max_it + 1):
                 self._set_conditions(changes)
                 nr = self._inner_solve(k, res)
                 update = self._update_statuses()
@@ -369,7 +369,7 @@ class ActiveSetContact:
                     elif seen[update.state] > self.REVISITS:
                         raise ContactError(f"{self.STATUSES} cycles (iteration {k}: "
                                            f"{update.summary})", res)
-        raise ContactError(f"{self.STATUSES} did not settle in {self.max_iterations} "
+        raise ContactError(f"{self.STATUSES} did not settle in {self.max_it} "
                            "iterations", res)
 
     def _inner_solve(self, k: int, res: SolveResult, before: int = 0) -> SolveResult:

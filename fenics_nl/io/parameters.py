@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from typing import ClassVar
 
 from fenics_nl.io import flags
+from fenics_nl.vocabulary import OLD_NAMES, say_renamed
 
 __all__ = ["Parameters", "choice", "number", "parser_of", "switch", "text"]
 
@@ -102,23 +103,36 @@ def _number_type(f: dataclasses.Field):
     return parse
 
 
+class _OldName(argparse.Action):
+    """A flag's old name: its value is the new flag's, and the note says so."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        say_renamed(option_string, "--" + self.dest.replace("_", "-"))
+        setattr(namespace, self.dest, values)
+
+
 def _add(target, f: dataclasses.Field) -> None:
-    """The flag of field `f` on the parser (or exclusive group) `target`."""
+    """The flag of field `f` on the parser (or exclusive group) `target`, and its old names.
+
+    An old name (`vocabulary.OLD_NAMES`) is read, said, and hidden from --help.
+    """
     m = f.metadata
     flag = "--" + f.name.replace("_", "-")
     meaning = m["meaning"] + (f" [{m['unit']}]" if m.get("unit") else "")
+    old = ["--" + k.replace("_", "-") for k, new in OLD_NAMES.items() if new == f.name]
     if m["kind"] == "number":
-        target.add_argument(flag, dest=f.name, type=_number_type(f), default=f.default,
-                            metavar=m["metavar"], help=meaning)
+        kind = dict(type=_number_type(f), metavar=m["metavar"])
     elif m["kind"] == "choice":
-        target.add_argument(flag, dest=f.name, default=f.default, choices=m["options"],
-                            type=flags.spelling(flag) if m["spelling"] else None,
-                            help=meaning)
+        kind = dict(choices=m["options"], type=flags.spelling(flag) if m["spelling"] else None)
     elif m["kind"] == "switch":
         target.add_argument(flag, dest=f.name, action="store_true", help=meaning)
+        return
     else:
-        target.add_argument(flag, dest=f.name, default=f.default, metavar=m["metavar"],
-                            help=meaning)
+        kind = dict(metavar=m["metavar"])
+    target.add_argument(flag, dest=f.name, default=f.default, help=meaning, **kind)
+    for name in old:
+        target.add_argument(name, dest=f.name, default=argparse.SUPPRESS, action=_OldName,
+                            help=argparse.SUPPRESS, **kind)
 
 
 def parser_of(cls: type[Parameters]) -> argparse.ArgumentParser:

@@ -7,6 +7,8 @@ near-nullspace: without them GAMG's coarse spaces miss rotations and CG stalls o
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 from dolfinx import fem, la
 from petsc4py import PETSc
@@ -14,6 +16,8 @@ from petsc4py import PETSc
 __all__ = ["block_preconditioned_ksp", "create_ksp", "rigid_body_modes"]
 
 KINDS = ("lu", "cholesky", "gamg")
+# the spelling of the linear solver everywhere (`linear_solver=`, `--linear-solver`, TOML)
+LinearSolver = Literal["lu", "cholesky", "gamg"]
 
 
 def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:

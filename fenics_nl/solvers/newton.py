@@ -37,6 +37,7 @@ import math
 import os
 import time
 from collections.abc import Sequence
+from typing import Literal
 
 import numpy as np
 import ufl
@@ -50,6 +51,7 @@ from ufl.algorithms.analysis import extract_constants
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
+    LinearSolver,
     block_preconditioned_ksp,
     create_ksp,
     rigid_body_modes,
@@ -72,6 +74,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 METHODS = ("full", "modified", "periodic", "bfgs")
+Method = Literal["full", "modified", "periodic", "bfgs"]  # the Newton variant
 
 
 class ConvergenceError(SolveError):
@@ -420,7 +423,7 @@ class NewtonSolver:
         bcs: Sequence[fem.DirichletBC] = (),
         *,
         # the variant
-        method: str = "full",
+        method: Method = "full",
         tangent: ufl.Form | None = None,
         constant_tangent: str | ufl.Form = "initial",
         period: int = 3,
@@ -433,7 +436,7 @@ class NewtonSolver:
         max_it: int = 50,
         divergence_tol: float = 1e8,
         # the linear solver
-        linear_solver: str = "lu",
+        linear_solver: LinearSolver = "lu",
         reuse_factorization: bool = False,
         lag_preconditioner: bool = True,
         saddle_point: bool = False,

@@ -68,7 +68,7 @@ def _eps(u) -> float:
 
 def solve(r: Callable[[float], float], u0: float, method: str = "newton",
           dr: Callable[[float], float] | None = None, k: float | None = None,
-          tol: float = 1e-14, maxit: int = 100) -> ScalarResult:
+          tol: float = 1e-14, max_it: int = 100) -> ScalarResult:
     """Solve r(u) = 0 from u0; stop when |r(u)| <= tol or the update is below round-off.
 
     `dr` is r' (central differences if omitted); `k` the constant slope of modified Newton.
@@ -83,7 +83,7 @@ def solve(r: Callable[[float], float], u0: float, method: str = "newton",
         rs.append(r(u0))
         if method == "modified":
             k = dr(u0) if k is None else k
-        return _iterate(r, dr, method, k, us, rs, tol, maxit)
+        return _iterate(r, dr, method, k, us, rs, tol, max_it)
     except (ScalarSolveError, ArithmeticError) as err:
         failure = err if isinstance(err, ScalarSolveError) else ScalarSolveError(
             f"{method}: arithmetic failed at u = {us[-1]!r}: {err}")
@@ -91,9 +91,9 @@ def solve(r: Callable[[float], float], u0: float, method: str = "newton",
         raise failure from (None if failure is err else err)
 
 
-def _iterate(r, dr, method, k, us, rs, tol, maxit) -> ScalarResult:
+def _iterate(r, dr, method, k, us, rs, tol, max_it) -> ScalarResult:
     """The loop of `solve`, appending to `us` and `rs` in place."""
-    for _ in range(maxit):
+    for _ in range(max_it):
         u, ru = us[-1], rs[-1]
         if not (math.isfinite(float(u)) and math.isfinite(float(ru))):
             raise ScalarSolveError(f"{method}: non-finite value at u = {u!r}, r = {ru!r}")
@@ -115,7 +115,7 @@ def _iterate(r, dr, method, k, us, rs, tol, maxit) -> ScalarResult:
             return ScalarResult(us, rs, True, _orders(us, r, dr))
         us.append(u_new)
         rs.append(r(u_new))
-    raise ScalarSolveError(f"{method}: no convergence in {maxit} iterations "
+    raise ScalarSolveError(f"{method}: no convergence in {max_it} iterations "
                            f"(u = {us[-1]!r}, r = {rs[-1]!r})")
 
 

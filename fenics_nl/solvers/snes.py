@@ -18,7 +18,8 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.solvers.form_matrix import FormMatrix
-from fenics_nl.solvers.newton import ConvergenceError
+from fenics_nl.solvers.linear_solver import LinearSolver
+from fenics_nl.solvers.newton import ConvergenceError, Method
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.supports import RigidMotions, check_supports
 
@@ -147,8 +148,8 @@ class SnesSolver:
     """
 
     def __init__(self, residual: ufl.Form, u: fem.Function, bcs: Sequence[fem.DirichletBC] = (),
-                 *, method: str = "full", tangent: ufl.Form | None = None, period: int = 3,
-                 linear_solver: str = "lu", prefix: str = "snes_", rtol: float = 1e-10,
+                 *, method: Method = "full", tangent: ufl.Form | None = None, period: int = 3,
+                 linear_solver: LinearSolver = "lu", prefix: str = "snes_", rtol: float = 1e-10,
                  atol: float = 1e-10, force_scale: float | None = None, max_it: int = 50,
                  line_search: str = "basic"):
         lags = {"full": 1, "modified": -2, "periodic": period}
