@@ -32,16 +32,22 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
+import numpy as np
 import ufl
+from dolfinx import fem
 from mpi4py import MPI
 
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import quarter_annulus
+from fenics_nl.domain.probes import Probes
 from fenics_nl.errors import SolveError
-from fenics_nl.io import cli
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.plasticity import J2Plasticity
+from fenics_nl.parallel import global_max
 from fenics_nl.scenes import vessel_pictures
-from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
@@ -112,12 +118,60 @@ p_lim = vessels.limit_pressure(shape, a, b, s0)
 p_e_exact = vessels.yield_onset_pressure(shape, a, b, s0, args.nu)
 # -
 
-# ### The body
+# ### The mesh and its tags
 #
-# The quarter $a < |x| < b$ (P2 on curved edges), symmetric supports on its straight edges,
-# the inner surface loaded.
+# The quarter $a < |x| < b$ of the $(r, z)$ plane (sphere) or of the $(x, y)$ plane
+# (cylinder), P2 triangles on curved edges (`quarter_annulus`: gmsh, its edges tagged
+# `inner`, `outer`, `x0`, `y0`), 16 elements through the wall by default.
 
-body = VesselBody(shape, a, b, size=args.size, mixed=args.mixed)
+# +
+model = "axisymmetric" if shape == "sphere" else "plane_strain"
+h = args.size or (b - a) / 16
+mesh_data = quarter_annulus(comm, a, b, h)
+msh = mesh_data.mesh
+
+
+def tagged(name):
+    """The facets of the physical group `name`."""
+    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+
+# -
+
+# ### The function space and the boundary conditions
+#
+# P2 displacements (with `--mixed`, Taylor–Hood: a P1 mean stress as a second unknown).
+# The symmetry lines hold their normal component ($u_x = 0$ on $x = 0$, the sphere's axis;
+# $u_y = 0$ on $y = 0$). The inner surface carries the pressure $p$ (`p_inner`, a
+# `fem.Constant`), or
+# with `--inner-displacement` a prescribed radial motion (`inner_motion`), whose reaction
+# gives the pressure back.
+
+# +
+if args.mixed:
+    W = mixed.taylor_hood(msh, 2)
+    w = fem.Function(W, name="displacement_pressure")
+    (u, p_mean), (v, q) = ufl.split(w), ufl.TestFunctions(W)
+    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+    U, u_dofs = mixed.collapsed(V)  # its own space, and where its values sit in w
+else:
+    V = U = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    w = u = fem.Function(V, name="displacement")
+    v, u_dofs = ufl.TestFunction(V), slice(None)
+supports = [boundary.component(V, 0, tagged("x0")), boundary.component(V, 1, tagged("y0"))]
+p_inner = fem.Constant(msh, 0.0)  # the pressure on the inner surface
+motion = fem.Function(U)  # the inner surface's prescribed displacement
+inner_motion = fem.dirichletbc(motion, fem.locate_dofs_topological((V, U), 1, tagged("inner")),
+                               V) if args.mixed else fem.dirichletbc(
+    motion, fem.locate_dofs_topological(V, 1, tagged("inner")))
+
+
+def move_inner(delta):
+    """The radial displacement δ of the inner surface (tangential 0)."""
+    motion.interpolate(lambda x: delta * x[:2] / np.hypot(x[0], x[1]))
+
+
+# -
 
 # ### The material
 #
@@ -137,7 +191,7 @@ body = VesselBody(shape, a, b, size=args.size, mixed=args.mixed)
 # committed only when a step has converged: a failed step leaves no trace.
 
 material = J2Plasticity(args.E, args.nu, sigma0=s0, H=args.hardening)
-material.bind(body.mesh, body.quadrature_degree)
+material.bind(msh, 4)  # its state at the quadrature points of dx (degree 4: P2's 2 × 2)
 
 # ### The residual
 #
@@ -147,10 +201,17 @@ material.bind(body.mesh, body.quadrature_degree)
 # is the variation of $\Pi(u, p)$ (`fenics_nl.materials.mixed`).
 
 # +
-u, w = body.unknown, body.weight  # u: what the solver updates
-v = body.fields.v  # the displacement's test function (a part of (v, q) if mixed)
-internal = body.fields.internal_work(material, body.model)  # in either formulation
-residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * body.ds_inner
+dx = kinematics.quadrature_measure("dx", msh, 4)
+ds = ufl.Measure("ds", domain=msh, subdomain_data=mesh_data.facet_tags)
+ds_inner = ds(mesh_data.physical_groups["inner"].tag)
+weight = kinematics.measure_weight(msh, model)  # 2πr for the sphere, else 1
+if args.mixed:
+    internal = mixed.internal_work(material, u, p_mean, v, q, model)
+else:
+    eps = kinematics.small_strain(u, model)  # with the hoop strain u_r/r for the sphere
+    internal = ufl.inner(material.stress(eps), kinematics.small_strain(v, model)) * weight
+N = ufl.FacetNormal(msh)
+residual = internal * dx + p_inner * ufl.dot(N, v) * weight * ds_inner
 # -
 
 # ### The solver
@@ -172,9 +233,10 @@ residual = internal * body.dx + body.pressure * ufl.dot(body.normal, v) * w * bo
 
 # +
 control = "pressure" if args.inner_displacement is None else "displacement"
-bcs = body.supports + ([body.inner_motion] if control == "displacement" else [])
+bcs = supports + ([inner_motion] if control == "displacement" else [])
 force = p_lim * (math.pi * a * a if shape == "sphere" else a)
-elastic_tangent = body.fields.constant_tangent(material, body.model, body.dx)
+elastic_tangent = (mixed.modified_newton_tangent(material, w, model, dx) if args.mixed
+                   else material.modified_newton_tangent(u, model, dx))  # Hooke's
 
 
 # The tangent is symmetric (associated flow: the Hessian of the step's energy), so MUMPS
@@ -185,9 +247,9 @@ elastic_tangent = body.fields.constant_tangent(material, body.model, body.dx)
 def make_solver(bcs):
     """The --newton variant on the residual, with `bcs`."""
     if args.newton == "snes":
-        return SnesSolver(residual, u, bcs, rtol=1e-10, atol=1e-10, force_scale=force,
+        return SnesSolver(residual, w, bcs, rtol=1e-10, atol=1e-10, force_scale=force,
                           linear_solver="cholesky", prefix="vessel_snes_")
-    return NewtonSolver(residual, u, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
+    return NewtonSolver(residual, w, bcs, method=args.newton, rtol=1e-10, atol=1e-10,
                         force_scale=force, max_it=50 if args.newton == "full" else 500,
                         constant_tangent=elastic_tangent, linear_solver="cholesky",
                         prefix="vessel_")
@@ -196,14 +258,79 @@ def make_solver(bcs):
 solver = make_solver(bcs)
 # -
 
+# ### What is measured
+#
+# At the inner and outer points of $y = 0$ (`Probes`): the radial displacement $u(a)$, and
+# $\sigma_{eq}$ and the hoop stress at $r = a$. The pressure under displacement control:
+# the reaction across the symmetry plane that cuts the wall, which carries the pressure's
+# resultant ($p\,\pi a^2$ for the sphere, $p\,a$ per unit length for the quarter cylinder;
+# the inner support's own reaction would also hold the corner node it shares with that
+# plane, an O(h) error). The plastic radius: the largest $|x|$ of a quadrature point where
+# $p > 0$.
+
+# +
+probes = Probes(msh, [[a, 0.0], [b, 0.0]])
+displacement = fem.Function(U, name="displacement")
+
+
+def displacement_now():
+    """u as a Function of its own space (a copy of w's part if mixed)."""
+    displacement.x.array[:] = w.x.array[u_dofs]
+    return displacement
+
+
+def inner_displacement():
+    """u_r(a) at y = 0."""
+    return probes.continuous(displacement_now())[0][0]
+
+
+def stresses_at_inner():
+    """(σ_eq, σ_θ) at r = a, y = 0."""
+    sigma = (mixed.cauchy_stress(material, u, p_mean, model) if args.mixed
+             else material.cauchy_stress(u, model))
+    s_dev = ufl.dev(sigma)
+    vm = probes.discontinuous("vm", ufl.sqrt(1.5 * ufl.inner(s_dev, s_dev)), 2)
+    return vm[0], probes.discontinuous("hoop", sigma[1, 1], 2)[0]
+
+
+def pressure_from_support():
+    """p from the reaction across the symmetry plane that cuts the wall."""
+    plane, axis = ("y0", 1) if shape == "sphere" else ("x0", 0)
+    held = boundary.reactions(residual, w, {plane: tagged(plane)}, {plane: [axis]},
+                              space=V)[plane][axis]
+    return -held / (math.pi * a * a if shape == "sphere" else a)
+
+
+def plastic_radius():
+    """The largest |x| of a quadrature point where p > 0 (the plastic zone's edge), or a."""
+    p_cum = material.cumulated_plastic_strain
+    Q = p_cum.function_space
+    x = ufl.SpatialCoordinate(msh)
+    r = fem.Function(Q)
+    r.interpolate(fem.Expression(ufl.sqrt(ufl.inner(x, x)), Q.element.interpolation_points))
+    n = Q.dofmap.index_map.size_local
+    return max(a, global_max(comm, r.x.array[:n][p_cum.x.array[:n] > 0]))
+
+
+# -
+
 # ### Yield onset
 #
 # One elastic step at half the closed-form onset (any elastic load would do: σ_eq grows in
 # proportion) gives σ_eq at the inner surface per unit pressure, hence $p_e$.
 
 # +
-p_e = body.yield_onset(residual, material, 0.5 * p_e_exact, force)
-say(f"{shape}, a = {a:g}, b = {b:g}, {body.dofs} unknowns; yield onset p_e = {p_e:.6g} "
+p_inner.value = 0.5 * p_e_exact  # elastic: σ_eq grows in proportion to p
+NewtonSolver(residual, w, supports, rtol=1e-10, atol=1e-10, force_scale=force,
+             prefix="vessel_onset_").solve()
+vm_a = stresses_at_inner()[0]
+if vm_a >= s0:
+    raise SolveError(f"the onset step yielded (σ_eq(a) = {vm_a:.4g} >= σ0): it must be elastic")
+p_e = float(p_inner.value) * s0 / vm_a
+w.x.array[:] = 0.0
+p_inner.value = 0.0
+dofs = output.dofs(w.function_space)
+say(f"{shape}, a = {a:g}, b = {b:g}, {dofs} unknowns; yield onset p_e = {p_e:.6g} "
     f"(closed form {p_e_exact:.6g}), limit {p_lim:.6g}")
 # -
 
@@ -220,9 +347,8 @@ pressure_from_reaction = control == "displacement"
 
 
 def record(t, result):
-    p_now = (body.pressure_from(residual) if pressure_from_reaction
-             else float(body.pressure.value))
-    path.append((p_now, body.inner_displacement()))
+    p_now = pressure_from_support() if pressure_from_reaction else float(p_inner.value)
+    path.append((p_now, inner_displacement()))
     step_iterations.append(result.iterations)
     cli.converged_step({"load_factor": p_now / target_pressure, "pressure": p_now,
                         "inner_displacement": path[-1][1],
@@ -232,22 +358,22 @@ def record(t, result):
 
 
 def commit():
-    material.commit(body.u, body.model)
+    material.commit(u, model)
 
 
-cli.known(dofs=body.dofs, ranks=comm.size, limit_pressure_exact=p_lim,
+cli.known(dofs=dofs, ranks=comm.size, limit_pressure_exact=p_lim,
           yield_onset_pressure_exact=p_e_exact)
 target_pressure = args.pressure_ratio * p_lim if control == "pressure" else p_lim
 if control == "pressure":
     target = args.pressure_ratio * p_lim
 
     def load(t):
-        body.pressure.value = t * target
+        p_inner.value = t * target
 else:
     target = args.inner_displacement
 
     def load(t):
-        body.move_inner(t * target)
+        move_inner(t * target)
 
 # a restart (--restart) puts the checkpoint's state back: the displacement, the plastic
 # state, the steps so far; --checkpoint saves it after each converged step of the loading
@@ -276,13 +402,13 @@ if args.hardening == 0 and pressure > p_lim * (1 + 1e-3):
     # perfect plasticity has no equilibrium there: a discrete one means the elements lock
     # in the isochoric plastic flow (P2 with a few elements through the wall)
     raise SolveError(f"p = {pressure / p_lim:.4f} p_lim found an equilibrium beyond the limit "
-                     f"pressure, which has none: the mesh locks (h = {body.h:.3g}, "
-                     f"{(b - a) / body.h:.0f} elements through the wall); refine --size")
-c_fe = body.plastic_radius(material)
+                     f"pressure, which has none: the mesh locks (h = {h:.3g}, "
+                     f"{(b - a) / h:.0f} elements through the wall); refine --size")
+c_fe = plastic_radius()
 c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
 say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "
     f"(closed form {c_exact:.5g}{', for ν = 1/2' if shape == 'cylinder' else ''}; "
-    f"h = {body.h:.3g})")
+    f"h = {h:.3g})")
 # -
 
 # ### Unloading
@@ -294,14 +420,14 @@ say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5
 residual_hoop = None
 if args.unload:
     if control == "displacement":  # the same state, now held by its pressure
-        bcs.remove(body.inner_motion)
+        bcs.remove(inner_motion)
         solver = make_solver(bcs)
         pressure_from_reaction = False
 
     def unload(t):
-        body.pressure.value = (1 - t) * loaded
+        p_inner.value = (1 - t) * loaded
 
-    body.pressure.value = loaded
+    p_inner.value = loaded
     t0 = time.perf_counter()
     back = solve_incrementally(solver, unload, args.steps, max_step=1.0 / args.steps,
                                on_step=record, commit=commit)
@@ -309,7 +435,7 @@ if args.unload:
     run.work.add(back.work)
     run.failures += back.failures
     run.results.extend(back.results)
-    residual_hoop = body.stresses_at_inner(material)[1]
+    residual_hoop = stresses_at_inner()[1]
     say(f"unloaded: permanent u(a) = {path[-1][1]:.6g}, residual hoop stress at r = a "
         f"{residual_hoop:.6g}" + (f" (closed form "
                                   f"{vessels.residual_hoop_stress_inner(a, b, s0, loaded):.6g}"
@@ -342,13 +468,13 @@ def summary():
     out = {"shape": shape, "control": control, "newton": args.newton, "mixed": args.mixed,
            "yield_onset_pressure": p_e, "yield_onset_pressure_exact": p_e_exact,
            "limit_pressure_exact": p_lim, "pressure": pressure,
-           "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": body.h,
+           "plastic_radius": c_fe, "plastic_radius_exact": c_exact, "element_size": h,
            "inner_displacement": inner,
            "newton_iterations": run.iterations, "factorizations": run.work.factorizations,
            "iterations_per_step": step_iterations, "step_cuts": run.failures,
            "phase_time_s": run.work.time,
            "path": [{"pressure": q, "inner_displacement": d} for q, d in path],
-           "dofs": body.dofs, "ranks": comm.size, "solve_time_s": solve_time, "warnings": []}
+           "dofs": dofs, "ranks": comm.size, "solve_time_s": solve_time, "warnings": []}
     if inner_exact is not None:
         out["inner_displacement_exact"] = inner_exact
     if shape == "cylinder":
@@ -371,4 +497,15 @@ def summary():
 outcome = vessel_pictures.VesselRun(
     shape, a, b, args.E, args.nu, s0, path, loaded, args.unload, p_lim, p_e_exact, c_fe,
     c_exact, compliance, exact_curve, inner, inner_exact)
-cli.results(summary(), vessel_pictures.writers(outcome, body, material, args))
+
+
+
+def picture():
+    """The plastic zone on the deformed quarter, and the path."""
+    vessel_pictures.plastic_zone(outcome, displacement_now(),
+                                 material.cumulated_plastic_strain_per_cell(), args.png)
+    say(f"wrote {args.png}")
+
+
+cli.results(summary(), [*([lambda: vessel_pictures.pressure_curve(outcome, args.plot)]
+                          if args.plot else []), *([picture] if args.png else [])])

@@ -14,7 +14,7 @@ from mpi4py import MPI
 from fenics_nl.io import pictures
 from fenics_nl.theory import vessels
 
-__all__ = ["VesselRun", "plastic_zone", "pressure_curve", "writers"]
+__all__ = ["VesselRun", "plastic_zone", "pressure_curve"]
 
 
 @dataclass
@@ -98,22 +98,6 @@ def pressure_curve(run: VesselRun, path: str, comm=MPI.COMM_WORLD) -> None:
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"b/a = {run.b / run.a:g}, " + run.title("\n"), fontsize=9)
     pictures.save_figure(fig, path)
-
-
-def writers(run: VesselRun, body, material, args) -> list:
-    """The writers of --plot (p against u(a)) and --png (the plastic zone)."""
-    todo = []
-    if args.plot:
-        todo.append(lambda: pressure_curve(run, args.plot))
-    if args.png:
-        def picture():
-            plastic_zone(run, body.displacement(), material.cumulated_plastic_strain_per_cell(),
-                         args.png)
-            if body.mesh.comm.rank == 0:
-                print(f"wrote {args.png}")
-
-        todo.append(picture)
-    return todo
 
 
 def plastic_zone(run: VesselRun, displacement, plastic_strain_per_cell, path: str) -> None:
