@@ -209,5 +209,19 @@ out = {"force": last["force"], "reduction": last["reduction"], "friction": args.
 title = (f"upsetting to {100 * last['reduction']:.0f} %, f = {args.friction:g}: "
          f"F = {last['force']:.4g} ({last['force'] / last['force_frictionless_exact']:.3f} x "
          "frictionless)")
-cli.results(out, upsetting_pictures.writers(up, history, args.friction, args, title))
+
+
+def picture():
+    """The billet at the last state, coloured by its plastic strain."""
+    upsetting_pictures.billet_picture(up, args.png, title)
+    say(f"wrote {args.png}")
+
+
+def curve():
+    """The force against the reduction, every converged step."""
+    if billet.mesh.comm.rank == 0:
+        upsetting_pictures.force_curve(history, args.friction, args.plot, title)
+
+
+cli.results(out, [*([picture] if args.png else []), *([curve] if args.plot else [])])
 # -

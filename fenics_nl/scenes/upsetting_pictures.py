@@ -10,7 +10,7 @@ import numpy as np
 
 from fenics_nl.io import pictures
 
-__all__ = ["billet_picture", "force_curve", "writers"]
+__all__ = ["billet_picture", "force_curve"]
 
 
 def billet_picture(up, path: str, title: str) -> None:
@@ -54,23 +54,3 @@ def force_curve(history: list[dict], friction: float, path: str, title: str) -> 
     ax.grid(alpha=0.3)
     ax.legend()
     pictures.save_figure(fig, path)
-
-
-def writers(up, history: list[dict], friction: float, args, title: str) -> list:
-    """The writers of --png (the billet) and --plot (the force curve)."""
-    todo = []
-    comm = up.billet.mesh.comm
-    if args.png:
-        def picture():
-            billet_picture(up, args.png, title)
-            if comm.rank == 0:
-                print(f"wrote {args.png}")
-
-        todo.append(picture)
-    if args.plot:
-        def curve():
-            if comm.rank == 0:
-                force_curve(history, friction, args.plot, title)
-
-        todo.append(curve)
-    return todo
