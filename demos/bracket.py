@@ -144,8 +144,8 @@ class BracketParameters(Parameters):
                              "own sizes")
         mm = MM[self.units]
         self.E = self.E if self.E is not None else 200e3 / mm**2
-        cli.material_flags(self, power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
-                           j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
+        self.material_flags(power_law={"sigma0": 200.0 / mm**2, "n": 0.2},
+                            j2={"sigma0": 200.0 / mm**2, "hardening": 13e3 / mm**2})
         if self.friction is not None and self.support != "contact":
             raise ValueError("--friction acts between the base and the floor: add --support "
                              "contact")

@@ -70,7 +70,8 @@ class Indentation(punch_run.PunchParameters):
                              "control: drop --force, or add --loading-only")
 
 
-args = cli.arguments(Indentation, prefixes=punch_run.prefixes)
+args = cli.arguments(Indentation,
+                     prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
 unload = not args.loading_only
 # -
 
@@ -82,12 +83,14 @@ unload = not args.loading_only
 # the consistent one, both by UFL.
 
 # +
-block = punch_run.block_for(args)
+a = punch_run.contact_radius_for(args.model, args.E, args.nu, args.radius, args.indentation,
+                                 args.force)
+block = punch_run.block_for(args.model, a, refine=args.refine, block=args.block,
+                            mixed=args.mixed)
 material = J2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
 material.bind(block.mesh, block.quadrature_degree)
 punch = Punch(block, material, block.residual(material), args.radius,
               formulation=args.formulation, gap=args.gap)
-a = punch_run.contact_radius_for(args)
 cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
 # -
 
@@ -130,7 +133,8 @@ p = material.cumulated_plastic_strain
 plastic_strain = global_max(block.mesh.comm,
                             p.x.array[:p.function_space.dofmap.index_map.size_local])
 cli.say(f"largest cumulated plastic strain {plastic_strain:.4g}")
-drawn = punch_run.pictures(args, punch, load.states, check, plastic=True)
+drawn = punch_run.pictures(punch, load.states, check, png=args.png, plot=args.plot,
+                           force_controlled=args.force is not None, plastic=True)
 # -
 
 # ### The imprint
@@ -153,7 +157,8 @@ if unload:
 # of every step for ParaView (with the plastic strains), the load–depth curve, loading and
 # unloading, and the block at the largest load coloured by the von Mises stress.
 
-out = punch_run.summary(args, punch, load.states, loaded, nodes, check, "j2", warnings)
+out = punch_run.summary(punch, load.states, loaded, nodes, check, "j2", warnings,
+                        formulation=args.formulation)
 out["max_cumulated_plastic_strain"] = plastic_strain
 if imprint is not None:
     out["residual_imprint_depth"] = imprint

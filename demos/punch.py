@@ -121,7 +121,7 @@ class Hertz(Parameters):
             raise ValueError("--block must be >= 10 (block size in contact radii)")
         if self.indentation is None and self.force is None:
             self.indentation = 0.01 * self.radius
-        cli.material_flags(self, power_law={"sigma0": 0.01, "n": 0.3})
+        self.material_flags(power_law={"sigma0": 0.01, "n": 0.3})
 
 
 args = cli.arguments(Hertz, prefixes=lambda a: {

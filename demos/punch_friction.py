@@ -106,7 +106,8 @@ class CattaneoMindlin(punch_run.PunchParameters):
         return self.model != "axisymmetric"
 
 
-args = cli.arguments(CattaneoMindlin, prefixes=punch_run.prefixes)
+args = cli.arguments(CattaneoMindlin,
+                     prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
 # -
 
 # ### The block, the material, the frictional punch
@@ -117,11 +118,13 @@ args = cli.arguments(CattaneoMindlin, prefixes=punch_run.prefixes)
 # the stick and slip statuses, and the slip history committed at each converged step.
 
 # +
-block = punch_run.block_for(args, tangential=args.moved)
+a = punch_run.contact_radius_for(args.model, args.E, args.nu, args.radius, args.indentation,
+                                 args.force)
+block = punch_run.block_for(args.model, a, refine=args.refine, block=args.block,
+                            mixed=args.mixed, tangential=args.moved)
 material = LinearElastic(args.E, args.nu)
 punch = Punch(block, material, block.residual(material), args.radius,
               formulation=args.formulation, gap=args.gap, friction=args.friction)
-a = punch_run.contact_radius_for(args)
 cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
 # -
 
@@ -195,8 +198,8 @@ if traction is not None and args.nu != 0.5:
 # against Cattaneo–Mindlin's, and the deformed contact zone.
 
 # +
-out = punch_run.summary(args, punch, load.states, load.states, nodes, check, "linear",
-                        warnings)
+out = punch_run.summary(punch, load.states, load.states, nodes, check, "linear", warnings,
+                        formulation=args.formulation)
 out["friction"] = args.friction
 if traction is not None:
     out.update({"tangential_force": T.tangential_force,
@@ -204,7 +207,8 @@ if traction is not None:
                 "stick_radius": T.stick_radius, "stick_nodes": T.stick_nodes,
                 "slip_nodes": T.slip_nodes, "status_iterations": T.status_iterations,
                 **mindlin})
-cli.results(out, punch_run.pictures(args, punch, load.states, check, friction=args.friction,
-                                    traction=traction,
+cli.results(out, punch_run.pictures(punch, load.states, check, png=args.png, plot=args.plot,
+                                    force_controlled=args.force is not None,
+                                    friction=args.friction, traction=traction,
                                     stick_radius_exact=mindlin.get("stick_radius_exact")))
 # -

@@ -62,7 +62,6 @@ __all__ = [
     "error",
     "finite",
     "known",
-    "material_flags",
     "notebook_results",
     "on_failure",
     "parse_with_petsc_options",
@@ -79,27 +78,6 @@ __all__ = [
 # that cannot be reached (and PETSc refusing an option). Anything else is a bug and keeps
 # its traceback.
 EXPECTED_ERRORS: tuple[type[BaseException], ...] = (ValueError, SolveError)
-
-
-def material_flags(args, *, power_law: dict, j2: dict | None = None) -> None:
-    """Fill the chosen --material's flags with their defaults.
-
-    Power law: --sigma0, --n; j2: --sigma0, --hardening. A flag that sets only another
-    material is a ValueError (in a `Parameters.check`: one line, status 2).
-    """
-    own = {"power-law": power_law, "j2": j2 or {}}.get(args.material, {})
-    others = sorted({k for d in (power_law, j2 or {}) for k in d} - set(own))
-    given = [f"--{k}" for k in others if getattr(args, k, None) is not None]
-    if given:
-        owners = [m for m, d in (("the power law", power_law), ("j2", j2 or {}))
-                  if any(g[2:] in d for g in given)]
-        raise ValueError(f"{', '.join(given)} set {' and '.join(owners)}, not --material "
-                         f"{args.material}")
-    for k, v in own.items():
-        if getattr(args, k) is None:
-            setattr(args, k, v)
-    if args.material == "j2" and args.hardening < 0:
-        raise ValueError(f"--hardening must be >= 0, got {args.hardening:g}")
 
 
 def parse_with_petsc_options(parser: argparse.ArgumentParser, argv=None):

@@ -79,6 +79,26 @@ class Parameters:
     def check(self) -> None:
         """Conditions on several fields: raise ValueError (one line, status 2)."""
 
+    def material_flags(self, *, power_law: dict, j2: dict | None = None) -> None:
+        """Fill the chosen `material`'s flags with their defaults (in `check`).
+
+        Power law: --sigma0, --n; j2: --sigma0, --hardening. A flag that sets only another
+        material is a ValueError (one line, status 2).
+        """
+        own = {"power-law": power_law, "j2": j2 or {}}.get(self.material, {})
+        others = sorted({k for d in (power_law, j2 or {}) for k in d} - set(own))
+        given = [f"--{k}" for k in others if getattr(self, k, None) is not None]
+        if given:
+            owners = [m for m, d in (("the power law", power_law), ("j2", j2 or {}))
+                      if any(g[2:] in d for g in given)]
+            raise ValueError(f"{', '.join(given)} set {' and '.join(owners)}, not --material "
+                             f"{self.material}")
+        for k, v in own.items():
+            if getattr(self, k) is None:
+                setattr(self, k, v)
+        if self.material == "j2" and self.hardening < 0:
+            raise ValueError(f"--hardening must be >= 0, got {self.hardening:g}")
+
 
 def _number_type(f: dataclasses.Field):
     m, integer = f.metadata, isinstance(f.default, int) and not isinstance(f.default, bool)

@@ -80,28 +80,28 @@ class PunchParameters(Parameters):
             self.indentation = 0.01 * self.radius
 
 
-def prefixes(args: PunchParameters) -> dict[str, str]:
-    """The PETSc prefix of the run's solver (`cli.arguments`)."""
-    form = args.formulation[:4]
-    return {f"punch_{args.model}_{form}_":
-            "KSP" if args.formulation == "elimination" else "SNES and KSP"}
+def prefixes(model: str, formulation: str) -> dict[str, str]:
+    """The PETSc prefix of a punch's solver, and what reads it (`cli.arguments`)."""
+    return {f"punch_{model}_{formulation[:4]}_":
+            "KSP" if formulation == "elimination" else "SNES and KSP"}
 
 
-def contact_radius_for(args: PunchParameters) -> float:
-    """The contact radius the block's mesh is made for.
+def contact_radius_for(model: str, E: float, nu: float, radius: float,
+                       indentation: float | None, force: float | None) -> float:
+    """The contact radius a block's mesh is made for.
 
     Hertz's a for a prescribed force (sphere, or the cylinder's half-width), else √(Rδ)
     (for a cylinder, a safe overestimate of its half-width).
     """
-    if args.force is None:
-        return math.sqrt(args.radius * abs(args.indentation))
-    law = hertz.cylinder_from_force if args.model == "plane_strain" else hertz.sphere_from_force
-    return law(args.E, args.nu, args.radius, args.force)["contact_radius"]
+    if force is None:
+        return math.sqrt(radius * abs(indentation))
+    law = hertz.cylinder_from_force if model == "plane_strain" else hertz.sphere_from_force
+    return law(E, nu, radius, force)["contact_radius"]
 
 
-def block_size(args: PunchParameters) -> float:
-    """The block's size in contact radii: the flag's, else 1000 (3D: 100)."""
-    return args.block or (100.0 if args.model == "3d" else 1000.0)
+def block_size(model: str, block: float | None) -> float:
+    """The block's size in contact radii: `block`, else 1000 (3D: 100)."""
+    return block or (100.0 if model == "3d" else 1000.0)
 
 
 @dataclass
@@ -176,12 +176,12 @@ REACTIONS_OF = {"axisymmetric": ("the whole body (2πr in the residual)",) * 2,
                                  "the whole block, per unit length")}
 
 
-def summary(args: PunchParameters, punch: Punch, states: list, loading: list, nodes: int,
-            check: HertzCheck, material: str, warnings: list[str]) -> dict:
+def summary(punch: Punch, states: list, loading: list, nodes: int, check: HertzCheck,
+            material: str, warnings: list[str], *, formulation: str) -> dict:
     """The JSON every punch run has: the loaded state, its check, the steps, the work."""
-    block, last = punch.block, loading[-1]
-    out = {"model": args.model, "formulation": args.formulation, "material": material,
-           "mixed": args.mixed, "elements": "P2-P1 (Taylor-Hood)" if args.mixed else "P1",
+    block, last, mixed = punch.block, loading[-1], punch.block.mixed is not None
+    out = {"model": punch.model, "formulation": formulation, "material": material,
+           "mixed": mixed, "elements": "P2-P1 (Taylor-Hood)" if mixed else "P1",
            "force": last.force, "indentation": last.indentation,
            "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
            "element_size": block.h, "nodes_in_contact": nodes,
@@ -195,30 +195,32 @@ def summary(args: PunchParameters, punch: Punch, states: list, loading: list, no
                       "contact_radius": s.contact_radius,
                       "active_set_iterations": s.active_set_iterations} for s in states],
            "reactions": punch.reactions(),
-           "reactions_of": REACTIONS_OF[args.model][block.tangential],
+           "reactions_of": REACTIONS_OF[punch.model][block.tangential],
            "dofs": punch.dofs, "ranks": punch.mesh.comm.size, "warnings": warnings}
     if check.exponent is not None:
         out["fitted_exponent"] = check.exponent
     for k, e in check.errors.items():
         out[f"hertz_{k}"], out[f"{k}_rel_error"] = check.ref[k], e
-    if args.model == "plane_strain" and check.ref is not None:
+    if punch.model == "plane_strain" and check.ref is not None:
         warnings.append("plane strain: the force is not checked (a cylinder's indentation "
                         "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
                         "checked against Hertz for the computed P")
     return out
 
 
-def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=None,
-             traction=None, stick_radius_exact=None, plastic: bool = False) -> list:
-    """The writers of --plot and --png, drawing the state at hand (collective).
+def pictures(punch: Punch, states: list, check: HertzCheck, *, png: str | None,
+             plot: str | None, force_controlled: bool = False, friction=None, traction=None,
+             stick_radius_exact=None, plastic: bool = False) -> list:
+    """The writers of the pictures asked for (`png`, `plot`: their paths, or None).
 
-    States added to `states` later (an unloading) join the curve only.
+    They draw the state at hand (gathered now: collective); states added to `states` later
+    (an unloading) join the curve only.
     """
-    if not (args.png or args.plot):
+    if not (png or plot):
         return []
     profile = None
     if traction is not None:
-        if args.model == "3d":  # Q(r), the force inside r
+        if punch.model == "3d":  # Q(r), the force inside r
             rings = np.linspace(0.0, 1.5, 301) * states[-1].contact_radius
             profile = (rings, punch.tangential_force_within(rings))
         else:
@@ -226,19 +228,21 @@ def pictures(args, punch: Punch, states: list, check: HertzCheck, *, friction=No
     block = punch.block
     section = (output.section(block.displacement(), punch.von_mises(),
                               normal_axis=1 if block.vertical == 2 else None)
-               if args.png else None)
+               if png else None)
+    material = punch.material
     run = indentation_pictures.PunchRun(
-        punch.model, states, check.ref, args.E, args.nu, args.radius,
+        punch.model, states, check.ref, float(material.E), float(material.nu), punch.R,
         rank0=punch.mesh.comm.rank == 0, profile=punch.surface_profile(), section=section,
-        gap_at=punch.gap_at, h=block.h, tangential=block.tangential, mixed=args.mixed,
-        force_controlled=args.force is not None, friction=friction, traction=traction,
+        gap_at=punch.gap_at, h=block.h, tangential=block.tangential,
+        mixed=block.mixed is not None, force_controlled=force_controlled,
+        friction=friction, traction=traction,
         traction_profile=profile, stick_radius_exact=stick_radius_exact,
         loading_steps=len(states), plastic=plastic)
     writers = []
-    if args.plot:  # (--output: the fields of every step were written as they converged)
-        writers.append(lambda: indentation_pictures.curves(run, args.plot))
-    if args.png:
-        writers.append(lambda: indentation_pictures.section_picture(run, args.png))
+    if plot:  # (--output: the fields of every step were written as they converged)
+        writers.append(lambda: indentation_pictures.curves(run, plot))
+    if png:
+        writers.append(lambda: indentation_pictures.section_picture(run, png))
     return writers
 
 
@@ -257,12 +261,12 @@ def checkpointing(punch: Punch, load, state: dict | None = None) -> cli.Checkpoi
     return checkpoints
 
 
-def block_for(args: PunchParameters, *, tangential: bool = False) -> PunchBlock:
-    """The graded block for the run's expected contact radius (said while it is made)."""
-    size = block_size(args)
-    say(f"meshing the {args.model} block ({size:g} contact radii) ...")
-    return PunchBlock(args.model, contact_radius_for(args), refine=args.refine, block=size,
-                      mixed=args.mixed, tangential=tangential)
+def block_for(model: str, a: float, *, refine: int, block: float | None, mixed: bool,
+              tangential: bool = False) -> PunchBlock:
+    """The graded block for the expected contact radius `a` (said while it is made)."""
+    size = block_size(model, block)
+    say(f"meshing the {model} block ({size:g} contact radii) ...")
+    return PunchBlock(model, a, refine=refine, block=size, mixed=mixed, tangential=tangential)
 
 
 def compare_with_mindlin(punch: Punch, T, friction: float, bonded: float | None) -> dict:
