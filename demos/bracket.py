@@ -302,6 +302,7 @@ def solver_for(variant):
                                        material.modified_newton_tangent(u, "3d", dx))
     if args.support == "clamped":
         return NewtonSolver(residual, w, bcs, prefix="bracket_", **options)
+    # the floor z = 0 under the base: outward normal −e_z, no node active before it presses
     floor = dict(normal_axis=2, normal_sign=-1, initial="none", prefix="bracket_",
                  newton_options=options, displacement_space=V if args.mixed else None)
     if args.friction is None:
@@ -394,9 +395,10 @@ def solve(variant):
     except LoadStepError as err:  # a stall at round-off needs a looser tolerance
         norms = err.result.residual_norms if err.result is not None else []
         advice = "raise --tolerance" if stalled_at_round_off(norms) else "take more --steps"
-        raise LoadStepError(f"load step {len(steps) + 1}/{args.steps} (F = "
-                            f"{err.target * args.force:.4g} N), {variant} Newton: "
-                            f"{err.__cause__}; {advice}", err.result) from err
+        back = len(steps) >= args.steps  # the failed step unloads
+        F = (1 - err.target if back else err.target) * args.force
+        raise LoadStepError(f"load step {len(steps) + 1}/{total} (F = {F:.4g} N), {variant} "
+                            f"Newton: {err.__cause__}; {advice}", err.result) from err
     return solver, steps, comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 
 
@@ -418,8 +420,9 @@ groups = {"bolts": tagged("bolts"), **({"base": tagged("base")}
 reactions = boundary.reactions(residual, w, groups, space=V if args.mixed else None)
 held = [sum(r[i] for r in reactions.values()) for i in range(3)]
 final = 0.0 if args.unload else args.force  # the load at the end of the path
+imbalance = np.linalg.norm(np.subtract(held, [-final, 0.0, 0.0])) / args.force
 say(f"supports hold ({', '.join(f'{x:.6g}' for x in held)}) N against the load "
-    f"({final:.6g}, 0, 0) N: imbalance {abs(held[0] + final) / args.force:.1e} F")
+    f"({final:.6g}, 0, 0) N: imbalance {imbalance:.1e} F")
 # -
 
 # ## Outputs

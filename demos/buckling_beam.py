@@ -12,15 +12,16 @@
 # (shift-and-invert). Euler: $P_{cr} = \pi^2 E I / (4 L^2)$, $I = h^3/12$ (plane stress;
 # $E/(1-\nu^2)$ in plane strain).
 #
-# Post-buckling: load steps from 0 to $P = r P_{cr}$, a Newton solve per step, a small
-# lateral end load $\varepsilon P$ ($\varepsilon = 10^{-4}$) as imperfection. The elastica
+# Post-buckling: load steps from 0 to $P = r P_{cr}$ ($P_{cr}$: Euler's), a Newton solve
+# per step, a small lateral end load $\varepsilon P$ ($\varepsilon = 10^{-4}$) as
+# imperfection. The elastica
 # (inextensible, tip rotation $\alpha$, $k = \sin(\alpha/2)$):
 #
 # $$ P/P_{cr} = (2K(k)/\pi)^2, \qquad \delta/L = 2k/K(k), \qquad x/L = 2E(k)/K(k) - 1 .$$
 #
 # Past $P_{cr}$ the straight beam is still an equilibrium, but an unstable one: Newton can
-# settle on it. The steps therefore never grow beyond $1/n$ of the load, and the end state is
-# checked for stability (the tangent's eigenvalue nearest 0, by SLEPc); an unstable end
+# settle on it. The steps therefore never grow beyond 1/`--steps` of the load, and the end
+# state is checked for stability (the tangent's eigenvalue nearest 0, by SLEPc); an unstable end
 # state is pushed along its unstable mode, scaled to the elastica's deflection, and solved
 # again (branch switching); if Newton cannot follow, the path is redone with 4 times the
 # steps (up to 256), and only then does the run stop with a clear message.
@@ -102,7 +103,7 @@ class Buckling(Parameters):
                                "straight branch)", unit="-", above=0)
     imperfection: float = number(1e-4, "lateral end load as a fraction of P, in [0, 0.1)",
                                  unit="-", at_least=0)
-    refine: int = number(0, "mesh: 2·2^refine Q2 elements through the height, square "
+    refine: int = number(0, "mesh: 2·2^refine Q2 elements through the height, twice as long "
                          "elements", at_least=0)
     mixed: bool = switch("Q2-Q1 Taylor-Hood displacement-pressure elements, for a nearly or "
                          "exactly incompressible beam (nu up to 0.5; --plane strain)")
@@ -127,7 +128,8 @@ args = cli.arguments(Buckling, prefixes={"beam_": "Newton, SLEPc and pre-stress 
 
 # ### The mesh and its tags
 #
-# Q2 quadrilaterals, square, 2·2^refine through the height; the facets of the clamped end
+# Q2 quadrilaterals, 2·2^refine through the height and twice as long as high; the facets
+# of the clamped end
 # x = 0 and of the loaded end x = L are tagged 1 and 2.
 
 # +
@@ -327,20 +329,20 @@ else:  # λ = P/P_Euler is an unknown of the arc-length path
 # Tip rotation, lateral deflection and axial displacement at the last load.
 
 # +
-tip = beam.tip()
-alpha = math.degrees(abs(tip["rotation"]))
+end = tip()  # the end state's
+alpha = math.degrees(abs(end["rotation"]))
 alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
 d_el, x_el = elastica.tip_position(args.load_ratio)
 say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
-    f"{alpha_el:.3f}), lateral deflection {abs(tip['lateral']):.5g} (elastica "
-    f"{d_el * args.length:.5g}), axial displacement {tip['axial']:.5g} (elastica "
+    f"{alpha_el:.3f}), lateral deflection {abs(end['lateral']):.5g} (elastica "
+    f"{d_el * args.length:.5g}), axial displacement {end['axial']:.5g} (elastica "
     f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
     f"{path.iterations} Newton iterations, {path.failures} step cuts")
 out = {
     "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
     "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
-    "tip_rotation_deg": alpha, "tip_deflection": abs(tip["lateral"]),
-    "tip_axial_displacement": tip["axial"], "elastica_tip_rotation_deg": alpha_el,
+    "tip_rotation_deg": alpha, "tip_deflection": abs(end["lateral"]),
+    "tip_axial_displacement": end["axial"], "elastica_tip_rotation_deg": alpha_el,
     "elastica_tip_deflection": d_el * args.length,
     "elastica_tip_axial_displacement": (x_el - 1) * args.length,
     "load_steps": len(path.factors), "step_cuts": path.failures,

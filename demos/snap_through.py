@@ -23,7 +23,7 @@
 # Arc-length (Crisfield): the load factor $\lambda$ becomes an unknown with the constraint
 # $\|\Delta u\|^2/u_{ref}^2 + \psi^2 \Delta\lambda^2 = \Delta s^2$; each corrector iteration
 # is a bordered solve (two back-solves on the tangent of the chosen Newton variant). Limit
-# points are told by the sign of $\lambda$ along the path's tangent, and bracketed.
+# points are told by the sign of $\dot\lambda$ along the path's tangent, and bracketed.
 #
 # ## Implementation
 

@@ -34,6 +34,15 @@ def test_sphere_displacement_closed_form_against_hill():
         vessels.sphere_inner_displacement(A, B, E, NU, SIGMA0, 1.01 * p_lim)
 
 
+def test_no_residual_stress_below_the_yield_onset():
+    # an elastic loading is undone by the unloading: σ_θ(a) = 0 (the plastic-zone formula
+    # gave 0.29 σ0 at 0.72 p_e); just past the onset the formula takes over, continuously
+    p_e = vessels.yield_onset_pressure("sphere", A, B, SIGMA0)
+    assert vessels.residual_hoop_stress_inner(A, B, SIGMA0, 0.72 * p_e) == 0.0
+    at_onset = vessels.residual_hoop_stress_inner(A, B, SIGMA0, p_e * (1 + 1e-9))
+    assert abs(at_onset) < 1e-6 * SIGMA0
+
+
 def test_sphere_onset_plastic_radius_and_residual_stress(demo):
     # p = 0.8 p_lim < 2 p_e: the unloading stays elastic (no reverse yielding)
     d = demo.json("pressure_vessel.py", "--pressure-ratio", "0.8", "--unload", "--steps", "5")

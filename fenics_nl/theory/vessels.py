@@ -84,7 +84,13 @@ def plastic_radius(shape: str, a: float, b: float, sigma0: float, p: float) -> f
 
 
 def residual_hoop_stress_inner(a: float, b: float, sigma0: float, p: float) -> float:
-    """Sphere, after loading to p (a < c ≤ b) and unloading elastically: σ_θ(a)."""
+    """Sphere, after loading to p and unloading elastically: σ_θ(a).
+
+    Zero if p did not reach the yield onset (the unloading undoes an elastic loading);
+    else the plastic zone's σ_θ(a) less Lamé's elastic one for the same p.
+    """
+    if p <= yield_onset_pressure("sphere", a, b, sigma0):  # ν-free for the sphere
+        return 0.0
     loaded = -p + sigma0  # plastic zone: σ_θ = σ_r + σ0, σ_r(a) = −p
     return loaded - elastic_stresses("sphere", a, b, p, a)[1]
 
