@@ -3,7 +3,7 @@
 (The demo writes the same steps out: the mesh and tags, the space, the residual, a solver
 per Newton variant.)
 
-The mesh comes from `bracket_geometry` (built on rank 0, distributed) or from a user's
+The mesh comes from `domain.bracket` (built on rank 0, distributed) or from a user's
 .msh file with the physical groups ``bolts``, ``load`` and ``base``. The loaded hole carries
 a uniform traction of total force F along +x; the bolt holes are clamped, and with
 ``support="contact"`` the base also rests on a rigid floor (may lift off; frictionless, or

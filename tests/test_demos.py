@@ -437,7 +437,7 @@ def test_bracket_contact_support_lifts_off(tmp_path, demo):
     assert c["lifted_off_area"] > 0 and c["contact_area"] > 0  # it lifts off, not all of it
     # both make up the meshed base: the plate less two bolt holes meshed as octagons (their
     # 37.7 mm circumference over gmsh's smallest element at 20 mm, size/4 = 5 mm:
-    # bracket_geometry), to round-off
+    # domain.bracket), to round-off
     r, n = 6.0, 8
     octagons = 2 * n / 2 * r**2 * math.sin(2 * math.pi / n)
     meshed = c["lifted_off_area"] + c["contact_area"]
