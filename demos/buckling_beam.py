@@ -130,10 +130,11 @@ args = cli.arguments(Buckling, prefixes={"beam_": "Newton, SLEPc and pre-stress 
 #
 # Q2 quadrilaterals, 2·2^refine through the height and twice as long as high; the facets
 # of the clamped end
-# x = 0 and of the loaded end x = L are tagged 1 and 2.
+# x = 0 and of the loaded end x = L are tagged CLAMPED and END.
 
 # +
 L, h = args.length, args.thickness
+CLAMPED, END = 1, 2  # the facet tags
 ny = 2 * 2**args.refine
 nx = max(4, round(L / h * ny / 2))
 msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, ny],
@@ -141,9 +142,9 @@ msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, ny],
 clamped = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], 0.0))
 end = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], L))
 facets = np.concatenate([clamped, end])
-order = np.argsort(facets)
-facet_tags = mesh.meshtags(msh, 1, facets[order],
-                           np.hstack([np.full_like(clamped, 1), np.full_like(end, 2)])[order])
+values = np.hstack([np.full_like(clamped, CLAMPED), np.full_like(end, END)])
+order = np.argsort(facets)  # meshtags takes sorted entities
+facet_tags = mesh.meshtags(msh, 1, facets[order], values[order])
 # -
 
 # ### The function space and the boundary conditions
@@ -162,7 +163,7 @@ else:
     V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
     w = u = fem.Function(V, name="displacement")
     v = ufl.TestFunction(V)
-bcs = [boundary.fixed(V, facet_tags.find(1))]
+bcs = [boundary.fixed(V, facet_tags.find(CLAMPED))]
 ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
 t = fem.Constant(msh, np.zeros(2))
 
@@ -221,7 +222,7 @@ else:
     e = ufl.variable((H + H.T + H.T * H) / 2)  # Green–Lagrange
     S = ufl.diff(phi(e), e)
     internal = ufl.inner(F * S, kinematics.displacement_gradient(v, model))
-residual = internal * dx - ufl.dot(t, v) * ds(2)
+residual = internal * dx - ufl.dot(t, v) * ds(END)
 # -
 
 # ### What is measured: the tip
@@ -231,7 +232,7 @@ residual = internal * dx - ufl.dot(t, v) * ds(2)
 
 # +
 F_plane = ufl.Identity(2) + ufl.grad(u)  # the in-plane F: the end's tangent F e_y
-tip_forms = [fem.form(f * ds(2)) for f in (u[0] / h, u[1] / h, F_plane[0, 1], F_plane[1, 1])]
+tip_forms = [fem.form(f * ds(END)) for f in (u[0] / h, u[1] / h, F_plane[0, 1], F_plane[1, 1])]
 
 
 def tip():
@@ -241,7 +242,7 @@ def tip():
 
 
 beam = Beam(residual, mixed.unknown_of(w), bcs, material=material, model=model, length=L,
-            thickness=h, dx=dx, ds_end=ds(2), set_load=set_load, tip=tip, clamp=clamped)
+            thickness=h, dx=dx, ds_end=ds(END), set_load=set_load, tip=tip, clamp=clamped)
 say(f"beam L/h = {L / h:g}, {beam.dofs} unknowns, {args.material}, plane {args.plane}"
     f"{', mixed Q2-Q1' if args.mixed else ''}")
 # -

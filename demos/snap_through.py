@@ -124,7 +124,7 @@ args = cli.arguments(Arch, prefixes={"arch_": "Newton and the stability checks"}
 # Q2 quadrilaterals on the strip around $y_0$: a rectangle whose points are moved up by
 # $e \sin(\pi x/L)$ (each section shifted vertically: the arch is shallow), `--elements`
 # through the thickness and `--aspect` times as long along the span. The top face is
-# tagged 1: it carries the load.
+# tagged TOP: it carries the load.
 
 # +
 L, h = args.span, args.span / args.slenderness
@@ -136,7 +136,8 @@ msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, args.elements]
 msh.geometry.x[:, 1] += e * np.sin(np.pi * msh.geometry.x[:, 0] / L)
 top = mesh.locate_entities_boundary(
     msh, 1, lambda x: np.isclose(x[1], h / 2 + e * np.sin(np.pi * x[0] / L)))
-facet_tags = mesh.meshtags(msh, 1, top, np.ones(len(top), dtype=np.int32))
+TOP = 1  # the facet tag of the loaded face
+facet_tags = mesh.meshtags(msh, 1, top, np.full(len(top), TOP, dtype=np.int32))
 # -
 
 # ### The function space and the boundary conditions
@@ -175,7 +176,7 @@ load_factor = fem.Constant(msh, 0.0)
 X, n = ufl.SpatialCoordinate(msh), ufl.FacetNormal(msh)
 q = load_factor * load_unit * ufl.sin(k * X[0]) * abs(n[1])
 dx = kinematics.quadrature_measure("dx", msh, 4)
-ds_top = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)(1)
+ds_top = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)(TOP)
 P = material.first_piola(u, "plane_stress")
 residual = ufl.inner(P, ufl.grad(v)) * dx + q * v[1] * ds_top
 
