@@ -86,16 +86,27 @@ class EliminationSystem:
 
     def set_active(self, active: np.ndarray, changes: int | None,
                    extra_bcs: Sequence[fem.DirichletBC] = ()) -> None:
-        """u_n = γ on the active nodes; `changes`: nodes changed since the last solve.
+        """u_n = γ on the active nodes, T = 0 on the others (the next solve's conditions).
 
-        `extra_bcs`: more rows of S_C (the tangential ones of sticking nodes).
+        Args:
+            active: one flag per node of S_C: the nodes held at u_n = γ.
+            changes: nodes changed since the last solve (None: unknown, many): a few keep the
+                factorization (rows updated), more rebuild it.
+            extra_bcs: more Dirichlet rows on S_C (friction's sticking tangential ones).
         """
         small = changes is not None and changes <= self.small_change
         self.newton.set_bcs([*self.bcs, self.surface.dirichlet(active), *extra_bcs],
                             small_change=small, new_path=changes is None)
 
     def solve(self) -> SolveResult:
-        """Newton on the current set."""
+        """Newton on the current set.
+
+        Returns:
+            Newton's SolveResult (iterations, residual norms, work counts).
+
+        Raises:
+            ConvergenceError: Newton did not converge.
+        """
         return self.newton.solve()
 
     def reactions(self) -> np.ndarray:
@@ -117,7 +128,11 @@ class EliminationSystem:
             return loc.array_r.copy()
 
     def normal_forces(self) -> np.ndarray:
-        """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows."""
+        """T_n = n·(f_int − f_ext) at the S_C nodes: the residual without S_C's rows.
+
+        Returns:
+            T_n at each node of S_C (negative in compression).
+        """
         return self.surface.sign * self.reactions()[self.surface.dofs_V]
 
 
@@ -219,7 +234,11 @@ class ActiveSetContact:
         return {"active": self.active.astype(np.uint8)}
 
     def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
-        """The state of `checkpoint_arrays` back (the next solve starts from it)."""
+        """The state of `checkpoint_arrays` back (the next solve starts from it).
+
+        Args:
+            arrays: what `checkpoint_arrays` gave.
+        """
         self.active = arrays["active"].astype(bool)
 
     # -- the surface's quantities, for the current state --------------------------------
@@ -243,15 +262,33 @@ class ActiveSetContact:
         return self.surface.normal_gap(self.u)
 
     def pressure(self, weight=1.0) -> np.ndarray:
-        """Nodal contact pressure p_j = −T_n,j / m_j (positive in compression)."""
+        """Nodal contact pressure p_j = −T_n,j / m_j (positive in compression).
+
+        Args:
+            weight: the measure's weight (2πr in the axisymmetric model).
+
+        Returns:
+            p_j at each node of S_C.
+        """
         return -self.normal_forces() / self.surface.nodal_areas(weight)
 
     def total_force(self, T_n: np.ndarray | None = None) -> float:
-        """−Σ T_n over S_C, summed over ranks (positive in compression)."""
+        """−Σ T_n over S_C, summed over ranks (positive in compression).
+
+        Args:
+            T_n: the nodal forces (default: the last solve's).
+
+        Returns:
+            The contact force of the modelled part.
+        """
         return 0.0 - self.surface.total(self.normal_forces() if T_n is None else T_n)
 
     def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
-        """New obstacle position (a load step); the active set is kept as a warm start."""
+        """New obstacle position (a load step); the active set is kept as a warm start.
+
+        Args:
+            gap: γ(x) for the points x (3 × n).
+        """
         self.surface.set_gap(gap)  # the formulation reads γ at its next set_active
 
     def restart(self) -> None:
@@ -264,7 +301,14 @@ class ActiveSetContact:
         self.active = self.surface.sync(self.active | (self.normal_gap() > 0))
 
     def fields(self, weight=1.0) -> list[fem.Function]:
-        """Nodal contact pressure and active set (1/0) on S_C, to write out."""
+        """Nodal contact pressure and active set (1/0) on S_C, to write out.
+
+        Args:
+            weight: the measure's weight (2πr in the axisymmetric model).
+
+        Returns:
+            [contact pressure, active set] as Functions on the normal component's space.
+        """
         return [self.nodal_field(self.pressure(weight), "contact_pressure"),
                 self.nodal_field(self.active.astype(float), "active_set")]
 
@@ -272,6 +316,12 @@ class ActiveSetContact:
         """Areas of S_C open (lifted off) and in contact, from `active_facets` (collective).
 
         A facet is in contact when all its vertices are active; the two add up to S_C's.
+
+        Args:
+            weight: the measure's weight (2πr in the axisymmetric model).
+
+        Returns:
+            (area open, area in contact).
         """
         ds = ufl.Measure("ds", domain=self.surface.mesh, subdomain_data=self.active_facets())
         return tuple(self.comm.allreduce(fem.assemble_scalar(fem.form(weight * ds(tag))))
@@ -286,7 +336,15 @@ class ActiveSetContact:
         return self.surface.facet_tags(self.active)
 
     def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
-        """`values` at the S_C nodes as a function, for output."""
+        """`values` at the S_C nodes as a function, for output.
+
+        Args:
+            values: one value per node of S_C.
+            name: the Function's name.
+
+        Returns:
+            The Function (0 off S_C).
+        """
         return self.surface.nodal_field(values, name)
 
     def _initial_set(self, initial: str) -> np.ndarray:

@@ -99,14 +99,26 @@ class MultiplierSystem:
         self.gamma.x.scatter_forward()
 
     def set_active(self, active: np.ndarray, changes: int | None = None) -> None:
-        """χ = 1 on the active S_C nodes, 0 elsewhere (and the current γ)."""
+        """χ = 1 on the active S_C nodes, 0 elsewhere (and the current γ).
+
+        Args:
+            active: one flag per node of S_C: where the constraint u_n = γ holds.
+            changes: unused (the saddle point is refactorized by SNES each solve).
+        """
         self.chi.x.array[:] = 0.0
         self.chi.x.array[self.q_of_node] = active.astype(float)
         self.chi.x.scatter_forward()
         self.update_gap()
 
     def solve(self) -> SolveResult:
-        """One SNES solve of the block system for the current active set."""
+        """One SNES solve of the block system for the current active set.
+
+        Returns:
+            SNES's SolveResult.
+
+        Raises:
+            ConvergenceError: SNES did not converge.
+        """
         t0 = time.perf_counter()
         self.counter.start()
         self.problem.solve()
@@ -121,7 +133,11 @@ class MultiplierSystem:
         return result
 
     def normal_forces(self) -> np.ndarray:
-        """Nodal normal contact forces w_j λ_j at the S_C nodes (the surface's ordering)."""
+        """Nodal normal contact forces w_j λ_j at the S_C nodes (the surface's ordering).
+
+        Returns:
+            T_n at each node of S_C (negative in compression).
+        """
         with self.weights.localForm() as w:
             return w.array_r[self.q_of_node] * self.lam.x.array[self.q_of_node]
 

@@ -73,18 +73,39 @@ class ContactSurface:
         return self.dofs_n < self.Vn.dofmap.index_map.size_local
 
     def sync(self, local: np.ndarray) -> np.ndarray:
-        """A nodal flag array with the owners' values pushed to the ghosts."""
+        """A nodal flag array with the owners' values pushed to the ghosts.
+
+        Args:
+            local: one flag per node of S_C (this rank's view).
+
+        Returns:
+            The flags with every shared node's value its owner's (bool array).
+        """
         self._flags.array[:] = 0.0
         self._flags.array[self.dofs_n] = local
         self._flags.scatter_forward()
         return self._flags.array[self.dofs_n] > 0.5
 
     def count(self, mask: np.ndarray) -> int:
-        """Global number of nodes in `mask`."""
+        """Global number of nodes in `mask`.
+
+        Args:
+            mask: one flag per node of S_C.
+
+        Returns:
+            How many nodes of `mask` there are on all ranks (each node once).
+        """
         return self.comm.allreduce(int(np.sum(mask & self.owned)))
 
     def total(self, values: np.ndarray) -> float:
-        """Σ values over the nodes, every rank's owned ones."""
+        """Σ values over the nodes, every rank's owned ones.
+
+        Args:
+            values: one value per node of S_C.
+
+        Returns:
+            Their sum over all ranks (each node once).
+        """
         return self.comm.allreduce(float(np.sum(values[self.owned])))
 
     def gathered(self, *columns: np.ndarray) -> tuple[np.ndarray, ...] | None:
@@ -99,7 +120,15 @@ class ContactSurface:
         return tuple(c[order] for c in rows)
 
     def fingerprint(self, mask: np.ndarray) -> tuple[int, int]:
-        """Global signature of a node set: its size and the sum of its global indices."""
+        """Global signature of a node set: its size and the sum of its global indices.
+
+        Args:
+            mask: one flag per node of S_C.
+
+        Returns:
+            (size, sum of global indices), the same on every rank: equal for equal sets (and,
+            rarely, for two different ones).
+        """
         im = self.Vn.dofmap.index_map
         gidx = im.local_to_global(self.dofs_n[mask & self.owned].astype(np.int32))
         return (self.comm.allreduce(len(gidx)),
@@ -108,16 +137,34 @@ class ContactSurface:
     # -- gap and geometry ---------------------------------------------------------------
 
     def set_gap(self, gap: Callable[[np.ndarray], np.ndarray]) -> None:
-        """New obstacle position: γ at the nodes, and the prescribed normal displacement."""
+        """New obstacle position: γ at the nodes, and the prescribed normal displacement.
+
+        Args:
+            gap: γ(x) for the points x (3 × n): the obstacle's distance along n.
+        """
         self.gamma = np.asarray(gap(self.x.T), dtype=float)
         self.g.x.array[self.dofs_n] = self.sign * self.gamma
 
     def normal_displacement(self, u: fem.Function) -> np.ndarray:
-        """u_n = n·u at the nodes."""
+        """u_n = n·u at the nodes.
+
+        Args:
+            u: the unknown (its displacement part is read).
+
+        Returns:
+            u_n at each node of S_C.
+        """
         return self.sign * u.x.array[self.dofs_V]
 
     def normal_gap(self, u: fem.Function) -> np.ndarray:
-        """u_n − γ at the nodes (positive = penetration)."""
+        """u_n − γ at the nodes (positive = penetration).
+
+        Args:
+            u: the unknown.
+
+        Returns:
+            u_n − γ at each node of S_C.
+        """
         return self.normal_displacement(u) - self.gamma
 
     def nodal_areas(self, weight=1.0) -> np.ndarray:
@@ -126,6 +173,12 @@ class ContactSurface:
         Row sums m_j = ∫_{S_C} φ_j w ds; where they vanish (the vertices of P2 triangles,
         whose basis functions integrate to zero) the diagonal (HRZ) lumping instead:
         m_j ∝ ∫ φ_j² w ds, scaled to the same total area. Every m_j is then positive.
+
+        Args:
+            weight: the measure's weight (a UFL expression, or 1).
+
+        Returns:
+            m_j at each node of S_C (cached per weight).
         """
         key = id(weight) if not isinstance(weight, float | int) else float(weight)
         if key not in self._areas:
@@ -158,6 +211,12 @@ class ContactSurface:
         """The largest displacement component of `u`: a length scale of the current state.
 
         The pressure of a mixed unknown is left out.
+
+        Args:
+            u: the unknown.
+
+        Returns:
+            max |u_i| over the displacement dofs, on all ranks.
         """
         values = u.x.array[self.displacement_dofs]
         return self.comm.allreduce(float(np.abs(values).max(initial=0.0)), op=MPI.MAX)
@@ -172,7 +231,14 @@ class ContactSurface:
         return values
 
     def dirichlet(self, mask: np.ndarray) -> fem.DirichletBC:
-        """u_n = γ on the nodes of `mask`."""
+        """u_n = γ on the nodes of `mask`.
+
+        Args:
+            mask: the nodes to hold (the active set).
+
+        Returns:
+            The Dirichlet condition on the normal component, with the current γ (sign included).
+        """
         if self.component is self.Vn:
             return fem.dirichletbc(self.g, self.dofs_V[mask])
         return fem.dirichletbc(self.g, [self.dofs_V[mask], self.dofs_n[mask]], self.component)
@@ -211,20 +277,42 @@ class ContactSurface:
     # -- output -------------------------------------------------------------------------
 
     def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
-        """A function on the normal component's space: `values` at the nodes, 0 elsewhere."""
+        """A function on the normal component's space: `values` at the nodes, 0 elsewhere.
+
+        Args:
+            values: one value per node of S_C.
+            name: the Function's name (in the output files).
+
+        Returns:
+            The Function, ghosts updated.
+        """
         f = fem.Function(self.Vn, name=name)
         f.x.array[self.dofs_n] = values
         f.x.scatter_forward()
         return f
 
     def vertex_tags(self, mask: np.ndarray) -> mesh.MeshTags:
-        """Vertex meshtags (value 1) of the nodes of `mask` that are mesh vertices."""
+        """Vertex meshtags (value 1) of the nodes of `mask` that are mesh vertices.
+
+        Args:
+            mask: one flag per node of S_C.
+
+        Returns:
+            Vertex meshtags, value 1 on the vertices in `mask`.
+        """
         verts = self.vertices[mask]
         verts = np.sort(verts[verts >= 0]).astype(np.int32)
         return mesh.meshtags(self.mesh, 0, verts, np.ones(len(verts), dtype=np.int32))
 
     def facet_tags(self, mask: np.ndarray) -> mesh.MeshTags:
-        """Facet meshtags of S_C: 1 where every vertex of the facet is in `mask`, else 0."""
+        """Facet meshtags of S_C: 1 where every vertex of the facet is in `mask`, else 0.
+
+        Args:
+            mask: one flag per node of S_C (the active set).
+
+        Returns:
+            Facet meshtags of every facet of S_C, sorted, valued 1 or 0.
+        """
         fdim = self.mesh.topology.dim - 1
         self.mesh.topology.create_connectivity(fdim, 0)
         f2v = self.mesh.topology.connectivity(fdim, 0)
@@ -238,13 +326,19 @@ class ContactSurface:
 
 
 def check_contact_resolution(nodes: int, h: float, state) -> list[str]:
-    """Refuse a contact zone of fewer than MIN_NODES nodes (ValueError).
+    """Refuse a contact zone of fewer than MIN_NODES nodes, warn below FEW_NODES.
 
-    `nodes`: the active nodes; `h`: the element size there; `state`: a converged state
-    with its total `force` and `contact_radius`.
+    Args:
+        nodes: the active nodes (all ranks).
+        h: the element size under the contact.
+        state: a converged state with its total `force` and `contact_radius`.
 
-    Returns the warnings: one below FEW_NODES, none when the zone is resolved or there is
-    no contact.
+    Returns:
+        The warnings: one below FEW_NODES, none when the zone is resolved or there is no
+        contact.
+
+    Raises:
+        ValueError: fewer than MIN_NODES nodes in contact under a positive force.
     """
     if state.force > 0 and nodes < MIN_NODES:
         raise ValueError(f"only {nodes} node(s) of the surface are in contact (h = {h:.3g}, "
