@@ -124,7 +124,11 @@ class FrictionalContact(ActiveSetContact):
                 "tangential_force": self.committed_tangential_force}
 
     def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
-        """The state of `checkpoint_arrays` back, committed (u is the caller's, restored)."""
+        """The state of `checkpoint_arrays` back, committed (u is the caller's, restored).
+
+        Args:
+            arrays: what `checkpoint_arrays` gave.
+        """
         self.active, self.slip = arrays["active"].astype(bool), arrays["slip"].astype(bool)
         self.direction = arrays["direction"].copy()
         self.slip_force = arrays["slip_force"].copy()
@@ -136,7 +140,11 @@ class FrictionalContact(ActiveSetContact):
         self.committed_tangential_force = arrays["tangential_force"].copy()
 
     def set_motion(self, d) -> None:
-        """The obstacle's tangential displacement d (one value per tangential axis)."""
+        """The obstacle's tangential displacement d (one value per tangential axis).
+
+        Args:
+            d: the obstacle's displacement along each tangential axis, from the start.
+        """
         self.motion = np.asarray(d, dtype=float).reshape(len(self.axes))
 
     # -- the surface's tangential quantities ------------------------------------------
@@ -149,8 +157,14 @@ class FrictionalContact(ActiveSetContact):
     def tangential_forces(self, reactions: np.ndarray | None = None) -> np.ndarray:
         """T_t at the nodes (the obstacle's force on the body), one column per axis.
 
-        Zero in a component the body's supports hold. `reactions`: the residual's local
-        array if already assembled (`EliminationSystem.reactions`).
+        Zero in a component the body's supports hold.
+
+        Args:
+            reactions: the residual's local array, if already assembled
+                (`EliminationSystem.reactions`; else it is assembled).
+
+        Returns:
+            T_t at each node of S_C, one column per tangential axis.
         """
         r = self.system.reactions() if reactions is None else reactions
         return self.free * np.column_stack([r[self.surface.tangential(i)[0]]

@@ -146,6 +146,16 @@ def dofs_at(Q: fem.FunctionSpace, points: np.ndarray) -> np.ndarray:
     """The local dof of the scalar space Q at each of `points` (n x 3), checked.
 
     Every S_C node lies on a facet of the submesh on its own rank, so its dof is local.
+
+    Args:
+        Q: a scalar space on the facet submesh of S_C.
+        points: the S_C nodes' coordinates (n × 3).
+
+    Returns:
+        Q's local dof at each point.
+
+    Raises:
+        RuntimeError: a point is not a dof of Q on this rank.
     """
     if len(points) == 0:
         return np.zeros(0, dtype=np.int32)

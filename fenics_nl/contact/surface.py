@@ -257,6 +257,13 @@ class ContactSurface:
         for the Dirichlet values of sticking nodes.
 
         Component spaces share one layout (checked), so node j is dof `dofs_n[j]` in each.
+
+        Args:
+            i: a tangential axis (one of `tangential_axes`).
+
+        Returns:
+            (the dofs of component i at the nodes, in the unknown's numbering; a Function on
+            the component's space).
         """
         if i not in self._tangential:
             part = self.V.sub(i)
@@ -269,7 +276,16 @@ class ContactSurface:
 
     def tangential_dirichlet(self, i: int, mask: np.ndarray, values: np.ndarray
                              ) -> fem.DirichletBC:
-        """u_i = `values` (one per node) on the nodes of `mask`."""
+        """u_i = `values` (one per node) on the nodes of `mask`.
+
+        Args:
+            i: a tangential axis.
+            mask: the nodes to hold (the sticking ones).
+            values: u_i at every node of S_C (those of `mask` are used).
+
+        Returns:
+            The Dirichlet condition on component i.
+        """
         dofs, g = self.tangential(i)
         g.x.array[self.dofs_n] = values
         return fem.dirichletbc(g, [dofs[mask], self.dofs_n[mask]], self.V.sub(i))
@@ -356,6 +372,16 @@ def nodal_quadrature(degree: int, facet_dim: int) -> dict:
     Integrals become nodal sums with positive weights (the nodal areas): the vertex rule
     for P1, Gauss–Lobatto's 3 points (h/6, 2h/3, h/6) for P2 on edges. A P2 triangle has
     no such rule (its vertex weights vanish): a ValueError.
+
+    Args:
+        degree: the Lagrange degree of the nodes (1 or 2).
+        facet_dim: the facets' dimension (1: edges, 2: triangles).
+
+    Returns:
+        The measure's metadata (the quadrature rule and its degree).
+
+    Raises:
+        ValueError: P2 on triangles.
     """
     if degree == 1:
         return {"quadrature_rule": "vertex", "quadrature_degree": 1}
@@ -370,6 +396,12 @@ def vertex_of_dof(V: fem.FunctionSpace) -> np.ndarray:
 
     A Lagrange cell on simplices numbers its vertex dofs first, in the order of the cell's
     vertices (checked: other cells are refused).
+
+    Args:
+        V: a scalar Lagrange space.
+
+    Returns:
+        One mesh vertex per local dof, −1 where the dof is not at a vertex.
     """
     topo = V.mesh.topology
     if topo.cell_type not in (mesh.CellType.interval, mesh.CellType.triangle,
