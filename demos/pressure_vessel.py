@@ -46,7 +46,6 @@ from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.parallel import global_max
 from fenics_nl.scenes import vessel_pictures
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
@@ -265,8 +264,7 @@ solver = make_solver(bcs)
 # the reaction across the symmetry plane that cuts the wall, which carries the pressure's
 # resultant ($p\,\pi a^2$ for the sphere, $p\,a$ per unit length for the quarter cylinder;
 # the inner support's own reaction would also hold the corner node it shares with that
-# plane, an O(h) error). The plastic radius: the largest $|x|$ of a quadrature point where
-# $p > 0$.
+# plane, an O(h) error).
 
 # +
 probes = Probes(msh, [[a, 0.0], [b, 0.0]])
@@ -299,17 +297,6 @@ def pressure_from_support():
     held = boundary.reactions(residual, w, {plane: tagged(plane)}, {plane: [axis]},
                               space=V)[plane][axis]
     return -held / (math.pi * a * a if shape == "sphere" else a)
-
-
-def plastic_radius():
-    """The largest |x| of a quadrature point where p > 0 (the plastic zone's edge), or a."""
-    p_cum = material.cumulated_plastic_strain
-    Q = p_cum.function_space
-    x = ufl.SpatialCoordinate(msh)
-    r = fem.Function(Q)
-    r.interpolate(fem.Expression(ufl.sqrt(ufl.inner(x, x)), Q.element.interpolation_points))
-    n = Q.dofmap.index_map.size_local
-    return max(a, global_max(comm, r.x.array[:n][p_cum.x.array[:n] > 0]))
 
 
 # -
@@ -404,7 +391,7 @@ if args.hardening == 0 and pressure > p_lim * (1 + 1e-3):
     raise SolveError(f"p = {pressure / p_lim:.4f} p_lim found an equilibrium beyond the limit "
                      f"pressure, which has none: the mesh locks (h = {h:.3g}, "
                      f"{(b - a) / h:.0f} elements through the wall); refine --size")
-c_fe = plastic_radius()
+c_fe = material.plastic_radius(a)  # the largest |x| where p > 0 (or a)
 c_exact = vessels.plastic_radius(shape, a, b, s0, min(pressure, p_lim))
 say(f"p = {pressure:.6g} = {pressure / p_lim:.4f} p_lim; plastic radius {c_fe:.5g} "
     f"(closed form {c_exact:.5g}{', for ν = 1/2' if shape == 'cylinder' else ''}; "

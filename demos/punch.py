@@ -31,7 +31,6 @@
 # ## Implementation
 
 # +
-import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -49,10 +48,11 @@ from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
 from fenics_nl.io import cli, indentation_pictures, output
-from fenics_nl.io.parameters import Parameters, choice, number, switch
+from fenics_nl.io.parameters import choice, number
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.parallel import global_max
+from fenics_nl.scenes import punch_run
 from fenics_nl.solvers.force_control import reach_force
 from fenics_nl.theory import hertz
 
@@ -61,48 +61,23 @@ from fenics_nl.theory import hertz
 # ### Parameters
 #
 # From the command line (`python demos/punch.py --help` lists them); in a notebook, the
-# defaults (R = 1, δ = 0.01 R, E = 1, ν = 0.3, axisymmetric, one load step).
+# defaults (R = 1, δ = 0.01 R, E = 1, ν = 0.3, axisymmetric, one load step). The flags
+# every punch demo has (the block, the load, the formulation) are
+# `punch_run.PunchParameters`; this one adds the material.
 
 # +
-MODELS = ("axisymmetric", "3d", "plane_strain")
-
-
 @dataclass
-class Hertz(Parameters):
+class Hertz(punch_run.PunchParameters):
     """Rigid spherical punch on an elastic block (Hertz contact, the course's active set).
     Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa)."""
 
-    EPILOG = ("PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
-              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
-              "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
-              "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
     OUTPUTS: ClassVar = {
         "output": "displacement, von Mises stress, contact pressure and active set",
         "png": "the deformed contact zone (von Mises stress) beside the contact pressure, "
                "against Hertz",
         "plot": "force-indentation and pressure against Hertz"}
+    CHECKPOINTS = False  # elastic and frictionless: no history to restart from
 
-    model: str = choice("axisymmetric", MODELS, "axisymmetric (r,z), 3D quarter, plane "
-                        "strain", spelling=True)
-    E: float = number(1.0, "Young's modulus", unit="stress", above=0)
-    nu: float = number(0.3, "Poisson's ratio", unit="-")
-    radius: float = number(1.0, "punch radius R", unit="length", above=0)
-    indentation: float | None = number(None, "displacement control: indentation δ, non-zero "
-                                       "(default 0.01 R; negative: the punch stays clear)",
-                                       unit="length", group="load")
-    force: float | None = number(None, "force control: total force P (per unit length in "
-                                 "plane strain)", unit="force", above=0, group="load")
-    steps: int = number(1, "load steps from 0 to the load", at_least=1)
-    formulation: str = choice("elimination", ["elimination", "multiplier"], "active normal "
-                              "displacements as Dirichlet rows, or Lagrange multipliers")
-    mixed: bool = switch("Taylor–Hood P2–P1 displacement–pressure elements: no locking as "
-                         "ν → 1/2, and ν = 0.5 exactly (with the elimination)")
-    gap: str = choice("parabola", ["parabola", "sphere"], "punch shape: Hertz's parabola or "
-                      "the exact sphere")
-    refine: int = number(1, "element size under the punch a/(20·2^refine) (plane strain: "
-                         "a/(40·2^refine), 3D: a/(6·2^refine))", at_least=0, at_most=6)
-    block: float | None = number(None, "block size in contact radii, >= 10 (default 1000, 3D "
-                                 "100)", above=0)
     material: str = choice("linear", ["linear", "power-law"], "linear elastic (Hertz "
                            "applies), or the power law (a Newton loop inside every "
                            "active-set iteration)")
@@ -111,22 +86,11 @@ class Hertz(Parameters):
     n: float | None = number(None, "power law exponent (default 0.3)", unit="-", above=0)
 
     def check(self):
-        if self.mixed and self.formulation == "multiplier" and self.model == "3d":
-            raise ValueError("--mixed --formulation multiplier is 2D and axisymmetric only (no "
-                             "nodal rule with positive weights on P2 triangles): use "
-                             "--formulation elimination in 3d")
-        if self.indentation is not None and self.indentation == 0:
-            raise ValueError("--indentation must be non-zero (negative: the punch stays clear)")
-        if self.block is not None and self.block < 10:
-            raise ValueError("--block must be >= 10 (block size in contact radii)")
-        if self.indentation is None and self.force is None:
-            self.indentation = 0.01 * self.radius
+        super().check()
         self.material_flags(power_law={"sigma0": 0.01, "n": 0.3})
 
 
-args = cli.arguments(Hertz, prefixes=lambda a: {
-    f"punch_{a.model}_{a.formulation[:4]}_": "KSP" if a.formulation == "elimination"
-    else "SNES and KSP"})
+args = cli.arguments(Hertz, prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
 R, model = args.radius, args.model
 # -
 
@@ -141,16 +105,12 @@ R, model = args.radius, args.model
 # (the top, $S_C$), `bottom`, `symmetry_x`, `symmetry_y` (3D) and `side`.
 
 # +
-if args.force is None:
-    a = math.sqrt(R * abs(args.indentation))
-else:
-    law = hertz.cylinder_from_force if model == "plane_strain" else hertz.sphere_from_force
-    a = law(args.E, args.nu, R, args.force)["contact_radius"]
+a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
 h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
 growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
-size = args.block or (100.0 if model == "3d" else 1000.0)
+size = punch_run.block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
 mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth)
 msh = mesh_data.mesh

@@ -82,6 +82,31 @@ class QuadratureStateOutputs:
         """The largest committed p of each cell's quadrature points (DG0 Function)."""
         return cell_max(self.cumulated_plastic_strain, "cumulated_plastic_strain")
 
+    def plastic_radius(self, least: float = 0.0) -> float:
+        """The largest distance from the origin of a quadrature point where p > 0.
+
+        The plastic zone's edge of a body loaded from a cavity at the origin (a vessel).
+
+        Args:
+            least: what is returned if no point has yielded (the cavity's radius).
+
+        Returns:
+            That distance, the same on every rank (collective).
+        """
+        import ufl
+        from dolfinx import fem
+        from mpi4py import MPI
+
+        p = self.cumulated_plastic_strain
+        Q = p.function_space
+        x = ufl.SpatialCoordinate(Q.mesh)
+        r = fem.Function(Q)
+        r.interpolate(Expression(ufl.sqrt(ufl.inner(x, x)), Q.element.interpolation_points))
+        n = Q.dofmap.index_map.size_local
+        yielded = r.x.array[:n][p.x.array[:n] > 0]
+        return max(least, Q.mesh.comm.allreduce(float(yielded.max(initial=least)),
+                                                op=MPI.MAX))
+
     def cell_mean(self, expression, name: str):
         """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
 

@@ -63,8 +63,9 @@ class PunchParameters(Parameters):
                          "ν → 1/2, and ν = 0.5 exactly (with the elimination)")
     gap: str = choice("parabola", ["parabola", "sphere"], "punch shape: Hertz's parabola or "
                       "the exact sphere")
-    refine: int = number(1, "element size under the punch a/(20·2^refine) (3D: "
-                         "a/(6·2^refine))", at_least=0, at_most=MAX_REFINE)
+    refine: int = number(1, "element size under the punch a/(20·2^refine) (plane strain: "
+                         "a/(40·2^refine), 3D: a/(6·2^refine))", at_least=0,
+                         at_most=MAX_REFINE)
     block: float | None = number(None, "block size in contact radii, >= 10 (default 1000, 3D "
                                  "100)", above=0)
 
@@ -76,6 +77,8 @@ class PunchParameters(Parameters):
                              "--formulation elimination in 3d")
         if self.indentation is not None and self.indentation == 0:
             raise ValueError("--indentation must be non-zero (negative: the punch stays clear)")
+        if self.block is not None and self.block < 10:
+            raise ValueError("--block must be >= 10 (block size in contact radii)")
         if self.indentation is None and self.force is None:
             self.indentation = 0.01 * self.radius
 

@@ -21,11 +21,9 @@ from mpi4py import MPI
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import quarter_annulus
 from fenics_nl.domain.probes import Probes
-from fenics_nl.expression import Expression
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.mixed import unknowns
-from fenics_nl.parallel import global_max
 
 __all__ = ["VesselBody"]
 
@@ -143,12 +141,4 @@ class VesselBody:
 
     def plastic_radius(self, material) -> float:
         """Largest |x| of a quadrature point where p > 0 (the plastic zone's edge), or a."""
-        p = material.cumulated_plastic_strain
-        Q = p.function_space
-        x = ufl.SpatialCoordinate(self.mesh)
-        r = fem.Function(Q)
-        r.interpolate(Expression(ufl.sqrt(ufl.inner(x, x)),
-                                 Q.element.interpolation_points))
-        n = Q.dofmap.index_map.size_local
-        plastic = p.x.array[:n] > 0
-        return max(self.a, global_max(self.mesh.comm, r.x.array[:n][plastic]))
+        return material.plastic_radius(self.a)
