@@ -112,6 +112,14 @@ class ContactSurface:
         """Nodal arrays gathered on rank 0 (each node once), sorted by the first; else None.
 
         For a profile along the surface: `gathered(r, p, active)`. Collective.
+
+        Args:
+            *columns: arrays of one value per node of S_C (this rank's view); the first is
+                the sort key.
+
+        Returns:
+            On rank 0, each column over every rank's owned nodes, sorted (stably) by the
+            first; None on the other ranks.
         """
         rows = gather_rows(self.comm, *(np.asarray(c)[self.owned] for c in columns))
         if rows is None:

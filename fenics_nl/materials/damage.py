@@ -51,7 +51,12 @@ class DamageState:
     update: object = None  # α of the threshold law as a fem.Expression, compiled once
 
     def bind(self, mesh, degree: int) -> None:
-        """Zero damage at the quadrature points of `degree` on `mesh`, w_c everywhere."""
+        """Zero damage at the quadrature points of `degree` on `mesh`, w_c everywhere.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         import basix.ufl
         from dolfinx import fem
 
@@ -91,13 +96,25 @@ class CourseDamage(Isotropic, SmallStrain):
         return math.sqrt(self.E * self.w_c)
 
     def homogeneous_stress(self, strain: float) -> float:
-        """σ of the uniaxial bar loaded monotonically (ν = 0): E ε, then w_c/ε past ε_c."""
+        """σ of the uniaxial bar loaded monotonically (ν = 0): E ε, then w_c/ε past ε_c.
+
+        Args:
+            strain: the bar's strain ε.
+
+        Returns:
+            σ (float).
+        """
         if abs(strain) <= self.critical_strain:
             return self.E * strain
         return self.w_c / strain
 
     def bind(self, mesh, degree: int) -> None:
-        """Create the state (no damage) at the quadrature points of `degree` on `mesh`."""
+        """Create the state (no damage) at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         self.state.bind(mesh, degree)
 
     def _bound(self) -> DamageState:
@@ -107,7 +124,12 @@ class CourseDamage(Isotropic, SmallStrain):
         return self.state
 
     def weaken(self, cells, factor: float) -> None:
-        """w_c times `factor` (in (0, 1]) in this rank's `cells` (local indices): a weak spot."""
+        """w_c times `factor` (in (0, 1]) in this rank's `cells` (local indices): a weak spot.
+
+        Args:
+            cells: the weak cells, by their local indices on this rank.
+            factor: the factor of w_c there, in (0, 1].
+        """
         if not 0 < factor <= 1:
             raise ValueError(f"a weak spot's factor must be in (0, 1], got {factor!r}")
         t = self._bound().toughness
@@ -123,7 +145,14 @@ class CourseDamage(Isotropic, SmallStrain):
         return 2 * LinearElastic(self.E, self.nu).energy(eps)
 
     def energy(self, eps):
-        """ψ(ε): the step's condensed energy at the threshold law's damage."""
+        """ψ(ε): the step's condensed energy at the threshold law's damage.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3; 2x2 in plane stress, with λ*).
+
+        Returns:
+            ψ (UFL scalar).
+        """
         alpha_n, w_c = self._bound().alpha, self._critical()
         W0 = self._undamaged(eps)
         r = (1 - alpha_n) * W0 / w_c
@@ -133,14 +162,30 @@ class CourseDamage(Isotropic, SmallStrain):
                                0.5 * (1 - alpha_n) * W0)
 
     def damage(self, eps):
-        """α at the strain ε from the committed state (UFL): max(αⁿ, 1 − w_c/W0)."""
+        """α at the strain ε from the committed state (UFL): max(αⁿ, 1 − w_c/W0).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3; 2x2 in plane stress).
+
+        Returns:
+            α (UFL scalar).
+        """
         alpha_n = self._bound().alpha
         r = (1 - alpha_n) * self._undamaged(eps) / self._critical()
         return ufl.conditional(ufl.gt(r, 1.0 + THRESHOLD_TOLERANCE),
                                1 - (1 - alpha_n) / ufl.max_value(r, 1.0), alpha_n)
 
     def modified_newton_tangent(self, u, model: str, dx):
-        """The tangent at the start of each solve (the step's damaged secant, "initial")."""
+        """The tangent at the start of each solve (the step's damaged secant, "initial").
+
+        Args:
+            u: the displacement (unused).
+            model: the kinematic model (unused).
+            dx: the measure of the residual (unused).
+
+        Returns:
+            "initial".
+        """
         return "initial"
 
     def reset(self) -> None:
@@ -167,7 +212,12 @@ class CourseDamage(Isotropic, SmallStrain):
         return [self.damage_per_cell()]
 
     def commit(self, u, model: str = "3d") -> None:
-        """Store the threshold law's damage at the displacement `u` (a converged step)."""
+        """Store the threshold law's damage at the displacement `u` (a converged step).
+
+        Args:
+            u: the displacement; the update is compiled for the first `u` given.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+        """
         from dolfinx import fem
 
         st = self._bound()

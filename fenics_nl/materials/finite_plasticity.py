@@ -79,6 +79,12 @@ def deviatoric_log_strain_squared(A):
 
     From two invariants of the unimodular Ā = A / det(A)^⅓: tr Ā and tr Ā⁻¹ = I₂(A) / det(A)^⅔
     (no inverse, no eigenvalue).
+
+    Args:
+        A: the 3x3 matrix (UFL), e.g. C Cp⁻¹, similar to the trial be_tr.
+
+    Returns:
+        |dev ½ ln A|² (UFL scalar), from the series `LOG_SERIES`.
     """
     det = ufl.det(A)
     I1 = ufl.tr(A)
@@ -106,7 +112,12 @@ class FiniteStrainState:
     update: tuple | None = None  # (F, Δp, ε̄) as fem.Expressions, compiled at the first commit
 
     def bind(self, mesh, degree: int) -> None:
-        """Virgin state (Cp⁻¹ = I, p = 0) at the quadrature points of `degree` on `mesh`."""
+        """Virgin state (Cp⁻¹ = I, p = 0) at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         from dolfinx import fem
 
         T, S = quadrature_spaces(mesh, degree)
@@ -166,7 +177,14 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return self.saturation is not None and self.saturation > self.sigma0 and self.delta > 0
 
     def yield_stress(self, p):
-        """σ_y(p): UFL for a UFL p, numpy for a number or an array."""
+        """σ_y(p): UFL for a UFL p, numpy for a number or an array.
+
+        Args:
+            p: the cumulated plastic strain (UFL, a number or a numpy array).
+
+        Returns:
+            σ_y(p), of the kind of `p`.
+        """
         exp = np.exp if isinstance(p, int | float | np.floating | np.ndarray) else ufl.exp
         s = self.sigma0 + self.H * p
         if self.voce:
@@ -174,13 +192,27 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return s
 
     def hardening_slope(self, p):
-        """dσ_y/dp (UFL)."""
+        """dσ_y/dp (UFL).
+
+        Args:
+            p: the cumulated plastic strain (UFL).
+
+        Returns:
+            dσ_y/dp (UFL; H itself for linear hardening).
+        """
         if not self.voce:
             return self.H
         return self.H + self.delta * (self.saturation - self.sigma0) * ufl.exp(-self.delta * p)
 
     def hardening_energy(self, p):
-        """∫₀ᵖ σ_y (UFL)."""
+        """∫₀ᵖ σ_y (UFL).
+
+        Args:
+            p: the cumulated plastic strain (UFL).
+
+        Returns:
+            The hardening energy ∫₀ᵖ σ_y (UFL scalar).
+        """
         w = self.sigma0 * p + 0.5 * self.H * p**2
         if self.voce:
             w = w + (self.saturation - self.sigma0) * (p + (ufl.exp(-self.delta * p) - 1)
@@ -190,7 +222,12 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
     # the step's return and energy
 
     def bind(self, mesh, degree: int) -> None:
-        """Create the virgin state at the quadrature points of `degree` on `mesh`."""
+        """Create the virgin state at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         self.state.bind(mesh, degree)
 
     def _bound(self) -> FiniteStrainState:
@@ -200,13 +237,28 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return self.state
 
     def trial(self, e):
-        """(ln J, |dev ε_tr|²) of the Green–Lagrange strain e from the committed Cp⁻¹ (UFL)."""
+        """(ln J, |dev ε_tr|²) of the Green–Lagrange strain e from the committed Cp⁻¹ (UFL).
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            (ln J, |dev ε_tr|²), UFL scalars.
+        """
         self.require_3x3(e)
         A = ufl.dot(ufl.Identity(3) + 2 * e, self._bound().metric)
         return 0.5 * ufl.ln(ufl.det(A)), deviatoric_log_strain_squared(A)
 
     def return_map(self, Q):
-        """(plastic?, ε̄, Δp) for |dev ε_tr|² = Q from the committed p (UFL)."""
+        """(plastic?, ε̄, Δp) for |dev ε_tr|² = Q from the committed p (UFL).
+
+        Args:
+            Q: |dev ε_tr|² (UFL scalar, the second of `trial`).
+
+        Returns:
+            (whether it flows, a UFL condition; the trial equivalent strain ε̄; Δp, 0 where
+            elastic).
+        """
         p_n = self._bound().p
         eq = ufl.sqrt(2.0 / 3.0 * Q)
         f = 3 * self.mu * eq - self.yield_stress(p_n)
@@ -219,7 +271,14 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return plastic, eq, ufl.conditional(plastic, dp, 0.0)
 
     def volumetric_split(self, e):
-        """ψ = [μ |dev ε_e|² + ∫ σ_y dp] + κ/2 (ln J)²: the plastic flow keeps the volume."""
+        """ψ = [μ |dev ε_e|² + ∫ σ_y dp] + κ/2 (ln J)²: the plastic flow keeps the volume.
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            (μ |dev ε_e|² + ∫ σ_y dp, ln J, κ).
+        """
         lnJ, Q = self.trial(e)
         plastic, _, dp = self.return_map(Q)
         p_n = self._bound().p
@@ -232,7 +291,14 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return rest, lnJ, self.kappa
 
     def energy(self, e):
-        """ψ(e): the step's condensed energy at the returned state."""
+        """ψ(e): the step's condensed energy at the returned state.
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            ψ (UFL scalar).
+        """
         self.require_compressible()
         rest, lnJ, k = self.volumetric_split(e)
         return rest + 0.5 * k * lnJ**2
@@ -269,6 +335,10 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         Raises SolveError, before storing anything, if the step was too large for the
         logarithm's series or the Voce return did not converge: the load driver then cuts
         the step.
+
+        Args:
+            u: the displacement; the update is compiled for the first `u` given.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
         """
         from dolfinx import fem
 

@@ -66,29 +66,66 @@ class GradientDamage(Isotropic):
         return MODELS[self.model]
 
     def w(self, alpha):
-        """The local dissipation: α (AT1) or α² (AT2)."""
+        """The local dissipation: α (AT1) or α² (AT2).
+
+        Args:
+            alpha: the damage α (UFL or a number).
+
+        Returns:
+            w(α), of the kind of `alpha`.
+        """
         return alpha if self.model == "at1" else alpha**2
 
     def stiffness(self, alpha):
-        """a(α) = (1 − α)² + k."""
+        """a(α) = (1 − α)² + k.
+
+        Args:
+            alpha: the damage α (UFL or a number).
+
+        Returns:
+            a(α), of the kind of `alpha`.
+        """
         return (1 - alpha) ** 2 + self.residual_stiffness
 
     def fracture_energy(self, alpha):
         """The dissipated energy density (Gc/c_w)(w(α)/ell + ell |∇α|²).
 
         Over the optimal profile of a crack it integrates to Gc per unit crack area.
+
+        Args:
+            alpha: the damage field α (a Function: its gradient is taken).
+
+        Returns:
+            The density (UFL scalar).
         """
         return self.Gc / self.c_w * (self.w(alpha) / self.ell
                                      + self.ell * ufl.inner(ufl.grad(alpha), ufl.grad(alpha)))
 
     def energy(self, u, alpha, model: str = "3d"):
-        """The energy density of (u, α) (times 2πr in the axisymmetric model)."""
+        """The energy density of (u, α) (times 2πr in the axisymmetric model).
+
+        Args:
+            u: the displacement.
+            alpha: the damage field α.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The density (UFL scalar), to be multiplied by the measure `dx`.
+        """
         eps = kinematics.small_strain(u, model)
         weight = kinematics.measure_weight(kinematics.domain(u), model)
         return (self.elastic_energy(eps, alpha) + self.fracture_energy(alpha)) * weight
 
     def elastic_energy(self, eps, alpha):
-        """a(α) ψ0(ε), or a(α) ψ0⁺ + ψ0⁻ with the volumetric split (ε: 3x3 for it)."""
+        """a(α) ψ0(ε), or a(α) ψ0⁺ + ψ0⁻ with the volumetric split (ε: 3x3 for it).
+
+        Args:
+            eps: the small strain ε (UFL).
+            alpha: the damage α (UFL).
+
+        Returns:
+            The degraded elastic energy density (UFL scalar).
+        """
         hooke = LinearElastic(self.E, self.nu)
         if self.split == "none":
             return self.stiffness(alpha) * hooke.energy(eps)
@@ -126,6 +163,12 @@ class GradientDamage(Isotropic):
         + (Gc/c_w)(w''/ell β² + 2 ell β'²) for a β of zero mean, and ½a'' − a'²/a = 1 − 4 = −3
         whatever α: the first mode, cos(πx/L), makes it negative past
         3 E ε_b² = (Gc/c_w)(w''/ell + 2 ell π²/L²), and not before the damage starts (AT1).
+
+        Args:
+            length: the bar's length L.
+
+        Returns:
+            ε_b (float), at least the critical strain ε_c.
         """
         w2 = 0.0 if self.model == "at1" else 2.0
         eb = math.sqrt(self.Gc / self.c_w * (w2 / self.ell + 2 * self.ell * math.pi**2
@@ -133,7 +176,14 @@ class GradientDamage(Isotropic):
         return max(eb, self.critical_strain)
 
     def degraded_share(self, strain: float) -> float:
-        """c: the share of ψ0 that a(α) multiplies in uniaxial strain (ν = 0)."""
+        """c: the share of ψ0 that a(α) multiplies in uniaxial strain (ν = 0).
+
+        Args:
+            strain: the uniaxial strain ε (its sign is read).
+
+        Returns:
+            c, 2/3 in compression with the volumetric split, else 1.
+        """
         return 2.0 / 3.0 if self.split == "volumetric" and strain < 0 else 1.0
 
     def homogeneous_damage(self, strain: float) -> float:
@@ -141,6 +191,12 @@ class GradientDamage(Isotropic):
 
         With the volumetric split, in compression: uniaxial strain (laterally held); a free
         bar in compression bulges once it has lost its shear stiffness.
+
+        Args:
+            strain: the uniaxial strain ε.
+
+        Returns:
+            α (float).
         """
         E, g = self.E, self.Gc / self.ell
         e2 = self.degraded_share(strain) * strain**2
@@ -150,7 +206,14 @@ class GradientDamage(Isotropic):
         return E * e2 / (E * e2 + g)
 
     def homogeneous_stress(self, strain: float) -> float:
-        """σ = (c a(α) + 1 − c) E ε of the homogeneous uniaxial state (ν = 0)."""
+        """σ = (c a(α) + 1 − c) E ε of the homogeneous uniaxial state (ν = 0).
+
+        Args:
+            strain: the uniaxial strain ε.
+
+        Returns:
+            σ (float).
+        """
         a = self.stiffness(self.homogeneous_damage(strain))
         c = self.degraded_share(strain)
         return (c * a + 1 - c) * self.E * strain
@@ -187,7 +250,12 @@ class DamagedElastic(SmallStrain):
         self.alpha = self.lower = None
 
     def bind(self, mesh, degree: int) -> None:
-        """The damage field (P1, zero) and its bound on `mesh` (`degree`: unused, P1)."""
+        """The damage field (P1, zero) and its bound on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (unused: the damage is P1).
+        """
         from dolfinx import fem
 
         A = fem.functionspace(mesh, ("Lagrange", 1))
@@ -195,7 +263,14 @@ class DamagedElastic(SmallStrain):
         self.lower = fem.Function(A, name="committed_damage")
 
     def energy(self, eps):
-        """a(α) ψ0(ε), or with the split a(α) ψ0⁺ + ψ0⁻ (ε: 3x3)."""
+        """a(α) ψ0(ε), or with the split a(α) ψ0⁺ + ψ0⁻ (ε: 3x3).
+
+        Args:
+            eps: the small strain ε (UFL).
+
+        Returns:
+            The energy density at the current damage field (UFL scalar).
+        """
         return self.law.elastic_energy(eps, self.alpha)
 
     def state_functions(self) -> dict:
@@ -207,5 +282,10 @@ class DamagedElastic(SmallStrain):
         return [self.alpha]
 
     def commit(self, u=None, model: str = "3d") -> None:
-        """The converged damage becomes the bound of the next steps (irreversibility)."""
+        """The converged damage becomes the bound of the next steps (irreversibility).
+
+        Args:
+            u: the displacement (unused: the damage is already converged).
+            model: the kinematic model (unused).
+        """
         self.lower.x.array[:] = self.alpha.x.array

@@ -33,7 +33,14 @@ __all__ = [
 
 
 def check_range(name: str, value: float, low: float, high: float) -> None:
-    """Raise ValueError unless low < value < high (a bound may be ±inf)."""
+    """Raise ValueError unless low < value < high (a bound may be ±inf).
+
+    Args:
+        name: the parameter's name, for the message.
+        value: its value (a number, or a scalar `fem.Constant` at its current value).
+        low: the lower bound (excluded).
+        high: the upper bound (excluded).
+    """
     if not (low < float(value) < high):
         raise ValueError(f"{name} must be in ({low:g}, {high:g}), got {value!r}")
 
@@ -91,7 +98,14 @@ class Isotropic:
                              "fenics_nl.materials.mixed): the bulk modulus is infinite")
 
     def lmbda_for(self, strain) -> float:
-        """λ for a 3x3 strain, the plane-stress λ* = 2λμ/(λ + 2μ) for a 2x2 one."""
+        """λ for a 3x3 strain, the plane-stress λ* = 2λμ/(λ + 2μ) for a 2x2 one.
+
+        Args:
+            strain: the strain (UFL); only its shape is read.
+
+        Returns:
+            λ, or λ* (2μ at ν = 1/2).
+        """
         if strain.ufl_shape[0] == 2:
             if self.incompressible:
                 return 2 * self.mu  # the limit λ → ∞
@@ -99,13 +113,24 @@ class Isotropic:
         return self.lmbda
 
     def require_3x3(self, strain) -> None:
-        """Raise ValueError for a plane-stress (2x2) strain this energy does not support."""
+        """Raise ValueError for a plane-stress (2x2) strain this energy does not support.
+
+        Args:
+            strain: the strain (UFL); only its shape is read.
+        """
         if strain.ufl_shape[0] != 3:
             raise ValueError(f"{type(self).__name__} does not support the plane-stress model")
 
 
 def von_mises_of(sigma):
-    """σ_eq = √(3/2) ‖dev σ‖ of a 3x3 stress, or of a 2x2 one embedded with σ_zz = 0 (UFL)."""
+    """σ_eq = √(3/2) ‖dev σ‖ of a 3x3 stress, or of a 2x2 one embedded with σ_zz = 0 (UFL).
+
+    Args:
+        sigma: the Cauchy stress (UFL, 3x3 or 2x2).
+
+    Returns:
+        σ_eq (UFL scalar).
+    """
     if sigma.ufl_shape[0] == 2:
         sigma = ufl.as_tensor([[sigma[0, 0], sigma[0, 1], 0],
                                [sigma[1, 0], sigma[1, 1], 0], [0, 0, 0]])
@@ -130,39 +155,93 @@ class Material(ABC):
         """The tangent modified Newton and BFGS keep: for an elastic law, "initial".
 
         `NewtonSolver`'s `constant_tangent`: the tangent at the start of each solve.
+
+        Args:
+            u: the displacement (the unknown Function).
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+            dx: the measure of the residual.
+
+        Returns:
+            "initial"; a law may return a bilinear form (UFL) instead (J2 gives Hooke's), which
+            the solver factorizes once for its life.
         """
         return "initial"
 
     @abstractmethod
     def energy(self, strain):
-        """Free-energy density of the strain (ε in small strain, e in finite strain)."""
+        """Free-energy density of the strain (ε in small strain, e in finite strain).
+
+        Args:
+            strain: ε or e (UFL, 3x3; 2x2 in plane stress, where the law supports it).
+
+        Returns:
+            φ (UFL scalar).
+        """
 
     def volumetric_split(self, strain):
         """(φ̃, g, k) with φ = φ̃ + k/2 g², for the mixed formulation (`materials.mixed`).
 
         g is the volumetric measure (tr ε, tr e or ln J), k the modulus that tends to ∞ as
-        ν → 1/2 (κ or λ).
+        ν → 1/2 (κ or λ). This default raises ValueError: the law has no split.
+
+        Args:
+            strain: ε or e (UFL, 3x3).
+
+        Returns:
+            (φ̃ (UFL), g (UFL), k (∞ at ν = 1/2)).
         """
         raise ValueError(f"{type(self).__name__} has no volumetric split: no mixed "
                          "displacement-pressure formulation")
 
     @abstractmethod
     def internal_work(self, u, v, model: str = "3d"):
-        """Integrand of the internal virtual work of `u` in the direction `v`."""
+        """Integrand of the internal virtual work of `u` in the direction `v`.
+
+        Args:
+            u: the displacement.
+            v: the test function (virtual displacement).
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the measure `dx`.
+        """
 
     @abstractmethod
     def cauchy_stress(self, u, model: str = "3d"):
-        """The Cauchy stress of the displacement `u` (3x3; 2x2 in plane stress)."""
+        """The Cauchy stress of the displacement `u` (3x3; 2x2 in plane stress).
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            σ (UFL).
+        """
 
     def von_mises_expression(self, u, model: str = "3d"):
         """σ_eq = √(3/2) ‖dev σ‖ of the displacement `u` (UFL).
 
         Plane stress: σ is embedded in 3D with σ_zz = 0 (the deviator is the 3D one).
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            σ_eq (UFL scalar).
         """
         return von_mises_of(self.cauchy_stress(u, model))
 
     def von_mises(self, u, model: str = "3d"):
-        """σ_eq of the displacement `u`, one value per cell (DG0 Function, at the centroid)."""
+        """σ_eq of the displacement `u`, one value per cell (DG0 Function, at the centroid).
+
+        Args:
+            u: the displacement (a Function: its mesh carries the DG0 space).
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            σ_eq, a DG0 Function named "von_mises".
+        """
         from dolfinx import fem
 
         Q = fem.functionspace(u.function_space.mesh, ("DG", 0))
@@ -178,24 +257,55 @@ class SmallStrain(Material):
     finite_strain = False
 
     def stress(self, eps):
-        """Cauchy stress σ = ∂φ/∂ε."""
+        """Cauchy stress σ = ∂φ/∂ε.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3; 2x2 in plane stress).
+
+        Returns:
+            σ (UFL, the shape of ε).
+        """
         eps = ufl.variable(eps)
         return ufl.diff(self.energy(eps), eps)
 
     def tangent(self, eps):
-        """Tangent moduli A = ∂²φ/∂ε∂ε = ∂σ/∂ε (fourth-order tensor)."""
+        """Tangent moduli A = ∂²φ/∂ε∂ε = ∂σ/∂ε (fourth-order tensor).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3; 2x2 in plane stress).
+
+        Returns:
+            A (UFL).
+        """
         eps = ufl.variable(eps)
         return ufl.diff(self.stress(eps), eps)
 
     def internal_work(self, u, v, model: str = "3d"):
-        """Integrand of the internal virtual work σ(ε(u)) : ε(v) (times 2πr if axisymmetric)."""
+        """Integrand of the internal virtual work σ(ε(u)) : ε(v) (times 2πr if axisymmetric).
+
+        Args:
+            u: the displacement.
+            v: the test function (virtual displacement).
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the measure `dx`.
+        """
         mesh = kinematics.domain(u)
         eps_u = kinematics.small_strain(u, model)
         eps_v = kinematics.small_strain(v, model)
         return ufl.inner(self.stress(eps_u), eps_v) * kinematics.measure_weight(mesh, model)
 
     def cauchy_stress(self, u, model: str = "3d"):
-        """σ(ε(u)): in small strain the Cauchy stress is the energy's derivative."""
+        """σ(ε(u)): in small strain the Cauchy stress is the energy's derivative.
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            σ (UFL, 3x3; 2x2 in plane stress).
+        """
         return self.stress(kinematics.small_strain(u, model))
 
 
@@ -205,22 +315,54 @@ class FiniteStrain(Material):
     finite_strain = True
 
     def second_piola(self, e):
-        """S = ∂φ/∂e."""
+        """S = ∂φ/∂e.
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3; 2x2 in plane stress).
+
+        Returns:
+            The second Piola–Kirchhoff stress S (UFL, the shape of e).
+        """
         e = ufl.variable(e)
         return ufl.diff(self.energy(e), e)
 
     def first_piola(self, u, model: str = "3d"):
-        """P = F·S(e(u))."""
+        """P = F·S(e(u)).
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The first Piola–Kirchhoff stress P (UFL).
+        """
         F = kinematics.deformation_gradient(u, model)
         return F * self.second_piola(kinematics.green_lagrange(u, model))
 
     def cauchy_stress(self, u, model: str = "3d"):
-        """σ = F S Fᵀ / det F (plane stress: det of the in-plane F, thickness change ignored)."""
+        """σ = F S Fᵀ / det F (plane stress: det of the in-plane F, thickness change ignored).
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            σ (UFL).
+        """
         F = kinematics.deformation_gradient(u, model)
         return F * self.second_piola(kinematics.green_lagrange(u, model)) * F.T / ufl.det(F)
 
     def internal_work(self, u, v, model: str = "3d"):
-        """Integrand of P(u) : ∇v over the reference configuration (times 2πR if axisymmetric)."""
+        """Integrand of P(u) : ∇v over the reference configuration (times 2πR if axisymmetric).
+
+        Args:
+            u: the displacement.
+            v: the test function (virtual displacement).
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the reference measure `dx`.
+        """
         mesh = kinematics.domain(u)
         H_v = kinematics.displacement_gradient(v, model)
         return ufl.inner(self.first_piola(u, model), H_v) * kinematics.measure_weight(mesh, model)
@@ -233,13 +375,27 @@ class LinearElastic(Isotropic, SmallStrain):
     is_linear = True
 
     def energy(self, eps):
-        """φ(ε)."""
+        """φ(ε).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3; 2x2 in plane stress, with λ*).
+
+        Returns:
+            φ (UFL scalar).
+        """
         if eps.ufl_shape[0] == 3:  # plane stress keeps a finite λ* at ν = 1/2
             self.require_compressible()
         return 0.5 * self.lmbda_for(eps) * ufl.tr(eps) ** 2 + self.mu * ufl.inner(eps, eps)
 
     def volumetric_split(self, eps):
-        """φ = μ dev ε : dev ε + κ/2 (tr ε)²."""
+        """φ = μ dev ε : dev ε + κ/2 (tr ε)².
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (μ |dev ε|², tr ε, κ).
+        """
         self.require_3x3(eps)
         d = ufl.dev(eps)
         return self.mu * ufl.inner(d, d), ufl.tr(eps), self.kappa
@@ -273,6 +429,12 @@ class PowerLaw(Isotropic, SmallStrain):
         """ε_eq/ε0 at the equivalent stress σ_eq, inverting σ_eq/σ0 = x (1 + x²)^((n−1)/2).
 
         The strain a computed peak stress means (a number, not UFL).
+
+        Args:
+            sigma_eq: the equivalent (von Mises) stress.
+
+        Returns:
+            ε_eq/ε0 (float; 0 for σ_eq ≤ 0).
         """
         from scipy.optimize import brentq
 
@@ -280,13 +442,27 @@ class PowerLaw(Isotropic, SmallStrain):
         return brentq(lambda x: x * (1 + x * x) ** ((n - 1) / 2) - s, 0.0, 1e9) if s > 0 else 0.0
 
     def energy(self, eps):
-        """φ(ε)."""
+        """φ(ε).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            φ (UFL scalar).
+        """
         self.require_compressible()
         rest, g, k = self.volumetric_split(eps)
         return 0.5 * k * g**2 + rest
 
     def volumetric_split(self, eps):
-        """φ = σ0 ε0/(n+1) [...] + κ/2 (tr ε)²: the deviatoric part is the power law."""
+        """φ = σ0 ε0/(n+1) [...] + κ/2 (tr ε)²: the deviatoric part is the power law.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (σ0 ε0/(n+1) [...], tr ε, κ).
+        """
         self.require_3x3(eps)
         d = ufl.dev(eps)
         x2 = (2.0 / 3.0) * ufl.inner(d, d) / self.eps0**2
@@ -300,13 +476,27 @@ class StVenantKirchhoff(Isotropic, FiniteStrain):
     """St Venant–Kirchhoff: φ(e) = λ/2 (tr e)² + μ e:e (the course's finite-strain law)."""
 
     def energy(self, e):
-        """φ(e)."""
+        """φ(e).
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3; 2x2 in plane stress, with λ*).
+
+        Returns:
+            φ (UFL scalar).
+        """
         if e.ufl_shape[0] == 3:
             self.require_compressible()
         return 0.5 * self.lmbda_for(e) * ufl.tr(e) ** 2 + self.mu * ufl.inner(e, e)
 
     def volumetric_split(self, e):
-        """φ = μ dev e : dev e + κ/2 (tr e)² (at κ = ∞: tr e = 0, not J = 1)."""
+        """φ = μ dev e : dev e + κ/2 (tr e)² (at κ = ∞: tr e = 0, not J = 1).
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            (μ |dev e|², tr e, κ).
+        """
         self.require_3x3(e)
         d = ufl.dev(e)
         return self.mu * ufl.inner(d, d), ufl.tr(e), self.kappa
@@ -317,7 +507,14 @@ class NeoHookean(Isotropic, FiniteStrain):
     """Compressible neo-Hookean: φ = μ/2 (tr C − 3) − μ ln J + λ/2 (ln J)², C = I + 2e."""
 
     def energy(self, e):
-        """φ(e)."""
+        """φ(e).
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            φ (UFL scalar).
+        """
         self.require_3x3(e)
         self.require_compressible()
         C = ufl.Identity(3) + 2 * e
@@ -337,8 +534,15 @@ class NeoHookean(Isotropic, FiniteStrain):
         split by the bulk modulus, φ̃ = [μ/2 (tr C − 3) − μ ln J − μ/3 (ln J)²] + κ/2 (ln J)²,
         gives it −2μ/3 of stiffness there: an inflated incompressible sphere then lost
         Newton's convergence near its pressure maximum and bifurcated onto mesh-scale modes
-        on a fine mesh (measured). For ν ≤ 0 (λ ≤ 0) that split is the only one with k > 0;
-        there the mixed form is not needed.
+        on a fine mesh (`cases/inflated_sphere.toml`, coarse and fine: the stress cases of
+        docs/validation.md). For ν ≤ 0 (λ ≤ 0) that split is the only one with k > 0; there
+        the mixed form is not needed.
+
+        Args:
+            e: the Green–Lagrange strain (UFL, 3x3).
+
+        Returns:
+            (φ̃, ln J, k), k being `volumetric_modulus`.
         """
         self.require_3x3(e)
         C = ufl.Identity(3) + 2 * e

@@ -54,6 +54,12 @@ def collapsed(V: fem.FunctionSpace):
 
     DOLFINx returns the map as a list holding one array; this gives the array (int32,
     owned dofs first, unrolled for a vector space).
+
+    Args:
+        V: a sub-space (`W.sub(i)`).
+
+    Returns:
+        (the collapsed FunctionSpace, the parent dof of each of its dofs).
     """
     Vc, parent = V.collapse()
     parent = parent[0] if isinstance(parent, list | tuple) else parent
@@ -61,7 +67,15 @@ def collapsed(V: fem.FunctionSpace):
 
 
 def taylor_hood(mesh, degree: int = 2) -> fem.FunctionSpace:
-    """The mixed space (P`degree` vector displacement, P`degree − 1` pressure)."""
+    """The mixed space (P`degree` vector displacement, P`degree − 1` pressure).
+
+    Args:
+        mesh: the mesh.
+        degree: the displacement's degree, >= 2.
+
+    Returns:
+        The Taylor–Hood FunctionSpace.
+    """
     if degree < 2:
         raise ValueError(f"Taylor–Hood needs a displacement degree >= 2, got {degree}")
     cell, gdim = mesh.basix_cell(), mesh.geometry.dim
@@ -74,8 +88,18 @@ def taylor_hood(mesh, degree: int = 2) -> fem.FunctionSpace:
 def internal_work(material, u, p, v, q, model: str = "3d"):
     """Integrand of δΠ(u, p; v, q): the virtual work of φ̃ + p g, and q (g − p/k).
 
-    `u`, `p` are the parts of the mixed unknown (`ufl.split`), `v`, `q` those of the test
-    function. Times 2πr in the axisymmetric model.
+    Times 2πr in the axisymmetric model.
+
+    Args:
+        material: the law (its `volumetric_split` and `finite_strain` are read).
+        u: the displacement part of the mixed unknown (`ufl.split`).
+        p: its pressure part.
+        v: the displacement part of the test function.
+        q: its pressure part.
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+    Returns:
+        The integrand (UFL scalar), to be multiplied by the measure `dx`.
     """
     if model == "plane_stress":
         raise ValueError("the mixed formulation is for 3D, plane-strain and axisymmetric "
@@ -97,7 +121,17 @@ def internal_work(material, u, p, v, q, model: str = "3d"):
 
 
 def cauchy_stress(material, u, p, model: str = "3d"):
-    """σ of the mixed state: ∂(φ̃ + p g)/∂ε in small strain, F S̃ Fᵀ / J in finite strain."""
+    """σ of the mixed state: ∂(φ̃ + p g)/∂ε in small strain, F S̃ Fᵀ / J in finite strain.
+
+    Args:
+        material: the law (its `volumetric_split` and `finite_strain` are read).
+        u: the displacement part of the mixed unknown.
+        p: its pressure part.
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+    Returns:
+        σ (UFL, 3x3).
+    """
     if material.finite_strain:
         e = ufl.variable(kinematics.green_lagrange(u, model))
         rest, g, _ = material.volumetric_split(e)
@@ -109,7 +143,17 @@ def cauchy_stress(material, u, p, model: str = "3d"):
 
 
 def von_mises_expression(material, u, p, model: str = "3d"):
-    """σ_eq = √(3/2) ‖dev σ‖ of the mixed state (UFL)."""
+    """σ_eq = √(3/2) ‖dev σ‖ of the mixed state (UFL).
+
+    Args:
+        material: the law.
+        u: the displacement part of the mixed unknown.
+        p: its pressure part.
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+    Returns:
+        σ_eq (UFL scalar).
+    """
     return von_mises_of(cauchy_stress(material, u, p, model))
 
 
@@ -118,6 +162,16 @@ def von_mises(material, u, p, model: str, mesh) -> fem.Function:
 
     At the centroid, or the mean over the quadrature points for a law whose state lives
     there (J2).
+
+    Args:
+        material: the law.
+        u: the displacement part of the mixed unknown.
+        p: its pressure part.
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+        mesh: the mesh of the DG0 space.
+
+    Returns:
+        σ_eq, a DG0 Function named "von_mises".
     """
     if hasattr(material, "cell_mean"):
         return material.cell_mean(von_mises_expression(material, u, p, model), "von_mises")
@@ -133,7 +187,16 @@ def modified_newton_tangent(material, w: fem.Function, model: str, dx):
 
     For a path-dependent law at small strain: the tangent of the same mixed form with
     Hooke's law (E, ν); at finite strain, the tangent each solve starts from, as in the
-    displacement formulation. `w`: the mixed unknown (u, p).
+    displacement formulation.
+
+    Args:
+        material: the law.
+        w: the mixed unknown (u, p).
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+        dx: the measure of the residual.
+
+    Returns:
+        "initial", or Hooke's mixed tangent, a bilinear form (UFL) in `w`.
     """
     if not material.path_dependent or material.finite_strain:
         return "initial"
@@ -148,8 +211,18 @@ def preconditioner(material, W: fem.FunctionSpace, model: str, dx):
     """diag(2μ ε:ε, (1/μ + 1/k) mass): the block preconditioner of the mixed tangent.
 
     Spectrally equivalent to it for any bulk modulus (Silvester–Wathen), so MINRES needs
-    about as many iterations at ν = 1/2 as at 0.3 (`NewtonSolver`, ``gamg``). The material's
-    initial shear modulus: a softening law (plastic flow) weakens it, as it does GAMG's.
+    about as many iterations at ν = 1/2 as at 0.3 (`NewtonSolver`, ``gamg``; measured by
+    benchmarks/mixed.py, table in docs/benchmarks.md). The material's initial shear
+    modulus: a softening law (plastic flow) weakens it, as it does GAMG's.
+
+    Args:
+        material: the law (its `mu` and `volumetric_modulus` are read).
+        W: the Taylor–Hood space.
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+        dx: the measure of the residual.
+
+    Returns:
+        The preconditioner, a bilinear form (UFL) on `W`.
     """
     (du, dp), (v, q) = ufl.TrialFunctions(W), ufl.TestFunctions(W)
     eps = kinematics.small_strain
@@ -188,11 +261,28 @@ class DisplacementUnknown:
         return self.w
 
     def internal_work(self, material, model: str):
-        """Integrand of the internal virtual work in the direction of the test function."""
+        """Integrand of the internal virtual work in the direction of the test function.
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the measure `dx`.
+        """
         return material.internal_work(self.u, self.v, model)
 
     def constant_tangent(self, material, model: str, dx):
-        """What modified Newton and BFGS keep (`NewtonSolver`'s `constant_tangent`)."""
+        """What modified Newton and BFGS keep (`NewtonSolver`'s `constant_tangent`).
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain", "plane_stress", "axisymmetric").
+            dx: the measure of the residual.
+
+        Returns:
+            The material's `modified_newton_tangent`, "initial" or a bilinear form (UFL).
+        """
         return material.modified_newton_tangent(self.u, model, dx)
 
 
@@ -230,17 +320,43 @@ class MixedUnknown:
         return self._p
 
     def internal_work(self, material, model: str):
-        """Integrand of δΠ(u, p; v, q) (`internal_work` of this module)."""
+        """Integrand of δΠ(u, p; v, q) (`internal_work` of this module).
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the measure `dx`.
+        """
         return internal_work(material, self.u, self.p, self.v, self.q, model)
 
     def constant_tangent(self, material, model: str, dx):
-        """What modified Newton and BFGS keep (`modified_newton_tangent` of this module)."""
+        """What modified Newton and BFGS keep (`modified_newton_tangent` of this module).
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+            dx: the measure of the residual.
+
+        Returns:
+            "initial", or a bilinear form (UFL) in `w`.
+        """
         return modified_newton_tangent(material, self.w, model, dx)
 
 
 def unknowns(mesh, degree: int = 2, mixed: bool = False
              ) -> DisplacementUnknown | MixedUnknown:
-    """The unknown of either formulation: P`degree` displacement, or Taylor–Hood (u, p)."""
+    """The unknown of either formulation: P`degree` displacement, or Taylor–Hood (u, p).
+
+    Args:
+        mesh: the mesh.
+        degree: the displacement's degree.
+        mixed: Taylor–Hood (u, p) if True.
+
+    Returns:
+        A new `MixedUnknown` or `DisplacementUnknown`.
+    """
     return MixedUnknown(mesh, degree) if mixed else DisplacementUnknown(mesh, degree)
 
 
@@ -248,6 +364,12 @@ def unknown_of(w: fem.Function) -> DisplacementUnknown | MixedUnknown:
     """The unknown whose Function is `w`, made by the caller (a demo's `fem.Function`).
 
     Mixed if `w`'s space is (a Taylor–Hood pair, as `taylor_hood` makes).
+
+    Args:
+        w: the displacement Function, or the (u, p) one.
+
+    Returns:
+        A `MixedUnknown` or `DisplacementUnknown` around `w` itself.
     """
     mesh = w.function_space.mesh
     if w.function_space.num_sub_spaces and w.ufl_element().is_mixed:

@@ -39,7 +39,15 @@ __all__ = [
 
 
 def whole_strain(u, ez):
-    """ε₃ of the in-plane displacement `u` and the out-of-plane strain `ez` (UFL)."""
+    """ε₃ of the in-plane displacement `u` and the out-of-plane strain `ez` (UFL).
+
+    Args:
+        u: the in-plane displacement (2 components; or its test function).
+        ez: the out-of-plane strain ε_zz (UFL, or 0).
+
+    Returns:
+        ε₃ (UFL, 3x3).
+    """
     e = ufl.sym(ufl.grad(u))
     return ufl.as_tensor([[e[0, 0], e[0, 1], 0], [e[1, 0], e[1, 1], 0], [0, 0, ez]])
 
@@ -86,11 +94,28 @@ class PlaneStressUnknown:
         return self._ez
 
     def internal_work(self, material, model: str = "plane_stress"):
-        """Integrand of δ∫ψ(ε₃) (`internal_work` of this module)."""
+        """Integrand of δ∫ψ(ε₃) (`internal_work` of this module).
+
+        Args:
+            material: the law, written in the 3x3 strain (J2).
+            model: unused (plane stress), for the other unknowns' signature.
+
+        Returns:
+            The integrand (UFL scalar), to be multiplied by the measure `dx`.
+        """
         return internal_work(material, self)
 
     def constant_tangent(self, material, model: str, dx):
-        """Hooke's tangent in (u, ε_zz) (`elastic_tangent` of this module)."""
+        """Hooke's tangent in (u, ε_zz) (`elastic_tangent` of this module).
+
+        Args:
+            material: the law (its E and ν are read).
+            model: unused (plane stress), for the other unknowns' signature.
+            dx: the measure of the residual.
+
+        Returns:
+            The tangent, a bilinear form (UFL) in `w`.
+        """
         return elastic_tangent(material, self, dx)
 
 
@@ -98,6 +123,13 @@ def pointwise_element(cell, quadrature: int):
     """The DG element with as many functions per cell as the rule has points (Legendre).
 
     Its nodal matrix at the points is then square; ValueError if no degree matches.
+
+    Args:
+        cell: the basix cell type.
+        quadrature: the quadrature degree of the residual's rule.
+
+    Returns:
+        The basix.ufl DG element (Legendre variant).
     """
     points, _ = basix.make_quadrature(cell, quadrature)
     for degree in range(quadrature + 1):
@@ -111,17 +143,42 @@ def pointwise_element(cell, quadrature: int):
 
 
 def internal_work(material, unknown: PlaneStressUnknown):
-    """Integrand of δ∫ψ(ε₃): σ(ε₃) : ε₃(v, 0) + σ_zz(ε₃) ζ (see the module)."""
+    """Integrand of δ∫ψ(ε₃): σ(ε₃) : ε₃(v, 0) + σ_zz(ε₃) ζ (see the module).
+
+    Args:
+        material: the law, written in the 3x3 strain (its `stress` is read: J2).
+        unknown: the unknown w = (u, ε_zz) and its test functions (v, ζ).
+
+    Returns:
+        The integrand (UFL scalar), to be multiplied by the measure `dx`.
+    """
     sigma = material.stress(unknown.strain())
     return ufl.inner(sigma, whole_strain(unknown.v, 0)) + sigma[2, 2] * unknown.dz
 
 
 def stress(material, unknown: PlaneStressUnknown):
-    """The Cauchy stress σ(ε₃), 3x3 (σ_zz = 0 at the quadrature points at equilibrium)."""
+    """The Cauchy stress σ(ε₃), 3x3 (σ_zz = 0 at the quadrature points at equilibrium).
+
+    Args:
+        material: the law, written in the 3x3 strain (J2).
+        unknown: the unknown w = (u, ε_zz).
+
+    Returns:
+        σ (UFL, 3x3).
+    """
     return material.stress(unknown.strain())
 
 
 def elastic_tangent(material, unknown: PlaneStressUnknown, dx):
-    """Hooke's tangent (E, ν) in (u, ε_zz): the course's modified Newton for J2."""
+    """Hooke's tangent (E, ν) in (u, ε_zz): the course's modified Newton for J2.
+
+    Args:
+        material: the law (its E and ν are read).
+        unknown: the unknown w = (u, ε_zz).
+        dx: the measure of the residual.
+
+    Returns:
+        The tangent, a bilinear form (UFL) in `unknown.w`.
+    """
     work = internal_work(LinearElastic(material.E, material.nu), unknown)
     return ufl.derivative(work * dx, unknown.w)

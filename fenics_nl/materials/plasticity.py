@@ -52,7 +52,12 @@ class PlasticState:
     commit: tuple | None = None  # (ε_p, p) of the return map as fem.Expressions, compiled once
 
     def bind(self, mesh, degree: int) -> None:
-        """Zero ε_p and p at the quadrature points of `degree` on `mesh`."""
+        """Zero ε_p and p at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         from dolfinx import fem
 
         T, S = quadrature_spaces(mesh, degree)
@@ -62,7 +67,15 @@ class PlasticState:
 
 
 def quadrature_spaces(mesh, degree: int):
-    """(3x3 tensor, scalar) spaces at the quadrature points of `degree` on `mesh`."""
+    """(3x3 tensor, scalar) spaces at the quadrature points of `degree` on `mesh`.
+
+    Args:
+        mesh: the mesh.
+        degree: the quadrature degree.
+
+    Returns:
+        (tensor space, scalar space), dolfinx FunctionSpaces of quadrature elements.
+    """
     import basix.ufl
     from dolfinx import fem
 
@@ -112,6 +125,13 @@ class QuadratureStateOutputs:
 
         The state exists at the quadrature points only, so anything that reads it (σ_eq,
         the mixed formulation's stress) is evaluated there.
+
+        Args:
+            expression: the scalar UFL expression.
+            name: the name of the returned Function.
+
+        Returns:
+            The means, a DG0 Function.
         """
         from dolfinx import fem
 
@@ -123,7 +143,15 @@ class QuadratureStateOutputs:
         return f
 
     def von_mises(self, u, model: str = "3d"):
-        """σ_eq per cell (DG0): the mean of its quadrature points' values."""
+        """σ_eq per cell (DG0): the mean of its quadrature points' values.
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+        Returns:
+            σ_eq, a DG0 Function named "von_mises".
+        """
         return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
 
 
@@ -153,7 +181,12 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
                 raise ValueError(f"{name} must be >= 0 and finite, got {getattr(self, name)!r}")
 
     def bind(self, mesh, degree: int) -> None:
-        """Create the state (zero) at the quadrature points of `degree` on `mesh`."""
+        """Create the state (zero) at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
         self.state.bind(mesh, degree)
 
     def modified_newton_tangent(self, u, model: str, dx):
@@ -161,6 +194,14 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
 
         Not K(0) of this energy: that form reads the committed state, and at u = 0 after
         plastic steps the trial stress −C:ε_p is beyond yield (a plastic tangent).
+
+        Args:
+            u: the displacement (the unknown Function).
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+            dx: the measure of the residual.
+
+        Returns:
+            Hooke's tangent, a bilinear form (UFL) in `u`.
         """
         v = ufl.TestFunction(u.function_space)
         work = LinearElastic(self.E, self.nu).internal_work(u, v, model)
@@ -192,6 +233,13 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
 
         What a sensitivity differentiates: the new state as a function of the strain, the
         committed state and the parameters.
+
+        Args:
+            strain: the small strain ε (UFL, 3x3).
+
+        Returns:
+            A dict of UFL expressions, the new ε_p ("plastic_strain") and p
+            ("cumulated_plastic_strain").
         """
         eps_p, p, _ = self.return_map(strain)
         return {"plastic_strain": eps_p, "cumulated_plastic_strain": p}
@@ -199,7 +247,13 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
     def plastic_zone(self, dx) -> dict:
         """The largest cumulated plastic strain, and the plastic fraction of the volume.
 
-        `dx`: the measure of the residual (the state's quadrature rule). Collective.
+        Args:
+            dx: the measure of the residual (the state's quadrature rule).
+
+        Returns:
+            A dict of floats, the same on every rank (collective), the largest p
+            ("max_cumulated_plastic_strain") and the share of ∫ dx where p > 0
+            ("plastic_volume_fraction").
         """
         from dolfinx import fem
         from mpi4py import MPI
@@ -236,7 +290,14 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         return self.state
 
     def return_map(self, eps):
-        """(ε_p, p, Δp) at the strain ε from the committed state (UFL, radial return)."""
+        """(ε_p, p, Δp) at the strain ε from the committed state (UFL, radial return).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (plastic strain ε_p, cumulated plastic strain p, its increment Δp), UFL.
+        """
         self.require_3x3(eps)
         st = self._bound()
         eps_p_n, p_n = st.eps_p, st.p
@@ -262,14 +323,28 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         drops out of dψ/dε (the envelope theorem): σ is ∂ψ_e/∂ε_e at ε_e = ε − ε_p(ε), the
         same stress without the terms that cancel, and its derivative through the return map
         is the consistent tangent. Against differentiating `energy` itself, the kernels
-        assemble the tangent 25 % and the residual 20 % faster (measured on
-        benchmarks/plasticity_peer.py's cylinder); the answers agree to round-off.
+        assemble the tangent and the residual faster (compared once, on
+        benchmarks/plasticity_peer.py's cylinder: no benchmark keeps that comparison); the
+        answers agree to round-off.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            σ (UFL, 3x3).
         """
         eps_p, _, _ = self.return_map(eps)
         return LinearElastic(self.E, self.nu).stress(eps - eps_p)
 
     def energy(self, eps):
-        """ψ(ε): the step's condensed energy at the return-mapped state."""
+        """ψ(ε): the step's condensed energy at the return-mapped state.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            ψ (UFL scalar).
+        """
         eps_p, p, dp = self.return_map(eps)
         return (LinearElastic(self.E, self.nu).energy(eps - eps_p)
                 + 0.5 * self.H * p**2 + self.C / 3.0 * ufl.inner(eps_p, eps_p)
@@ -279,6 +354,12 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         """ψ = [μ |dev ε_e|² + hardening + σ0 Δp] + κ/2 (tr ε)².
 
         The plastic flow is isochoric (tr ε_p = 0), so the bulk term holds the total strain.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (μ |dev ε_e|² + hardening + σ0 Δp, tr ε, κ).
         """
         eps_p, p, dp = self.return_map(eps)
         d = ufl.dev(eps - eps_p)
@@ -290,11 +371,19 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         """Store the return-mapped state of the displacement `u` (a converged step).
 
         The update is compiled for the first `u` given: one displacement per bound material.
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
         """
         self.commit_strain(kinematics.small_strain(u, model))
 
     def commit_strain(self, strain) -> None:
-        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`)."""
+        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
+
+        Args:
+            strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
+        """
         from dolfinx import fem
 
         st = self._bound()
@@ -312,7 +401,15 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
 
 
 def cell_max(at_points, name: str):
-    """The largest value of each cell's quadrature points of `at_points` (DG0, `name`)."""
+    """The largest value of each cell's quadrature points of `at_points` (DG0, `name`).
+
+    Args:
+        at_points: a scalar quadrature Function (p, α).
+        name: the name of the returned Function.
+
+    Returns:
+        The maxima, a DG0 Function.
+    """
     from dolfinx import fem
 
     cells = fem.Function(fem.functionspace(at_points.function_space.mesh, ("DG", 0)),
@@ -325,6 +422,11 @@ def per_cell(at_points, cells, reduce) -> None:
     """DG0 `cells` = `reduce` of each owned cell's quadrature values of `at_points`.
 
     Read and written through both dofmaps (no assumption on dof numbering); ghosts updated.
+
+    Args:
+        at_points: a scalar quadrature Function.
+        cells: the DG0 Function on the same mesh, written.
+        reduce: a numpy reduction called as `reduce(values, axis=1)` (np.max, np.mean).
     """
     msh = cells.function_space.mesh
     n = msh.topology.index_map(msh.topology.dim).size_local
