@@ -169,7 +169,7 @@ class Bracket:
         method = newton
         opts = {"method": method, "rtol": 1e-10, "atol": tolerance, "force_scale": force_scale,
                 "max_it": MAX_IT.get(method, 50),
-                "linear_solver": linear_solver, "period": period, "saddle_point": part.mixed}
+                "linear_solver": linear_solver, "period": period}
         if linear_solver == "gamg" and part.mixed:  # MINRES, block preconditioner
             opts["preconditioner"] = mixed_form.preconditioner(material, part.mixed.W, "3d",
                                                                part.dx)

@@ -20,12 +20,12 @@ from petsc4py import PETSc
 
 from fenics_nl.contact.surface import nodal_quadrature
 from fenics_nl.parallel import global_max
+from fenics_nl.solvers.convergence import ConvergenceTest
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import (
     EventCounter,
     all_event_names,
     petsc_work,
-    scale_absolute_tolerance,
     solver_options,
 )
 
@@ -58,7 +58,7 @@ def solve_snes_vi(punch, delta: float, prefix: str = "vi_") -> dict:
     with upper.localForm() as up:  # u_axis ≤ sign·γ, i.e. u_n ≤ γ (sign = +1 here)
         up.array[c.surface.dofs_V] = c.surface.sign * c.surface.gamma
     problem.solver.setVariableBounds(lower, upper)
-    scale_absolute_tolerance(problem.solver, 1e-12)
+    ConvergenceTest(1e-10, 1e-12, 100).attach(problem.solver)
     counter = EventCounter(all_event_names())
     t0 = time.perf_counter()
     problem.solve()

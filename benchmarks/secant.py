@@ -60,8 +60,9 @@ def anderson(size: float, depth: int) -> dict:
     acc = Anderson(u.function_space.mesh.comm, u.x.index_map.size_local * bs, depth=depth)
     norms = [s.residual(work)]
     # the solver's own test: ‖R‖ ≤ max(rtol ‖R₀‖, atol F)
-    threshold = max(s.rtol * norms[0], s.atol * FORCE)
-    while norms[-1] > threshold and len(norms) <= s.max_it:
+    test = s.convergence
+    threshold = test.threshold(norms[0], FORCE)
+    while norms[-1] > threshold and len(norms) <= test.max_it:
         s.update_tangent(len(norms) - 1, work)
         s.solve_linear(s.b, s.du, work)
         s.du.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
@@ -70,7 +71,7 @@ def anderson(size: float, depth: int) -> dict:
             u.x.array[:] = acc(x, x - du.array_r)
         norms.append(s.residual(work))
     if norms[-1] > threshold:
-        raise SystemExit(f"anderson, depth {depth}: no convergence in {s.max_it} iterations")
+        raise SystemExit(f"anderson, depth {depth}: no convergence in {test.max_it} iterations")
     return record(f"anderson, depth {depth}", time.perf_counter() - t0, norms, b)
 
 

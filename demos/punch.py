@@ -217,7 +217,7 @@ P_scale = (np.pi / 4 * E_star * a * a / R if model == "plane_strain"
 newton = {"rtol": 1e-10, "max_it": 50, "line_search": not material.is_linear,
           "force_scale": P_scale / symmetry}
 if args.mixed and args.formulation == "elimination":  # a symmetric saddle point: LDLᵀ
-    newton.update(linear_solver="cholesky", saddle_point=True)
+    newton.update(linear_solver="cholesky")
 System = EliminationSystem if args.formulation == "elimination" else MultiplierSystem
 system = System(residual, w, bcs, surface, prefix=f"punch_{model}_{args.formulation[:4]}_",
                 **newton)

@@ -151,7 +151,7 @@ def test_the_beam_path_on_two_ranks_is_the_serial_one():
 
 
 def test_a_residual_that_falls_onto_its_round_off_is_accepted_one_iteration_later():
-    from fenics_nl.solvers.arclength import _at_round_off
+    from fenics_nl.solvers.convergence import at_round_off as _at_round_off
 
     # the arch with 8 elements through its thickness (demos/snap_through.py --elements 8),
     # one step's |R|: full Newton reaches the internal forces' round-off (2e-13) in two

@@ -371,7 +371,7 @@ class CaseProblem:
             contact = ActiveSetContact(
                 self.residual, self.unknown, self.bcs, facets, self.gap(0.0), normal_axis=axis,
                 normal_sign=sign, initial="penetrating", prefix=PREFIX,
-                newton_options={"method": method, "saddle_point": bool(self.mixed), **opts},
+                newton_options={"method": method, **opts},
                 displacement_space=self.V if self.mixed or self.plane_stress else None)
             return ContactSteps(contact, self)
         if case.newton == "snes":

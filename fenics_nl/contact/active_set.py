@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import dataclasses
 import logging
 import time
 from collections.abc import Callable, Sequence
@@ -82,7 +83,8 @@ class EliminationSystem:
         # a saddle point's (u, p) GMRES needs about as many iterations per changed node as
         # a factorization costs back-solves (3D Taylor–Hood, measured): only new springs
         # on the same rows, which move the matrix a little, keep its factorization
-        self.small_change = 0 if opts.get("saddle_point") else self.SMALL_CHANGE
+        mixed = u.function_space.ufl_element().is_mixed  # a (u, p) saddle point
+        self.small_change = 0 if mixed else self.SMALL_CHANGE
 
     def set_active(self, active: np.ndarray, changes: int | None,
                    extra_bcs: Sequence[fem.DirichletBC] = ()) -> None:
@@ -154,12 +156,13 @@ class _Loosened:
     def __init__(self, newton, tolerance: float | None):
         self.newton, self.on = newton, newton is not None and tolerance is not None
         if self.on:
-            self.saved = newton.rtol, newton.atol
-            newton.rtol, newton.atol = (max(t, tolerance) for t in self.saved)
+            self.saved = test = newton.convergence
+            newton.convergence = dataclasses.replace(
+                test, rtol=max(test.rtol, tolerance), atol=max(test.atol, tolerance))
 
     def off(self) -> None:
         if self.on:
-            self.newton.rtol, self.newton.atol = self.saved
+            self.newton.convergence = self.saved
             self.on = False
 
 

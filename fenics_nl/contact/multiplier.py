@@ -30,13 +30,13 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.contact.surface import nodal_quadrature
+from fenics_nl.solvers.convergence import ConvergenceTest
 from fenics_nl.solvers.newton import ConvergenceError
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import (
     EventCounter,
     all_event_names,
     petsc_work,
-    scale_absolute_tolerance,
     solver_options,
 )
 
@@ -89,7 +89,7 @@ class MultiplierSystem:
                 [F_u, F_l], [u, self.lam], bcs=list(bcs), kind="mpi", entity_maps=[emap],
                 petsc_options_prefix=prefix, petsc_options=passed)
         self.problem.solver.setConvergenceHistory(reset=True)
-        scale_absolute_tolerance(self.problem.solver, atol, force_scale)
+        ConvergenceTest(rtol, atol, max_it).attach(self.problem.solver, force_scale)
         self.counter = EventCounter(all_event_names())
         self.update_gap()
 

@@ -244,7 +244,6 @@ class Punch:
                 "force_scale": force / self.block.symmetry_factor}
         if block.mixed and formulation == "elimination":  # a symmetric saddle point: MUMPS
             opts["linear_solver"] = "cholesky"  # LDLᵀ (benchmarks/mixed.py)
-            opts["saddle_point"] = True
         opts.update(newton_options or {})
         contact = dict(normal_axis=self.block.vertical, normal_sign=1, formulation=formulation,
                        initial="penetrating", newton_options=opts,

@@ -47,6 +47,7 @@ from petsc4py import PETSc
 
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.buckling import mode_nearest_zero, unstable_directions
+from fenics_nl.solvers.convergence import at_round_off
 from fenics_nl.solvers.newton import LinearSolveError, NewtonSolver
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
@@ -83,27 +84,6 @@ class _StepFailed(Exception):
 
 class _TurnedBack(_StepFailed):
     """The step went back along the path it came by."""
-
-
-def _at_round_off(norms: list[float], largest: float, threshold: float) -> bool:
-    """‖R‖ has stopped falling, 1e6 below the run's largest and within 1e4 of the tolerance.
-
-    A slender body's internal forces are far larger than its load (membrane forces), and
-    near a critical point K is nearly singular and amplifies the round-off of each
-    correction: the residual then stops falling just above a tolerance on the load; the
-    finer the mesh, the higher that floor. "Stopped": either a fall of 100x or more onto a
-    residual that the next iteration does not halve (Newton in its quadratic phase meets the
-    floor: one iteration confirms it), or the last 5 within a factor 3 and the last not below
-    half the one 4 iterations earlier (a steady linear rate, even 0.85, halves it in 4
-    iterations: the modified and quasi-Newton variants).
-    """
-    low = min(1e-6 * largest, 1e4 * threshold)
-    if (len(norms) >= 3 and norms[-2] <= 1e-2 * norms[-3] and norms[-1] > 0.5 * norms[-2]
-            and max(norms[-2:]) < low):
-        return True
-    last = norms[-5:]
-    return (len(last) == 5 and max(last) < low
-            and max(last) < 3 * min(last) and last[-1] > 0.5 * last[0])
 
 
 @dataclass
@@ -463,7 +443,8 @@ class ArcLength:
         b_old, ddu, ddlam = None, None, 0.0  # the last correction, for a BFGS pair
         on_arc = True  # the predictor is on the arc
         try:
-            for k in range(s.max_it + 1):
+            test = s.convergence
+            while True:
                 rnorm = s.residual(work)
                 b = s.residual_vector
                 norms.append(rnorm)
@@ -474,17 +455,17 @@ class ArcLength:
                     s.add_secant_pair(ddu, y)
                     b_old.destroy()
                     b_old = None
-                if not math.isfinite(rnorm) or rnorm > s.divergence_tol * max(norms[0], 1e-300):
+                k = len(norms) - 1
+                self._largest = max(self._largest, norms[0])
+                reason = test.reason(norms, c.q_norm)  # F: the reference load's ‖q‖
+                if reason in ("nan", "diverged"):
                     raise _StepFailed(f"the corrector diverged: |R| = {rnorm:.3e} at "
                                       f"iteration {k}")
-                self._largest = max(self._largest, norms[0])
-                threshold = max(s.rtol * norms[0], s.atol * c.q_norm)
-                if on_arc and (rnorm <= threshold
-                               or _at_round_off(norms, self._largest, threshold)):
+                if on_arc and (reason == "converged" or at_round_off(
+                        norms, self._largest, test.threshold(norms[0], c.q_norm))):
                     return _Increment(du, dlam, k, c.ds)
-                if k == s.max_it:
-                    raise _StepFailed(f"no convergence in {s.max_it} iterations "
-                                      f"(|R| = {rnorm:.3e})")
+                if reason == "max_it":
+                    raise _StepFailed(f"no convergence in {k} iterations (|R| = {rnorm:.3e})")
                 s.set_forcing(rnorm, norms[0])  # an iterative solver's tolerance
                 if s.update_tangent(k, work):
                     if c.ds is not None:

@@ -49,6 +49,7 @@ from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.errors import SolveError
+from fenics_nl.solvers.convergence import ConvergenceTest, at_round_off
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
     LinearSolver,
@@ -68,7 +69,6 @@ __all__ = [
     "NewtonSolver",
     "TangentPolicy",
     "forcing_term",
-    "stalled_at_round_off",
 ]
 
 log = logging.getLogger(__name__)
@@ -92,18 +92,16 @@ def forcing_term(relative_residual: float) -> float:
     return 1e-3 * min(1.0, max(relative_residual, 1e-11))
 
 
-def stalled_at_round_off(norms: list[float]) -> bool:
-    """‖R‖ flat over the last 5 iterates, far below its start: round-off, not a bad method."""
-    last = norms[-5:]
-    return len(last) == 5 and max(last) < 1e-8 * max(norms) and max(last) < 10 * min(last)
-
-
-def _round_off_hint(norms: list[float]) -> str:
-    """The error's hint when the residual stalled at round-off."""
-    if stalled_at_round_off(norms):
-        return (f"; |R| stalls at {min(norms[-5:]):.1e}, the round-off of the internal "
-                "forces: raise atol (relative to the force scale) above it")
-    return ""
+def _adaptive_lag(prefix: str) -> bool:
+    """GAMG's set-up lagged adaptively, unless ``-{prefix}snes_lag_preconditioner 1``."""
+    name = f"{prefix}snes_lag_preconditioner"
+    if not PETSc.Options().hasName(name):
+        return True
+    lag = PETSc.Options().getInt(name)
+    if lag != 1:
+        raise ValueError(f"-{name} {lag}: only 1 (an AMG set-up for every tangent) is read; "
+                         "without it the set-up is lagged adaptively")
+    return False
 
 
 class _Timer:
@@ -363,7 +361,12 @@ class NewtonSolver:
 
     The options, keyword-only, come in three groups, in this order below: the variant (which
     tangent, when it is rebuilt: `method` to `line_search`), convergence (`rtol` to
-    `divergence_tol`) and the linear solver (`linear_solver` to `prefix`).
+    `max_it`, held in `convergence`, the `ConvergenceTest` arc-length and SNES use too) and
+    the linear solver (`linear_solver` to `prefix`). The rest is tuned through PETSc's
+    options under `prefix`, with PETSc's names: ``-{prefix}ksp_*``, ``-{prefix}pc_*``,
+    ``-{prefix}snes_qn_m`` (the pairs BFGS keeps, 30), ``-{prefix}snes_divergence_tolerance``
+    (1e8), ``-{prefix}snes_lag_preconditioner 1`` (with ``gamg``, an AMG set-up for every
+    tangent instead of the adaptive lag below).
 
     Args:
         residual: the residual form R(u; v), linear in the test function v.
@@ -376,30 +379,23 @@ class NewtonSolver:
             or a bilinear form, assembled and factorized once for the solver's life (a
             material with internal variables gives its elastic tangent this way: K(0) would
             read its current state).
-        period: iterations between tangent rebuilds of ``periodic``.
-        bfgs_memory: pairs kept by ``bfgs``.
+        period: iterations between tangent rebuilds of ``periodic`` (PETSc's lag).
         line_search: True (or ``residual``): backtracking (halving, at most 10 times) until
             ‖R‖ falls; ``slope``: the full step if ‖R‖ fell, else secant steps to the
             energy's minimum along the step (for a minimised smooth energy, a hyperelastic
             law: see `_step`).
+        force_scale: F, a force of the problem (the load); default the largest ‖R₀‖ seen.
         rtol: convergence when ‖R‖ ≤ rtol ‖R₀‖ ...
-        atol: ... or ‖R‖ ≤ atol F, F = `force_scale` (relative too).
-        force_scale: a force of the problem (the load); default the largest ‖R₀‖ seen.
+        atol: ... or ‖R‖ ≤ atol F (relative too).
         max_it: iterations before ConvergenceError.
-        divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ stops with ConvergenceError.
-        linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton).
+        linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton;
+            within a solve, the AMG hierarchy of its first tangent serves the later ones
+            while CG needs at most twice the iterations per digit it took on it: an adaptive
+            lag, measured in benchmarks/bracket.py).
         reuse_factorization: keep the last factorization as a CG preconditioner (see above).
-        lag_preconditioner: with ``gamg``, keep the AMG hierarchy of a solve's first tangent
-            for its later ones while CG needs at most twice the iterations it took on it
-            per digit (PETSc's -snes_lag_preconditioner, adaptive). Measured on the bracket:
-            1 set-up for 7 iterations, 8.2 s against 8.7 s with 7: GAMG reuses its
-            interpolation, so a set-up is cheap (benchmarks/bracket.py).
-            ``-{prefix}lag_preconditioner false`` on the command line: one per tangent.
-        saddle_point: the tangent is indefinite (a displacement–pressure unknown): a reused
-            factorization preconditions GMRES, not CG.
-        indefinite: the tangent may be indefinite (a path past a limit point, in
-            arc-length): with ``gamg`` too, GMRES (right-preconditioned) instead of CG, which
-            diverges there.
+        indefinite: the tangent may be indefinite (a path past a limit point; a mixed
+            displacement–pressure unknown always is): a reused factorization, or GAMG,
+            preconditions GMRES, not CG, which may diverge there.
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
         prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
@@ -427,19 +423,15 @@ class NewtonSolver:
         tangent: ufl.Form | None = None,
         constant_tangent: str | ufl.Form = "initial",
         period: int = 3,
-        bfgs_memory: int = 30,
         line_search: bool | str = False,
         # convergence
+        force_scale: float | None = None,
         rtol: float = 1e-10,
         atol: float = 1e-10,
-        force_scale: float | None = None,
         max_it: int = 50,
-        divergence_tol: float = 1e8,
         # the linear solver
         linear_solver: LinearSolver = "lu",
         reuse_factorization: bool = False,
-        lag_preconditioner: bool = True,
-        saddle_point: bool = False,
         indefinite: bool = False,
         preconditioner: ufl.Form | None = None,
         prefix: str = "newton_",
@@ -455,14 +447,15 @@ class NewtonSolver:
         if force_scale is not None and not (force_scale > 0 and math.isfinite(force_scale)):
             raise ValueError(f"force_scale must be a finite force > 0, got {force_scale!r}")
         self.u, self.bcs, self.method = u, list(bcs), method
-        self.force_scale = force_scale
+        self._force_scale = force_scale
         self._largest_r0 = 0.0  # the default force scale
-        self.rtol, self.atol, self.max_it = rtol, atol, max_it
+        opts = PETSc.Options()
+        self.convergence = ConvergenceTest(
+            rtol, atol, max_it, opts.getReal(f"{prefix}snes_divergence_tolerance", 1e8))
         if line_search not in (False, True, "residual", "slope"):
             raise ValueError("line_search must be False, True, 'residual' or 'slope', got "
                              f"{line_search!r}")
-        self.divergence_tol, self.line_search = divergence_tol, line_search
-        self.period, self.bfgs_memory = period, bfgs_memory
+        self._line_search = line_search
         V = u.function_space
         J = ufl.derivative(residual, u) if tangent is None else tangent
         self.tangent_form = J  # UFL, for a stability analysis of the current state
@@ -491,7 +484,7 @@ class NewtonSolver:
         self.A = self._matrix.mat
         # reuse: the factorized matrix P lags behind A and preconditions CG on A
         reuse = reuse_factorization and linear_solver in ("lu", "cholesky")
-        self.P = None  # with reuse: a copy of the last factorized tangent, made on first use
+        self._P = None  # with reuse: a copy of the last factorized tangent, made on first use
         # with reuse and a linear material: new Dirichlet rows solved on the last
         # factorization, by a bordered solve on the rows that changed (made with K)
         self._rows: RowUpdate | None = None
@@ -515,36 +508,34 @@ class NewtonSolver:
                                  "preconditioner)")
             self._M_form = fem.form(preconditioner)
             self._M = petsc.create_matrix(self._M_form)
-            self.ksp = block_preconditioned_ksp(self.A, self._M, V, prefix, rtol=1e-12)
+            self._ksp = block_preconditioned_ksp(self.A, self._M, V, prefix, rtol=1e-12)
         else:
             nullspace = rigid_body_modes(V) if linear_solver == "gamg" else None
-            self.ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
+            self._ksp = create_ksp(self.A, linear_solver, prefix, nullspace,
                                   P=self.A if reuse else None, rtol=1e-12,
-                                  indefinite=saddle_point or indefinite)
+                                  indefinite=indefinite or V.ufl_element().is_mixed)
         # the block preconditioner is built from its own matrix: always set up again
         self._factorizations = None if self._M is not None or reuse else Factorizations(
-            self.A, self.ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
+            self.A, self._ksp, lambda A, kind: create_ksp(A, kind, prefix, rtol=1e-12))
         # inexact Newton with CG + GAMG: solve each correction only as well as the current
         # residual deserves, unless the command line fixed -{prefix}ksp_rtol; a linear
         # problem (fixed tangent) is solved once, to the Newton tolerance
         own_rtol = linear_solver == "gamg" and not PETSc.Options().hasName(f"{prefix}ksp_rtol")
-        self.forcing = own_rtol and not fixed
+        self._forcing = own_rtol and not fixed
         if own_rtol and fixed:
-            self.ksp.setTolerances(rtol=1e-11)
-        if reuse and self.ksp.getType() == "preonly":
+            self._ksp.setTolerances(rtol=1e-11)
+        if reuse and self._ksp.getType() == "preonly":
             # options turned CG off: a lagging factorization would then give wrong solves
             log.warning("%sksp_type preonly: factorization reuse disabled", prefix)
             reuse = False
         # the block preconditioner's matrix is assembled with the tangent: not lagged
-        opts = PETSc.Options()
-        if opts.hasName(f"{prefix}lag_preconditioner"):  # the command line's choice
-            lag_preconditioner = opts.getBool(f"{prefix}lag_preconditioner")
-        lag = lag_preconditioner and linear_solver == "gamg" and self._M is None
-        self.policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse,
+        lag = linear_solver == "gamg" and self._M is None and _adaptive_lag(prefix)
+        self._policy = TangentPolicy(method, period, fixed=fixed, for_life=for_life, reuse=reuse,
                                     lag=lag)
-        self.bfgs = InverseBFGS(bfgs_memory) if method == "bfgs" else None
+        memory = opts.getInt(f"{prefix}snes_qn_m", 30)
+        self.bfgs = InverseBFGS(memory) if method == "bfgs" else None
         self.total = WorkCounts()
-        self.motions = RigidMotions.of(V)  # None: not a displacement (sub-)space
+        self._motions = RigidMotions.of(V)  # None: not a displacement (sub-)space
         self._supports_checked = False  # for the current Dirichlet rows (and springs)
 
     @property
@@ -584,7 +575,7 @@ class NewtonSolver:
         self.bcs = list(bcs)
         if same:
             return
-        self.policy.bcs_changed(small_change)
+        self._policy.bcs_changed(small_change)
         self._supports_checked = False
 
     # -- the loop --------------------------------------------------------------------
@@ -604,30 +595,24 @@ class NewtonSolver:
             return SolveResult(converged, reason, k, norms, work, time.perf_counter() - t_start,
                                 elapsed)
 
-        while True:
+        while True:  # (i) the residual R(U_k) is in `b`, its norm in `norms`
             rnorm = norms[-1]
             log.info("  Newton %s it %d |R| = %.3e", self.method, k, rnorm)
-            if not math.isfinite(rnorm):
-                raise ConvergenceError(f"residual is not finite at iteration {k}",
-                                       result(False, "nan"))
-            if rnorm <= self._threshold(norms[0]) and not lift:
-                return result(True, "converged")
-            if k >= self.max_it:
-                raise ConvergenceError(f"no convergence in {self.max_it} iterations "
-                                       f"(|R| = {rnorm:.3e}, |R0| = {norms[0]:.3e})"
-                                       + _round_off_hint(norms), result(False, "max_it"))
-            if rnorm > self.divergence_tol * norms[0]:
-                raise ConvergenceError(f"Newton diverged: |R| grew from {norms[0]:.3e} to "
-                                       f"{rnorm:.3e} at iteration {k}",
-                                       result(False, "diverged"))
-            try:
+            reason = self.convergence.reason(norms, self._force(norms[0]))
+            if reason == "converged" and not lift:  # (ii) small enough: U_k is the answer
+                return result(True, reason)
+            if reason not in (None, "converged"):
+                if reason == "max_it" and self._at_round_off(norms):
+                    reason = "round_off"  # not a bad method: a tolerance below round-off
+                raise ConvergenceError(self._failure(reason, norms), result(False, reason))
+            try:  # (iii) the tangent, as the variant's policy says, and δU = −K⁻¹R
                 self.update_tangent(k, work)
                 self.set_forcing(rnorm, norms[0])
                 b_old = self.b.copy() if self.bfgs else None
                 self.solve_linear(self.b, self.du, work)
             except LinearSolveError as err:
                 raise ConvergenceError(f"{err} at iteration {k}", result(False, "ksp")) from None
-            alpha, rnorm_new = self._step(rnorm, work, full_step=lift)
+            alpha, rnorm_new = self._step(rnorm, work, full_step=lift)  # (iv) U += α δU
             norms.append(rnorm_new)
             elapsed.append(time.perf_counter() - t_start)
             if self.bfgs:
@@ -641,7 +626,7 @@ class NewtonSolver:
 
     def start_solve(self) -> None:
         """A new solve begins: the variant's tangent policy restarts, BFGS forgets its pairs."""
-        self.policy.start_solve()
+        self._policy.start_solve()
         if self.bfgs:
             self.bfgs.clear()
 
@@ -734,9 +719,9 @@ class NewtonSolver:
             # but near the last one (friction's springs follow the slip directions as they
             # converge): with reuse, the last factorization preconditions CG first
             self._nodal_version = self.nodal.version
-            self.policy.bcs_changed(small=True)
+            self._policy.bcs_changed(small=True)
             self._supports_checked = False
-        if not self.policy.needs_tangent(k):
+        if not self._policy.needs_tangent(k):
             return False
         self._assemble_tangent(work)
         return True
@@ -747,9 +732,9 @@ class NewtonSolver:
         From ‖R_k‖/‖R_0‖ = rnorm/first (`forcing_term`); a frozen operator's (modified,
         BFGS) from 1: its own error is about its contraction, a tighter solve buys nothing.
         """
-        if self.forcing:
+        if self._forcing:
             frozen = self.method in ("modified", "bfgs") or not first
-            self.ksp.setTolerances(rtol=forcing_term(1.0 if frozen else rnorm / first))
+            self._ksp.setTolerances(rtol=forcing_term(1.0 if frozen else rnorm / first))
 
     def solve_linear(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
         """out = K⁻¹ rhs with the current operator (BFGS: its corrected inverse H rhs).
@@ -772,7 +757,7 @@ class NewtonSolver:
         `reuse_factorization` the factorization already made preconditions CG on it:
         back-solves only. ValueError for a tangent kept for the solver's life (not K(u)).
         """
-        if self.policy.for_life:
+        if self._policy.for_life:
             raise ValueError("a constant tangent for the solver's life is not K(u): "
                              "tangent solves need method full, periodic, or initial tangents")
         self._assemble_tangent(work)
@@ -799,10 +784,28 @@ class NewtonSolver:
 
     # -- pieces ----------------------------------------------------------------------
 
-    def _threshold(self, r0: float) -> float:
-        """max(rtol ‖R₀‖, atol F): both relative to forces of the problem itself."""
+    def _force(self, r0: float) -> float:
+        """F: `force_scale`, or the largest first residual seen (this one included)."""
         self._largest_r0 = max(self._largest_r0, r0)
-        return max(self.rtol * r0, self.atol * (self.force_scale or self._largest_r0))
+        return self._force_scale or self._largest_r0
+
+    def _failure(self, reason: str, norms: list[float]) -> str:
+        """The one line that says why the solve failed at its last iteration."""
+        k, r0, r = len(norms) - 1, norms[0], norms[-1]
+        if reason == "nan":
+            return f"residual is not finite at iteration {k}"
+        if reason == "diverged":
+            return f"Newton diverged: |R| grew from {r0:.3e} to {r:.3e} at iteration {k}"
+        hint = ""
+        if reason == "round_off":
+            hint = (f"; |R| stalls at {min(norms[-5:]):.1e}, the round-off of the internal "
+                    "forces: raise atol (relative to the force scale) above it")
+        return f"no convergence in {k} iterations (|R| = {r:.3e}, |R0| = {r0:.3e}){hint}"
+
+    def _at_round_off(self, norms: list[float]) -> bool:
+        """Whether ‖R‖ stalls at the round-off of the internal forces (`at_round_off`)."""
+        threshold = self.convergence.threshold(norms[0], self._force(norms[0]))
+        return at_round_off(norms, self._largest_r0, threshold)
 
     def _boundary_moved(self) -> bool:
         """Whether U differs from g on a Dirichlet dof (on any rank).
@@ -839,7 +842,7 @@ class NewtonSolver:
 
     def _assemble_tangent(self, work: WorkCounts) -> None:
         with _Timer(work, "tangent"):
-            if self.policy.fixed and not self._constant:
+            if self._policy.fixed and not self._constant:
                 self._fixed_tangent(work)
             else:
                 self._matrix.assemble(self._K_used, self.bcs)
@@ -849,10 +852,10 @@ class NewtonSolver:
                 self._M.zeroEntries()
                 petsc.assemble_matrix(self._M, self._M_form, bcs=self.bcs, diag=1.0)
                 self._M.assemble()
-        if not self._supports_checked and self.motions is not None:
+        if not self._supports_checked and self._motions is not None:
             # a free rigid motion makes K singular: refused before any factorization
             # (K's own rows resist what A's do: `free_motions` reads neither's Dirichlet rows)
-            check_supports(self._K_fixed if self._A_stale else self.A, self.motions, self.bcs)
+            check_supports(self._K_fixed if self._A_stale else self.A, self._motions, self.bcs)
             self._supports_checked = True
         if self._rows is not None:
             self._rows.serving = False
@@ -863,13 +866,13 @@ class NewtonSolver:
             if not serves:  # a factorization reads A
                 self._apply_rows_to_fixed_tangent()
                 self._factorize(work)
-        elif self.policy.needs_factorization():
+        elif self._policy.needs_factorization():
             self._factorize(work)
         else:  # an older tangent's factorization (reuse) or AMG hierarchy (lag) serves
-            if self.policy.lag:
-                self.ksp.getPC().setReusePreconditioner(True)
-            self.policy.stale = True
-        self.policy.assembled()
+            if self._policy.lag:
+                self._ksp.getPC().setReusePreconditioner(True)
+            self._policy.stale = True
+        self._policy.assembled()
 
     def _fixed_tangent(self, work: WorkCounts) -> None:
         """K assembled once; A = K with the current Dirichlet rows, now or when it is read.
@@ -884,7 +887,7 @@ class NewtonSolver:
             self._matrix.assemble(self._K)
             work.tangent_assemblies += 1
             self._K_fixed = self.A.copy()
-            if self.policy.reuse:
+            if self._policy.reuse:
                 self._rows = RowUpdate(self._K_fixed)
         self._A_stale = True
         # deferred only while A is the base's matrix: springs added since (and gone again)
@@ -910,19 +913,19 @@ class NewtonSolver:
         with _Timer(work, "factorization"):
             if self._factorizations is not None:
                 work.factorizations += self._factorizations.factorize(
-                    self.A, self.ksp.getPC().setUp)
+                    self.A, self._ksp.getPC().setUp)
             else:
-                if self.policy.reuse and self.P is None:
-                    self.P = self.A.copy()
-                    self.ksp.setOperators(self.A, self.P)
-                elif self.policy.reuse:
-                    self.A.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-                self.ksp.getPC().setUp()
+                if self._policy.reuse and self._P is None:
+                    self._P = self.A.copy()
+                    self._ksp.setOperators(self.A, self._P)
+                elif self._policy.reuse:
+                    self.A.copy(self._P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+                self._ksp.getPC().setUp()
                 work.factorizations += 1
         self._A_factorized = True
-        self.policy.factorized()
+        self._policy.factorized()
         if self._rows is not None:  # the next rows are solved on this factorization
-            pc = self.ksp.getPC()
+            pc = self._ksp.getPC()
             if pc.getFactorSolverType() != "mumps":  # (the options chose another package)
                 self._rows = None
             elif self.nodal.springs is None:
@@ -939,7 +942,7 @@ class NewtonSolver:
                 self._rows.solve(rhs, self.du)
                 work.linear_solves += 1
             return
-        ksp = self._factorizations.ksp if self._factorizations else self.ksp
+        ksp = self._factorizations.ksp if self._factorizations else self._ksp
         with _Timer(work, "solve"):
             ksp.solve(rhs, self.du)
             work.linear_solves += 1
@@ -947,15 +950,15 @@ class NewtonSolver:
         its = ksp.getIterationNumber()
         if ksp.getType() != "preonly":
             work.krylov_iterations += its
-        lagging = self.policy.reuse or self.policy.lag
-        if lagging and reason < 0 and retry and self.policy.stale:
+        lagging = self._policy.reuse or self._policy.lag
+        if lagging and reason < 0 and retry and self._policy.stale:
             # the old factorization no longer helps: refactorize, solve once more
             self._factorize(work)
             return self._linear_solve(rhs, work, retry=False)
         if reason < 0:
             raise LinearSolveError(reason)
         if lagging:  # many iterations: cheaper to refactorize next time
-            self.policy.krylov_iterations(its, ksp.getTolerances()[0])
+            self._policy.krylov_iterations(its, ksp.getTolerances()[0])
 
     def _step(self, rnorm: float, work: WorkCounts, full_step: bool = False
               ) -> tuple[float, float]:
@@ -973,9 +976,9 @@ class NewtonSolver:
         from cycling. `full_step`: α = 1 whatever (the lifted step must reach the boundary
         values). Returns α and the new ‖R‖.
         """
-        if full_step or not self.line_search:
+        if full_step or not self._line_search:
             return 1.0, self._move(1.0, 0.0, work)
-        if self.line_search == "slope":
+        if self._line_search == "slope":
             return self._critical_point(rnorm, work)
         alpha = 1.0
         norm = self._move(alpha, 0.0, work)

@@ -45,7 +45,7 @@ class SolveResult:
     """
 
     converged: bool
-    reason: str
+    reason: str  # converged, nan, max_it, round_off (max_it at round-off), diverged, ksp...
     iterations: int
     residual_norms: list[float]
     work: WorkCounts

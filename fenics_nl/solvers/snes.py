@@ -17,6 +17,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc
 from petsc4py import PETSc
 
+from fenics_nl.solvers.convergence import ConvergenceTest
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import LinearSolver
 from fenics_nl.solvers.newton import ConvergenceError, Method
@@ -28,7 +29,6 @@ __all__ = [
     "SnesSolver",
     "all_event_names",
     "petsc_work",
-    "scale_absolute_tolerance",
     "unless_set",
 ]
 
@@ -119,26 +119,6 @@ def unless_set(prefix: str, options: dict) -> dict:
     return {k: v for k, v in options.items() if not db.hasName(prefix + k)}
 
 
-def scale_absolute_tolerance(snes: PETSc.SNES, atol: float, force_scale: float | None = None
-                             ) -> None:
-    """SNES's absolute tolerance as NewtonSolver's: atol × a force of the problem.
-
-    The force is `force_scale`, or the largest first residual ‖F₀‖ of this SNES's solves.
-    Set by a monitor at iteration 0, which PETSc calls before the convergence test. The
-    monitor holds no reference to a Python solver object (see SnesSolver).
-    """
-    if PETSc.Options().hasName(f"{snes.getOptionsPrefix() or ''}snes_atol"):
-        return  # the command line's -<prefix>snes_atol stays
-    largest = [0.0]
-
-    def monitor(snes, it, norm):
-        if it == 0:
-            largest[0] = max(largest[0], norm)
-            snes.setTolerances(atol=atol * (force_scale or largest[0]))
-
-    snes.setMonitor(monitor)
-
-
 class SnesSolver:
     """Newton through SNES `newtonls` with a plain full step (no line search by default).
 
@@ -183,7 +163,8 @@ class SnesSolver:
             self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes.setConvergenceHistory(reset=True)
-        scale_absolute_tolerance(self.snes, atol, force_scale)
+        self.convergence = ConvergenceTest(rtol, atol, max_it)  # NewtonSolver's test
+        self.convergence.attach(self.snes, force_scale)
         # time of each residual norm, as SolveResult.elapsed. The monitor holds the list,
         # not self: a cycle self → snes → monitor → self would leave the PETSc objects to the
         # garbage collector, which destroys them in a different order on each rank (hang).
