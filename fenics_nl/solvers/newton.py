@@ -29,12 +29,9 @@ numeric factorization only and reuse the symbolic analysis.
 
 from __future__ import annotations
 
-import collections
 import contextlib
-import hashlib
 import logging
 import math
-import os
 import time
 from collections.abc import Sequence
 from typing import Literal
@@ -50,6 +47,7 @@ from ufl.algorithms.analysis import extract_constants
 
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.convergence import ConvergenceTest, at_round_off
+from fenics_nl.solvers.factorizations import Factorizations
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
     LinearSolver,
@@ -61,13 +59,12 @@ from fenics_nl.solvers.nodal import NodalTerms
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.solvers.row_update import RowUpdate
 from fenics_nl.solvers.supports import RigidMotions, check_supports, constrained_dofs
+from fenics_nl.solvers.tangent_policy import InverseBFGS, TangentPolicy
 
 __all__ = [
     "ConvergenceError",
-    "InverseBFGS",
     "LinearSolveError",
     "NewtonSolver",
-    "TangentPolicy",
     "forcing_term",
 ]
 
@@ -113,223 +110,6 @@ class _Timer:
 
     def __exit__(self, *exc):
         self.work.time[self.phase] += time.perf_counter() - self.t0
-
-
-class TangentPolicy:
-    """When the tangent is rebuilt and refactorized, and when a factorization is reused.
-
-    * ``full``: every iteration; ``periodic``: every `period` iterations; ``modified`` and
-      ``bfgs``: once per solve, or once for the solver's life with the elastic tangent;
-    * a tangent with no coefficient (linear material) once per solve: it is exact;
-    * with `reuse` (a direct solver as CG preconditioner), a new tangent keeps the last
-      factorization while CG on it needs at most REUSE_ITERATIONS iterations, or while the
-      Dirichlet rows changed only a little (`bcs_changed(small=True)`);
-    * with `lag` (CG + AMG), a new tangent within a solve keeps the AMG hierarchy of the
-      solve's first one while CG needs at most twice the iterations per digit of residual
-      reduction it took on it fresh (per digit: the inexact-Newton tolerance tightens).
-
-    "Factorization" stands for the preconditioner's set-up: an AMG hierarchy too.
-    """
-
-    REUSE_ITERATIONS = 10
-
-    def __init__(self, method: str, period: int, *, fixed: bool, for_life: bool, reuse: bool,
-                 lag: bool = False):
-        self.method, self.period = method, period
-        self.fixed, self.for_life, self.reuse, self.lag = fixed, for_life, reuse, lag
-        self.ready = False  # a tangent valid for this solve is assembled and factorized
-        self.factorization_current = False  # the factorization is of the current tangent
-        self._fresh_rate = None  # lag: CG iterations per digit on the hierarchy's tangent
-        self.stale = False  # the last tangent is solved with an older one's factorization
-
-    def start_solve(self) -> None:
-        """A new solve: the state moved, so every tangent is stale but two.
-
-        A life-long one, and a linear material's (it changes with the Dirichlet rows and
-        the springs only, which say so themselves).
-        """
-        if not (self.for_life or self.fixed):
-            self.ready = False
-        if self.lag:  # a new step: the hierarchy is rebuilt on its first tangent
-            self.factorization_current = False
-
-    def bcs_changed(self, small: bool) -> None:
-        """New Dirichlet rows: rebuild the tangent; refactorize unless only a few changed."""
-        self.ready = False
-        if not small:
-            self.factorization_current = False
-
-    def needs_tangent(self, k: int) -> bool:
-        """At iteration k."""
-        if self.fixed and self.ready:
-            return False  # a linear material: the tangent built for this solve is exact
-        if self.method == "full":
-            return True
-        if self.method == "periodic":
-            return k % self.period == 0
-        return not self.ready
-
-    def needs_factorization(self) -> bool:
-        """After a tangent assembly."""
-        return not ((self.reuse or self.lag) and self.factorization_current)
-
-    def factorized(self) -> None:
-        """A factorization of the current tangent was made."""
-        self.factorization_current = True
-        self._fresh_rate = None
-        self.stale = False
-
-    def assembled(self) -> None:
-        """The tangent for this solve is in place."""
-        self.ready = True
-
-    def krylov_iterations(self, its: int, rtol: float) -> None:
-        """CG on a reused factorization took `its` to `rtol`: beyond a few, refactorize.
-
-        Lagged AMG: beyond twice the iterations per digit the hierarchy's own tangent took,
-        set it up again (next time).
-        """
-        if not self.lag:
-            self.factorization_current = its <= self.REUSE_ITERATIONS
-            return
-        rate = its / max(-math.log10(rtol), 1.0)
-        if self._fresh_rate is None:
-            self._fresh_rate = rate
-        else:
-            self.factorization_current = rate <= 2 * self._fresh_rate
-
-
-class Factorizations:
-    """Which factorization solves with the tangent just assembled (none new if it has one).
-
-    A tangent equal, bit for bit and on every rank, to one already factorized is not
-    factorized again. Full Newton on a path-dependent law assembles Hooke's tangent again
-    and again: at every elastic increment, and at the first iteration of every plastic one
-    (the trial state is the committed one, on the yield surface, hence elastic). The
-    factorization last made is reused when the tangent equals it; a tangent that comes back
-    after its factorization was replaced is factorized aside instead, in a copy (once per
-    solver, MUMPS, while both fit in a quarter of the memory), and solves each time it comes
-    back again, while the other tangents are factorized in the solver's own matrix: the
-    copy costs no factorization that would not be made anyway. Tangents are compared through
-    their product with a fixed random vector, so that no copy is kept to compare with: a
-    change it hides (rows whose change sums to zero against it, to the last bit) would
-    leave a factorization off by round-off, which a Newton iteration tolerates (its
-    residual is exact). A restarted run has no factorization in memory: where the
-    uninterrupted one kept one across the restart point, the restart makes one more, on
-    the same path. `ksp` is the solver of the tangent last assembled (the solver's own,
-    or the copy's): solve through it, not through `NewtonSolver.ksp`.
-    """
-
-    def __init__(self, A: PETSc.Mat, ksp: PETSc.KSP, make_ksp):
-        self._probe, self._product = A.createVecs()
-        rng = np.random.default_rng(A.comm.rank)
-        self._probe.array[:] = rng.uniform(0.5, 1.5, self._probe.getLocalSize())
-        self.ksp, self._own, self._make_ksp = ksp, ksp, make_ksp
-        self._digest = None  # of the matrix `ksp`'s factorization is of
-        self._kept = None  # (digest, its matrix, its KSP): a returning tangent's, aside
-        self._replaced = collections.deque(maxlen=8)  # digests of replaced factorizations
-        self._may_keep = ksp.getType() == "preonly"  # a direct solver
-
-    def _same(self, a: bytes | None, b: bytes | None, comm) -> bool:
-        return comm.allreduce(a is not None and a == b, op=MPI.LAND)
-
-    def factorize(self, A: PETSc.Mat, setup) -> bool:
-        """Point `ksp` at a factorization of A; whether one was made (collective).
-
-        `setup()` factorizes the solver's own KSP on A when no factorization is of A.
-        """
-        comm = A.comm.tompi4py()
-        A.mult(self._probe, self._product)
-        digest = hashlib.blake2b(self._product.array_r, digest_size=16).digest()
-        if self._kept and self._same(digest, self._kept[0], comm):
-            self.ksp = self._kept[2]
-            return False
-        self.ksp = self._own
-        pc = self._own.getPC()
-        if self._same(digest, self._digest, comm):
-            pc.setReusePreconditioner(True)  # A was assembled again: PETSc would refactor
-            return False
-        if (self._kept is None and self._may_keep  # the same on every rank
-                and comm.allreduce(digest in self._replaced, op=MPI.LAND)
-                and _room_for_another(pc, comm)):
-            self._keep_aside(A, digest)
-            return True
-        pc.setReusePreconditioner(False)
-        if self._digest is not None:
-            self._replaced.append(self._digest)
-        self._digest = None  # a factorization that fails leaves none behind to reuse
-        setup()
-        self._digest = digest
-        return True
-
-    def _keep_aside(self, A: PETSc.Mat, digest: bytes) -> None:
-        copy = A.copy()
-        ksp = self._make_ksp(copy, self._own.getPC().getType())  # lu or cholesky, as its own
-        ksp.getPC().setUp()
-        self._kept = (digest, copy, ksp)
-        self.ksp = ksp
-
-
-def _room_for_another(pc: PETSc.PC, comm) -> bool:
-    """Whether a second MUMPS factorization as large as `pc`'s fits in a quarter of RAM."""
-    try:
-        megabytes = pc.getFactorMatrix().getMumpsInfog(22)  # summed over the ranks
-    except PETSc.Error:
-        return False
-    ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    return comm.allreduce(2 * megabytes * 2**20 < ram / 4, op=MPI.LAND)
-
-
-class InverseBFGS:
-    """L-BFGS corrections of a constant tangent's inverse (Matthies–Strang), two-loop form.
-
-    du = H R with H built on H0 = K0⁻¹ from the last `memory` pairs s_i = u_{i+1} − u_i,
-    y_i = R_{i+1} − R_i, ρ_i = 1/(y_i·s_i); one solve with K0 per iteration.
-    """
-
-    def __init__(self, memory: int):
-        self.memory = memory
-        self.pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []
-
-    def direction(self, b: PETSc.Vec, du: PETSc.Vec, solve) -> None:
-        """du = H b; `solve(q)` puts K0⁻¹ q into du."""
-        q = b.copy()
-        alphas = []
-        for s, y, rho in reversed(self.pairs):
-            a = rho * s.dot(q)
-            q.axpy(-a, y)
-            alphas.append(a)
-        solve(q)
-        for (s, y, rho), a in zip(self.pairs, reversed(alphas), strict=True):
-            du.axpy(a - rho * y.dot(du), s)
-        q.destroy()
-
-    def store(self, du: PETSc.Vec, alpha: float, b_old: PETSc.Vec, b_new: PETSc.Vec) -> None:
-        """Keep s = −α du and y = b_new − b_old if y·s > 0 (H stays positive definite)."""
-        s = du.copy()
-        s.scale(-alpha)
-        y = b_old.copy()
-        y.aypx(-1.0, b_new)
-        self.store_pair(s, y)
-
-    def store_pair(self, s: PETSc.Vec, y: PETSc.Vec) -> None:
-        """Keep the pair (s, y), which it now owns, if y·s > 0 (else destroy it)."""
-        ys = y.dot(s)
-        if not ys > 1e-12 * y.norm() * s.norm():
-            s.destroy()
-            y.destroy()
-            return  # curvature condition fails: skip the update
-        self.pairs.append((s, y, 1.0 / ys))
-        if len(self.pairs) > self.memory:
-            for v in self.pairs.pop(0)[:2]:
-                v.destroy()
-
-    def clear(self) -> None:
-        """Forget every pair (a new solve), destroying their vectors."""
-        for s, y, _ in self.pairs:
-            s.destroy()
-            y.destroy()
-        self.pairs.clear()
 
 
 class LinearSolveError(Exception):
