@@ -53,6 +53,8 @@ from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers import LoadStepError, NewtonSolver, SnesSolver, solve_incrementally
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 comm = MPI.COMM_WORLD
 VARIANTS = ("full", "modified", "periodic", "bfgs", "snes")
 MM = {"mm": 1.0, "m": 1e-3}  # the length of 1 mm in the chosen unit

@@ -59,6 +59,8 @@ from fenics_nl.scenes import beam_pictures
 from fenics_nl.scenes.beam import MATERIALS, Beam
 from fenics_nl.theory import elastica
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 comm = MPI.COMM_WORLD
 # -
 

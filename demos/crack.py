@@ -57,6 +57,8 @@ from fenics_nl.scenes import crack_pictures
 from fenics_nl.scenes.notched_specimen import NotchedSpecimen
 from fenics_nl.scenes.surfing import Surfing, release_rate
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # -
 
 # ### Parameters

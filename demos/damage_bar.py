@@ -84,6 +84,8 @@ from fenics_nl.materials.gradient_damage import GradientDamage
 from fenics_nl.scenes import damage_bar, damage_bar_pictures, gradient_damage_bar
 from fenics_nl.scenes.gradient_damage_bar import GradientDamageBar
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # -
 
 # ### Parameters

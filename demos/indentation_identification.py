@@ -64,6 +64,8 @@ from fenics_nl.scenes.identification import (
 )
 from fenics_nl.scenes.indentation_test import IndentationTest
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # -
 
 # ### Parameters

@@ -54,6 +54,8 @@ from fenics_nl.io import cli
 from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.solvers import scalar
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # Each function: r(u), a starting point, and what it models.
 
 FUNCTIONS = {

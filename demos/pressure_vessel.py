@@ -52,6 +52,8 @@ from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
 from fenics_nl.theory import vessels
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 comm = MPI.COMM_WORLD
 # -
 

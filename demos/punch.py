@@ -56,6 +56,8 @@ from fenics_nl.scenes import punch_run
 from fenics_nl.solvers.force_control import reach_force
 from fenics_nl.theory import hertz
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # -
 
 # ### Parameters

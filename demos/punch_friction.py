@@ -44,6 +44,8 @@ from fenics_nl.scenes import punch_run
 from fenics_nl.scenes.punch import Punch, PunchLoad, check_contact_resolution
 from fenics_nl.solvers.loading import solve_incrementally
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 # -
 
 # ### Parameters

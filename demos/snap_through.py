@@ -54,6 +54,8 @@ from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as theory
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 comm = MPI.COMM_WORLD
 # -
 

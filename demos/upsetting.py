@@ -50,6 +50,8 @@ from fenics_nl.scenes.upsetting import Billet, Upsetting
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import forming
 
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
 comm = MPI.COMM_WORLD
 # -
 

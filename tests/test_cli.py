@@ -73,6 +73,7 @@ class P(Parameters):
     x: float = number(1.0, "x")
 
 
+cli.run_script(__name__)
 args = cli.arguments(P, prefixes={})
 print("solved", args.x)
 '''
@@ -106,6 +107,7 @@ class P(Parameters):
     """A run whose rank 1 fails alone while rank 0 waits in a collective."""
 
 
+cli.run_script(__name__)
 args = cli.arguments(P, prefixes={})
 if MPI.COMM_WORLD.rank == 1:
     raise ValueError("rank 1 alone")

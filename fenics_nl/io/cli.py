@@ -1,14 +1,15 @@
 """Command-line plumbing shared by the demos: argument types, PETSc options, the run itself.
 
 A demo is a plain script of top-level cells (jupytext's light format), run once, top to
-bottom. Its first cell calls `arguments` (flags from `parser(...)`: every default shown
-once, numeric flags that refuse NaN and infinities by name; PETSc options accepted only
-under the run's own prefixes), its last `results`. Run as a script, `arguments` starts the
-run: the library's errors end it with one line and status 2, `results` writes the JSON first
-and then every other output, each on its own, so that a failing picture never loses the
-numbers, and reports a PETSc option that no solver read. In a notebook the same cells run
-with the defaults (or the flags in the environment variable FENICS_NL_ARGS). `run_file`
-runs a demo's cells in this process under the same contract (the tests do).
+bottom. After its imports it calls ``run_script(__name__)``: run as a script, that executes
+the demo's cells under the scene contract and ends the process with the run's status (the
+library's errors: one line and status 2; the JSON first and then every other output, each
+on its own, so that a failing picture never loses the numbers; a PETSc option that no solver
+read reported). Its first cell then calls `arguments` (flags from `parser(...)`: every
+default shown once, numeric flags that refuse NaN and infinities by name; PETSc options
+accepted only under the run's own prefixes), its last `results`. In a notebook the same
+cells run with the defaults (or the flags in the environment variable FENICS_NL_ARGS).
+`run_file` runs a demo's cells in this process under the same contract (the tests do).
 
 Nothing computed is lost: the output paths are checked before anything is solved, and each
 converged step a scene reports (`converged_step`) is kept, so that a run that fails after
@@ -19,7 +20,6 @@ step and the last converged load factor.
 from __future__ import annotations
 
 import argparse
-import atexit
 import json
 import os
 import re
@@ -70,6 +70,7 @@ __all__ = [
     "results",
     "run_file",
     "run_scene",
+    "run_script",
     "say",
     "spelling",
 ]
@@ -158,7 +159,6 @@ class _Run:
     def __init__(self, argv: Sequence[str]):
         self.argv = list(argv)
         self.t0 = time.perf_counter()
-        self.script = False  # started by `arguments` in a script (not by run_file)
         self.options: PetscOptions | None = None
         self.json_path: str | None = None
         self.out: dict | None = None
@@ -315,24 +315,87 @@ def run_file(path: str | Path, argv: Sequence[str] | None = None) -> int:
     Library errors end the run with one line and status 2; the JSON is written first, then
     every writer on its own (a failing one: status 1); a PETSc option no solver read:
     status 2, as when the demo runs as a script.
+
+    Args:
+        path: the demo file.
+        argv: its flags and PETSc options.
+
+    Returns:
+        The exit status the script would have.
+    """
+    return _run(Path(path), sys.argv[1:] if argv is None else argv, script=False)
+
+
+def run_script(name: str) -> None:
+    """``python demos/x.py ...``: run the demo under the scene contract, then end the process.
+
+    A demo calls ``cli.run_script(__name__)`` after its imports. Run as a script (`name` is
+    ``__main__`` outside IPython), it executes the demo file (``sys.argv[0]``) once more in
+    this process, as `run_file` does, on every rank, and ends the process with the run's
+    status: 0; 1 for a failed output or a bug (its traceback); 2 for a library error (one
+    line, the JSON of the converged steps first) or a PETSc option that no solver read.
+    Anywhere else (a notebook, `run_file`, an import) it does nothing.
+
+    Args:
+        name: the calling module's ``__name__``.
+    """
+    if name != "__main__" or _current is not None or _in_ipython():
+        return
+    status = _run(Path(sys.argv[0]), sys.argv[1:], script=True)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    if status == 2 and MPI.Is_initialized() and not MPI.Is_finalized():
+        # a failed solve's objects are left undestroyed: their collective destruction at
+        # the interpreter's exit could wait for a rank that failed elsewhere
+        MPI.Finalize()
+        os._exit(status)
+    sys.exit(status)
+
+
+def _run(path: Path, argv: Sequence[str], script: bool) -> int:
+    """Execute the demo at `path` with `argv`; the exit status (see `run_file`, `run_script`).
+
+    A script's library error is reported collectively (the JSON of what converged) only if
+    every rank raised it; a rank alone in its error, or a bug under MPI, stops every rank.
+    Elsewhere (`run_file`: the tests) a bug propagates.
     """
     global _current
     from petsc4py import PETSc
 
-    run = _current = _Run(sys.argv[1:] if argv is None else argv)
-    run.path = Path(path)
+    run = _current = _Run(argv)
+    run.path = path
+    if script:
+        run.failure_comm = MPI.COMM_WORLD.Dup()  # every rank starts the script here
     try:
         runpy.run_path(str(path), run_name="__scene__")
     except SystemExit as stop:  # argparse: --help, or a bad flag (already said)
         _forget(run.options)
         return stop.code if isinstance(stop.code, int) else int(stop.code is not None)
     except (*EXPECTED_ERRORS, PETSc.Error) as err:
+        if script and not _every_rank_failed(run):  # the others go on: no collective way out
+            print(f"error: {_one_line(err)} (on rank {MPI.COMM_WORLD.rank} only: the run "
+                  "is stopped)", file=sys.stderr, flush=True)
+            sys.stdout.flush()
+            _abort(2)
         return _failed(run, err)
+    except Exception:
+        if not script:
+            raise
+        traceback.print_exc()  # a bug: its traceback
+        if MPI.COMM_WORLD.size > 1:  # the other ranks may not have failed: end them all
+            sys.stderr.flush()
+            _abort(1)
+        _forget(run.options)
+        return 1
     finally:
         _current = None
         run.close_series()  # the fields of every converged step, also after a failure
     if run.out is None:
-        raise RuntimeError(f"{path} ended without calling cli.results")
+        if not script:
+            raise RuntimeError(f"{path} ended without calling cli.results")
+        error(f"{path.name} ended without reporting its results (cli.results was never "
+              "called): nothing was written")
+        return 1
     return _finish(run)
 
 
@@ -344,8 +407,8 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
 
     `parser`: a `parameters.Parameters` dataclass (its fields make the flags; an instance is
     returned, checked), or an argparse parser (a Namespace is returned).
-    Called by a script (``python demos/punch.py ...``), it starts the run (`_script_run`).
-    In a notebook: the defaults, or the flags in the environment variable FENICS_NL_ARGS.
+    Within a run (`run_script`, `run_file`): its command line. In a notebook: the defaults,
+    or the flags in the environment variable FENICS_NL_ARGS.
     `prefixes` (or a function of the parsed arguments giving them): the PETSc options
     prefixes of the run's solvers, with what reads each; an option outside them is refused.
     """
@@ -355,10 +418,6 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
     tune_kernel_flags()  # a demo opts in to the faster kernels (`import fenics_nl` does not)
     declared = isinstance(parser, type) and issubclass(parser, parameters.Parameters)
     cls, parser = (parser, parameters.parser_of(parser)) if declared else (None, parser)
-    caller = sys._getframe(1).f_globals
-    if (_current is None and caller.get("__name__") == "__main__" and "__file__" in caller
-            and not _in_ipython()):  # IPython's %run sets __file__ too: a notebook's run
-        _script_run(Path(caller["__file__"]))
     global _notebook_args
     run = _current
     argv = run.argv if run else shlex.split(os.environ.get(NOTEBOOK_ARGS, ""))
@@ -462,26 +521,18 @@ def checkpointing(functions: dict, *, newton=None, contact=None,
 def results(out: dict, writers: Sequence[Callable[[], None]] = ()) -> None:
     """The run's quantities (the JSON) and its output writers.
 
-    A script's run ends here: the JSON first, then each writer, and the exit status (a
-    non-zero one ends the script). Inside `run_file`, it writes them. In a notebook the
-    quantities are kept for `notebook_results` and the pictures asked for (--png, --plot in
-    FENICS_NL_ARGS) are drawn and shown.
+    Within a run (`run_script`, `run_file`) they are written when the demo's cells end: the
+    JSON first, then each writer on its own. In a notebook the quantities are kept for
+    `notebook_results` and the pictures asked for (--png, --plot in FENICS_NL_ARGS) are drawn
+    and shown.
     """
-    global _current, _notebook_results
+    global _notebook_results
     run = _current
     if run is None:
         _notebook_results = out
         _show_in_notebook(writers)
         return
     run.out, run.writers = out, writers
-    if not run.script:
-        return
-    _current = None
-    sys.excepthook = sys.__excepthook__
-    run.close_series()
-    status = _finish(run)
-    if status:
-        sys.exit(status)
 
 
 _notebook_results: dict | None = None
@@ -513,52 +564,6 @@ def _show_in_notebook(writers: Sequence[Callable[[], None]]) -> None:
 def notebook_results() -> dict | None:
     """The quantities the last demo run in this kernel gave `results` (None: none yet)."""
     return _notebook_results
-
-
-def _script_run(path: Path) -> None:
-    """Start the run of a demo called as a script: its command line, and its way out.
-
-    An error of the library (bad input, a solve that cannot converge) that reaches the top
-    of the script ends it with one line, the JSON of the converged steps and status 2, on
-    every rank; any other error keeps its traceback (a bug). The exit is immediate
-    (`os._exit` after MPI_Finalize): Python's own exit would give status 1.
-    """
-    global _current
-    run = _current = _Run(sys.argv[1:])
-    run.path, run.script = path, True
-    run.failure_comm = MPI.COMM_WORLD.Dup()  # every rank starts the script here
-    atexit.register(_ended_without_results, run)
-
-    def one_line_exit(kind, err, tb):
-        global _current
-        from petsc4py import PETSc
-
-        _current = None
-        sys.excepthook = sys.__excepthook__
-        if not isinstance(err, (*EXPECTED_ERRORS, PETSc.Error)):
-            sys.__excepthook__(kind, err, tb)  # a bug: its traceback first
-            if MPI.COMM_WORLD.size > 1:  # the other ranks may not have failed: no
-                sys.stderr.flush()       # collective clean-up, end them all
-                _abort(1)
-            run.close_series()
-            _forget(run.options)
-            return
-        if not _every_rank_failed(run):  # the others go on: no collective way out
-            print(f"error: {_one_line(err)} (on rank {MPI.COMM_WORLD.rank} only: the run "
-                  "is stopped)", file=sys.stderr, flush=True)
-            sys.stdout.flush()
-            _abort(2)
-        try:
-            status = _failed(run, err)
-        finally:
-            run.close_series()
-        sys.stdout.flush()
-        sys.stderr.flush()
-        if MPI.Is_initialized() and not MPI.Is_finalized():
-            MPI.Finalize()
-        os._exit(status)
-
-    sys.excepthook = one_line_exit
 
 
 def _abort(status: int) -> None:
@@ -594,23 +599,6 @@ def _every_rank_failed(run: _Run, seconds: float = FAILURE_WAIT_S) -> bool:
             return True
         time.sleep(0.005)
     return False
-
-
-def _ended_without_results(run: _Run) -> None:
-    """At the interpreter's exit: a script that never called `results` fails (status 1).
-
-    Nothing was reported, so a status 0 would be a lie. (`--help` and a bad flag end in
-    the parser, before the run has its parameters: they are left alone.)
-    """
-    if _current is not run or run.args is None:
-        return
-    error(f"{run.path.name} ended without reporting its results (cli.results was never "
-          "called): nothing was written")
-    sys.stdout.flush()
-    sys.stderr.flush()
-    if MPI.Is_initialized() and not MPI.Is_finalized():
-        MPI.Finalize()
-    os._exit(1)
 
 
 def run_scene(solve: Callable[[], tuple[dict, Sequence[Callable[[], None]]]], *,
