@@ -81,7 +81,22 @@ class Anderson:
 
 def accelerator(name: str, comm: MPI.Comm, owned: int, *, omega: float = 1.5,
                 depth: int = 5):
-    """None (plain iteration), an `OverRelaxation` or an `Anderson` by its name."""
+    """None (plain iteration), an `OverRelaxation` or an `Anderson` by its name.
+
+    Args:
+        name: ``none``, ``overrelaxed`` or ``anderson``.
+        comm: the vector's communicator (Anderson's global inner products).
+        owned: how many leading entries this rank owns (Anderson's).
+        omega: ω, the over-relaxation factor, in [1, 2).
+        depth: m, the differences Anderson keeps.
+
+    Returns:
+        The accelerator, called as ``accelerate(x, G(x))`` for the next iterate, or None
+        for ``none``.
+
+    Raises:
+        ValueError: for another name.
+    """
     if name == "none":
         return None
     if name == "overrelaxed":

@@ -53,7 +53,11 @@ class AlternateWork:
     damage_iterations: int = 0  # the bound-constrained damage solves', over the steps
 
     def count(self, *solves: AlternateResult) -> None:
-        """One load step's solves (a step solved again counts in the same step)."""
+        """One load step's solves (a step solved again counts in the same step).
+
+        Args:
+            *solves: the step's `AlternateResult`s, whose iterations are added up.
+        """
         self.iterations.append(sum(r.iterations for r in solves))
         self.newton_iterations += sum(r.newton_iterations for r in solves)
         self.damage_iterations += sum(r.damage_iterations for r in solves)
@@ -143,6 +147,17 @@ class AlternateMinimization:
         that the iteration cannot be drawn to an unstable stationary state (a fixed point
         that is not a minimum: the homogeneous bar past its bifurcation). Otherwise the plain
         iterate is restored and the history forgotten.
+
+        Args:
+            bcs: the Dirichlet conditions of u for this step (None: those given at
+                construction).
+
+        Returns:
+            The step's iteration counts, its last max |Δα| and its work.
+
+        Raises:
+            SolveError: if max |Δα| is still ≥ `tol` after `max_it` iterations, or if a u- or
+                damage solve does not converge.
         """
         bcs = self.bcs if bcs is None else list(bcs)
         snes = self.damage_problem.solver

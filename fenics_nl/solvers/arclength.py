@@ -237,7 +237,15 @@ class ArcState:
 
     @classmethod
     def saved(cls, scalars: dict, arrays: dict[str, np.ndarray]) -> ArcState:
-        """The state from `scalars()` and `arrays()` read back."""
+        """The state from `scalars()` and `arrays()` read back.
+
+        Args:
+            scalars: what `scalars()` gave (e.g. read back from JSON).
+            arrays: what `arrays()` gave on this rank (a vector the walk had not is absent).
+
+        Returns:
+            The state, for `ArcLength.run(resume=...)`.
+        """
         bracket = scalars["bracket"]
         return cls(**{**scalars, "bracket": tuple(bracket) if bracket else None},
                    **{k: arrays.get(k) for k in cls.VECTORS})
@@ -532,22 +540,37 @@ class ArcLength:
             stop: Callable[[], bool] | None = None) -> ContinuationPath:
         """Follow the path from λ = `start` (u converged there) until λ crosses `target`.
 
-        `stop()`: asked after each converged step (after `on_step`); True ends the path
-        there, whatever λ (a condition on the state: a displacement reached on a falling
-        branch, where λ alone cannot say which side of the limit point the path is on).
+        The step that crosses the target is then solved at λ = target exactly (Newton at
+        fixed λ, from the nearer of its two ends).
 
-        `descending`: only where λ falls through `target` (a softening branch past its limit
-        point: the way up through the same λ goes on).
+        Args:
+            target: the load factor λ to reach.
+            max_steps: the converged steps allowed.
+            start: λ where the path begins (with `resume`: the state's own start instead).
+            on_step: ``on_step(λ, result)`` after each converged step, with its SolveResult.
+            progress: ``progress(message)``: a line for every `progress_every`-th converged
+                step, and for every event (a limit point, a bifurcation, a cut arc).
+            progress_every: how many converged steps between two `progress` lines.
+            resume: go on from a state `on_state` gave (u, and the internal variables, back
+                in place): the path then takes the steps the uninterrupted run would have
+                taken.
+            on_state: ``on_state(state)`` after each converged step but the last, with the
+                `ArcState` a restart needs.
+            descending: the target counts only where λ falls through it (a softening branch
+                past its limit point: the way up through the same λ goes on).
+            stop: ``stop()``, asked after each converged step (after `on_step`); True ends
+                the path there, whatever λ (a condition on the state: a displacement reached
+                on a falling branch, where λ alone cannot say which side of the limit point
+                the path is on).
 
-        The step that crosses it is then solved at λ = target exactly (Newton at fixed λ,
-        from the nearer of its two ends). ContinuationError if the target is not crossed
-        within `max_steps` converged steps, or if the arc is cut below its minimum (a step
-        that does not converge, or turns back onto the path it came along).
-        `on_state(state)` after each converged step but the last, with what a restart
-        needs; `resume`: go on from such a state (u, and the internal variables, back in
-        place): the path then takes the steps the uninterrupted run would have taken.
-        `progress(message)`: a line for every `progress_every`-th converged step, and for
-        every event (a limit point, a bifurcation, a cut arc).
+        Returns:
+            The path followed (also kept in `self.path`), with its converged states,
+            critical points and work; `stopped` is set if `stop` ended it.
+
+        Raises:
+            ContinuationError: if the target is not crossed within `max_steps` converged
+                steps, or if the arc is cut below its minimum (a step that does not
+                converge, or turns back onto the path it came along).
         """
         if not math.isfinite(target) or target == start:
             raise ValueError(f"target load factor must be finite and differ from the start "

@@ -28,7 +28,17 @@ __all__ = [
 
 
 def geometric_stiffness(stress, du, v, gradient=ufl.grad):
-    """Integrand of a_G(du, v) = σ₀ : (∇duᵀ·∇v) for a (linear) pre-stress σ₀."""
+    """Integrand of a_G(du, v) = σ₀ : (∇duᵀ·∇v) for a (linear) pre-stress σ₀.
+
+    Args:
+        stress: σ₀, the stress of the reference load's linear solution (UFL).
+        du: the trial function (or its displacement part).
+        v: the test function (or its displacement part).
+        gradient: ∇, applied to du and v (e.g. an embedded 3×3 gradient for a 3×3 σ₀).
+
+    Returns:
+        The UFL integrand; times dx it is a_G.
+    """
     return ufl.inner(stress, gradient(du).T * gradient(v))
 
 
@@ -85,8 +95,20 @@ def critical_loads(a_K: ufl.Form, a_G: ufl.Form, bcs, V: fem.FunctionSpace, n: i
                    ) -> tuple[list[float], list[fem.Function]]:
     """The `n` smallest positive load factors λ and their modes.
 
-    Modes are normalised to max |φ| = 1 over `scale_dofs` (local indices; all by default:
-    a mixed space gives its displacement's, so that the pressure's units do not count).
+    Args:
+        a_K: the bilinear form of K, the tangent at the undeformed state.
+        a_G: that of K_G, the geometric stiffness of the reference load's stress σ₀.
+        bcs: the Dirichlet conditions (their rows: K's largest diagonal entry in K, 0 in K_G).
+        V: the function space of the modes.
+        n: how many load factors.
+        prefix: PETSc options prefix of the SLEPc eigensolver (``-{prefix}eps_...``).
+        scale_dofs: local indices over which modes are normalised to max |φ| = 1 (all by
+            default: a mixed space gives its displacement's, so that the pressure's units do
+            not count).
+
+    Returns:
+        The load factors λ in increasing order (at most `n`, the converged real positive
+        ones) and their modes, as two lists.
     """
     K = _stiffness(a_K, bcs)
     G = petsc.assemble_matrix(fem.form(-a_G), bcs=bcs, diag=0.0)
@@ -119,8 +141,17 @@ def negative_eigenvalues(A: PETSc.Mat, prefix: str, rhs: PETSc.Vec | None = None
     """The number of negative eigenvalues of the symmetric matrix A, from its inertia.
 
     Sylvester's law: A = L D Lᵀ (MUMPS) has as many negative eigenvalues as D has negative
-    pivots. One factorization, no eigensolver; `-{prefix}...` options reach its KSP. With
-    `rhs`, also `solution` = A⁻¹ rhs: one back-solve on the same factorization.
+    pivots. One factorization, no eigensolver.
+
+    Args:
+        A: the assembled symmetric matrix.
+        prefix: PETSc options prefix of the factorization's KSP (``-{prefix}...``).
+        rhs: if given, a right-hand side to solve for: one back-solve on the same
+            factorization.
+        solution: receives A⁻¹ rhs (needed with `rhs`).
+
+    Returns:
+        The number of negative eigenvalues of A.
     """
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOptionsPrefix(prefix)
@@ -149,11 +180,24 @@ def unstable_directions(a_T: ufl.Form, bcs, prefix: str = "stability_",
     """The number of eigenvalues of K_T below −margin·max diag K_T, less `multipliers`.
 
     0 on a stable equilibrium; it changes by one where the path crosses a limit point or a
-    bifurcation. One assembly and one LDLᵀ factorization (`negative_eigenvalues`); with
-    `rhs` (zero on the Dirichlet rows), also `solution` = (K_T + margin·max diag)⁻¹ rhs.
-    A small `margin` counts an eigenvalue that round-off puts on either side of 0 as 0; it is
-    added where `rows` is 1 (a mixed unknown's displacement dofs: a pressure block scales
-    otherwise, and would change sign in some units), everywhere by default.
+    bifurcation. One assembly and one LDLᵀ factorization (`negative_eigenvalues`).
+
+    Args:
+        a_T: the bilinear form of the tangent K_T.
+        bcs: the Dirichlet conditions (identity rows scaled to K_T's largest diagonal entry).
+        prefix: the factorization's PETSc options are ``-{prefix}inertia_...``.
+        multipliers: negative eigenvalues a saddle-point tangent always has (its pressure
+            or multiplier dofs), not counted.
+        rhs: if given (zero on the Dirichlet rows), a right-hand side to solve for.
+        solution: receives (K_T + margin·max diag)⁻¹ rhs (needed with `rhs`).
+        margin: a small shift that counts an eigenvalue that round-off puts on either side
+            of 0 as 0, relative to K_T's largest diagonal entry.
+        rows: 1 where the margin is added (a mixed unknown's displacement dofs: a pressure
+            block scales otherwise, and would change sign in some units); everywhere by
+            default.
+
+    Returns:
+        The count of unstable directions, 0 on a stable equilibrium.
     """
     K = _stiffness(a_T, bcs)
     if margin:
@@ -176,9 +220,6 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
                         ) -> tuple[float, fem.Function]:
     """Whether the tangent K_T is positive definite, told by a negative eigenvalue.
 
-    Returns the smallest eigenvalue of K_T φ = λ M φ and its mode if there is a negative one
-    (unstable), else the one nearest 0 (M: the bilinear form `mass`, or the identity).
-
     The count of negative eigenvalues is the inertia of K_T (`negative_eigenvalues`), less
     `multipliers`: a saddle point [[A, Bᵀ], [B, −C]] with C ≥ 0 and B of full rank m has m
     negative eigenvalues for the constraint, and the others are those of A condensed on
@@ -187,6 +228,19 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     nearest 0 finds a positive one. A mass that vanishes on part of the unknown (a mixed
     formulation's pressure) condenses that part out of the pencil: infinite eigenvalues.
     Dirichlet rows are identity rows scaled to the largest diagonal entry (and zero in M).
+
+    Args:
+        a_T: the bilinear form of the tangent K_T.
+        bcs: the Dirichlet conditions.
+        V: the function space of the unknown (the mode's).
+        prefix: PETSc options prefix of the eigensolver (``-{prefix}eps_...``); the inertia
+            factorizations' is ``{prefix}inertia_``.
+        mass: the bilinear form of M (None: the identity).
+        multipliers: m, the negative eigenvalues of the constraint, not counted.
+
+    Returns:
+        The smallest eigenvalue of K_T φ = λ M φ and its mode if there is a negative one
+        (unstable), else the eigenvalue nearest 0 and its mode.
     """
     comm = V.mesh.comm
     K = _stiffness(a_T, bcs)
@@ -219,7 +273,19 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
 
 def mode_nearest_zero(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "stability_",
                       mass: ufl.Form | None = None) -> PETSc.Vec:
-    """The eigenvector of K_T φ = λ M φ (or K_T φ = λ φ) with λ nearest 0 (SLEPc)."""
+    """The eigenvector of K_T φ = λ M φ (or K_T φ = λ φ) with λ nearest 0 (SLEPc).
+
+    Args:
+        a_T: the bilinear form of the tangent K_T.
+        bcs: the Dirichlet conditions (identity rows scaled to K_T's largest diagonal entry,
+            zero in M).
+        V: the function space of the unknown.
+        prefix: PETSc options prefix of the eigensolver (``-{prefix}eps_...``).
+        mass: the bilinear form of M (None: the identity).
+
+    Returns:
+        The eigenvector, a new PETSc Vec (the caller destroys it).
+    """
     K = _stiffness(a_T, bcs)
     M = None
     if mass is not None:

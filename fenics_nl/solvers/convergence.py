@@ -140,8 +140,8 @@ def at_round_off(norms: Sequence[float], largest: float, threshold: float) -> bo
         threshold: the residual norm the test asks for.
 
     Returns:
-        Whether ‖R‖ stalls at round-off: arc-length accepts such a step; Newton fails with
-        the advice to raise atol.
+        Whether ‖R‖ stalls at round-off (arc-length accepts such a step; Newton fails with
+        the advice to raise atol).
     """
     low = min(1e-6 * largest, 1e4 * threshold)
     if (len(norms) >= 3 and norms[-2] <= 1e-2 * norms[-3] and norms[-1] > 0.5 * norms[-2]

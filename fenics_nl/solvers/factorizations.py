@@ -54,7 +54,14 @@ class Factorizations:
     def factorize(self, A: PETSc.Mat, setup) -> bool:
         """Point `ksp` at a factorization of A; whether one was made (collective).
 
-        `setup()` factorizes the solver's own KSP on A when no factorization is of A.
+        Args:
+            A: the tangent K just assembled.
+            setup: ``setup()`` factorizes the solver's own KSP on A when no factorization is
+                of A.
+
+        Returns:
+            True if a factorization was made (by `setup`, or of a copy kept aside), False if
+            one already made is reused.
         """
         comm = A.comm.tompi4py()
         A.mult(self._probe, self._product)

@@ -2,16 +2,16 @@
 
 `petsc.assemble_matrix` inserts each cell's element matrix through PETSc's
 MatSetValuesBlockedLocal, which for P2 elements costs more than the kernel: the J2 tangent of
-the thick cylinder at 52k unknowns takes 31-35 ms an assembly through PETSc against 20-22 ms
-into DOLFINx's `MatrixCSR`, the same values to the last bit (measured). On one rank the PETSc
-matrix is therefore made on the CSR's own arrays (MatCreateSeqAIJWithArrays shares them, no
-copy): the assembler writes into the very matrix MUMPS factorizes, whose pattern never
-changes, so the symbolic factorization is kept as before. On several ranks the CSR holds
-ghost rows too: its entries, ghost rows included, are handed to PETSc as coordinates
-(MatSetPreallocationCOO once, with global indices; MatSetValuesCOO per assembly), and PETSc
-sums what belongs to another rank's rows over a pattern of messages it built once. The
-sphere's elastic tangent at 91k unknowns on 2 ranks: 34 ms against 47 ms through PETSc
-(measured), the same matrix to round-off (summation order).
+the thick cylinder assembles faster into DOLFINx's `MatrixCSR` than through PETSc, the same
+values to the last bit (the times are in docs/benchmarks.md, section "J2 plasticity against
+dolfinx-external-operator"). On one rank the PETSc matrix is therefore made on the CSR's own
+arrays (MatCreateSeqAIJWithArrays shares them, no copy): the assembler writes into the very
+matrix MUMPS factorizes, whose pattern never changes, so the symbolic factorization is kept
+as before. On several ranks the CSR holds ghost rows too: its entries, ghost rows included,
+are handed to PETSc as coordinates (MatSetPreallocationCOO once, with global indices;
+MatSetValuesCOO per assembly), and PETSc sums what belongs to another rank's rows over a
+pattern of messages it built once. The sphere's elastic tangent on 2 ranks, too, assembles
+faster this way than through PETSc, the same matrix to round-off (summation order).
 """
 
 from __future__ import annotations
@@ -81,7 +81,12 @@ class FormMatrix:
     def assemble(self, form: fem.Form, bcs=(), diag: float = 1.0) -> None:
         """Fill `mat` with the matrix of `form` (this pattern's).
 
-        The Dirichlet rows and columns of `bcs` are zero but for `diag` on the diagonal.
+        Args:
+            form: the compiled bilinear form (the tangent K), of the pattern `mat` was made
+                for.
+            bcs: Dirichlet conditions whose rows and columns are zero but for `diag` on the
+                diagonal.
+            diag: the Dirichlet rows' diagonal value.
         """
         if self._csr is None:
             self.mat.zeroEntries()

@@ -65,6 +65,18 @@ def statistics(r: np.ndarray, J: np.ndarray) -> dict:
 
     s² = ‖r‖²/(m − n); covariance s² (JᵀJ)⁻¹. Where JᵀJ is singular (a parameter the data
     does not determine) its inverse is the pseudo-inverse and `rank` says so.
+
+    Args:
+        r: the m residuals at the solution.
+        J: their Jacobian ∂r/∂x, m × n (m > n).
+
+    Returns:
+        A dict with ``noise`` (s), ``covariance``, ``std`` (the parameters' standard
+        deviations), ``correlation``, ``rank`` (of JᵀJ) and ``unit_inverse`` ((JᵀJ)⁻¹, the
+        covariance for s = 1).
+
+    Raises:
+        ValueError: if there are no more residuals than parameters (m ≤ n).
     """
     m, n = J.shape
     if m <= n:
@@ -100,7 +112,26 @@ def levenberg_marquardt(
 ) -> FitResult:
     """Minimise ½‖r(x)‖² from x0 within lower ≤ x ≤ upper; `evaluate(x)` returns (r, J).
 
-    A SolveError raised by `evaluate` refuses the step (the model could not be run there).
+    Args:
+        evaluate: the model run, ``evaluate(x)`` → (r, J); a SolveError it raises refuses
+            the step (the model could not be run there).
+        x0: the initial parameters, within the bounds.
+        lower: the lower bounds.
+        upper: the upper bounds (None: none).
+        max_it: the most iterations (steps taken); the fit stops unconverged after them.
+        xtol: a step below this fraction of the parameters is negligible.
+        ftol: the relative fall of the misfit below which it stopped falling.
+        spread_tol: a step below this fraction of the parameters' standard deviations is
+            negligible.
+        max_factor: the most a parameter may be multiplied or divided by in one step.
+        progress: ``progress(message)``, a line for each step taken.
+
+    Returns:
+        The parameters found, with the residuals and Jacobian there, whether and why the fit
+        converged, its iterates and misfits, and its cost.
+
+    Raises:
+        ValueError: if x0 is outside the bounds.
     """
     t0 = time.perf_counter()
     x = np.asarray(x0, dtype=float).copy()

@@ -21,7 +21,14 @@ LinearSolver = Literal["lu", "cholesky", "gamg"]
 
 
 def rigid_body_modes(V: fem.FunctionSpace) -> PETSc.NullSpace:
-    """Orthonormal rigid-body modes (translations, rotations) of a vector P1/P2 space."""
+    """Orthonormal rigid-body modes (translations, rotations) of a vector P1/P2 space.
+
+    Args:
+        V: the displacement's vector function space (2D or 3D).
+
+    Returns:
+        The modes as a PETSc NullSpace, GAMG's near-nullspace.
+    """
     gdim = V.mesh.geometry.dim
     x = V.tabulate_dof_coordinates()
     n_owned = V.dofmap.index_map.size_local
@@ -46,18 +53,26 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
                P: PETSc.Mat | None = None, indefinite: bool = False) -> PETSc.KSP:
     """A KSP on `A`: direct MUMPS LU/Cholesky, or CG+GAMG (needs `near_nullspace`).
 
-    With a separate preconditioning matrix `P` and a direct `kind`, the KSP is CG
-    preconditioned by the factorization of P: P may lag behind A (an older tangent, older
-    Dirichlet rows) and the factorization is reused until it no longer pays. An
-    `indefinite` A (a saddle point) takes GMRES instead, preconditioned on the right so
-    that it stops on the true residual: CG's energy norm does not exist there, and
-    P⁻¹A = I + (a term of the rank of the changed rows and springs) converges in about as
-    many iterations either way. With GAMG an `indefinite` A (a tangent past a limit point)
-    takes GMRES too, restarted every 200 iterations: CG diverges on it. Its 200 Krylov
-    vectors cost 1.6 kB per unknown (1.6 GB at a million, shared by the ranks);
-    `-{prefix}ksp_gmres_restart` lowers it.
-    PETSc options with `prefix` (e.g. `-{prefix}ksp_monitor`) are read last, so the
-    command line can override every choice made here.
+    Args:
+        A: the tangent K.
+        kind: ``lu``, ``cholesky`` (MUMPS) or ``gamg``.
+        prefix: PETSc options prefix; its options (e.g. ``-{prefix}ksp_monitor``) are read
+            last, so the command line can override every choice made here.
+        near_nullspace: the rigid-body modes (`rigid_body_modes`), needed by ``gamg``.
+        rtol: the relative tolerance of an iterative solve.
+        P: a separate preconditioning matrix: with a direct `kind`, the KSP is then CG
+            preconditioned by the factorization of P. P may lag behind A (an older tangent,
+            older Dirichlet rows) and the factorization is reused until it no longer pays.
+        indefinite: A is indefinite. With `P` (a saddle point) the KSP is GMRES instead,
+            preconditioned on the right so that it stops on the true residual: CG's energy
+            norm does not exist there, and P⁻¹A = I + (a term of the rank of the changed
+            rows and springs) converges in about as many iterations either way. With GAMG
+            (a tangent past a limit point) GMRES too, restarted every 200 iterations: CG
+            diverges on it. Its 200 Krylov vectors cost 1.6 kB per unknown (1.6 GB at a
+            million, shared by the ranks); ``-{prefix}ksp_gmres_restart`` lowers it.
+
+    Returns:
+        The KSP, its options set from the command line.
     """
     if kind not in KINDS:
         raise ValueError(f"linear solver must be one of {', '.join(KINDS)}, got {kind!r}")
@@ -107,8 +122,9 @@ def _keep_mumps(ksp: PETSc.KSP, A: PETSc.Mat, prefix: str) -> None:
     """MUMPS for a factorization the options chose, and symmetry flags for Cholesky.
 
     `-{prefix}pc_type cholesky` resets the factorization package to PETSc's own sequential
-    one (measured 7.5x slower than MUMPS LU on the bracket, while MUMPS's LDLᵀ is 10 %
-    faster than its LU and needs 43 % less memory: benchmarks/cholesky.py).
+    one (far slower than MUMPS LU on the bracket, while MUMPS's LDLᵀ is faster than its LU
+    and needs less memory: measured by benchmarks/cholesky.py, table in docs/benchmarks.md,
+    section "Direct solver: MUMPS LDLᵀ against LU", which records the PETSc trial too).
     """
     pc = ksp.getPC()
     if pc.getType() not in ("lu", "cholesky"):
@@ -124,10 +140,21 @@ def block_preconditioned_ksp(A: PETSc.Mat, M: PETSc.Mat, W: fem.FunctionSpace,
                              prefix: str = "", rtol: float = 1e-10) -> PETSc.KSP:
     """MINRES on a symmetric saddle-point tangent (u, p), preconditioned block-diagonally.
 
-    `M` = diag(2μ ε:ε, (1/μ + 1/k) mass): the displacement block by GAMG (with the rigid-body
-    near-nullspace), the pressure block by Jacobi on the mass matrix, which is spectrally
+    The displacement block of `M` by GAMG (with the rigid-body near-nullspace), its pressure
+    block by Jacobi on the mass matrix, which is spectrally
     equivalent to the Schur complement whatever the bulk modulus: the iteration count does
-    not grow as ν → 1/2 (Silvester–Wathen). The fields are W's sub-spaces 0 and 1.
+    not grow as ν → 1/2 (Silvester–Wathen).
+
+    Args:
+        A: the tangent K of the mixed unknown (u, p).
+        M: the block preconditioner's matrix, diag(2μ ε:ε, (1/μ + 1/k) mass).
+        W: the mixed space; its sub-spaces 0 and 1 are the fields u and p.
+        prefix: PETSc options prefix (a block's: ``-{prefix}fieldsplit_u_...``,
+            ``-{prefix}fieldsplit_p_...``).
+        rtol: MINRES's relative tolerance.
+
+    Returns:
+        The KSP, its options set from the command line.
     """
     from fenics_nl.materials.mixed import collapsed
 

@@ -96,11 +96,38 @@ def solve_incrementally(
 ) -> LoadPath:
     """Drive the load factor from 0 to 1, starting with `steps` equal increments.
 
-    `start`: go on from a converged state (a restart: `solver.u` and the internal variables
-    already hold it), `path_so_far` the path before it (the one returned goes on from it);
-    `on_state(state, path)` after each converged step, with what a restart needs (a
-    checkpoint) and the path so far. `progress(message)`: a line for every
-    `progress_every`-th converged step, and one for every cut step.
+    Args:
+        solver: the solver of each step: it has `u` and `solve()` (see the module).
+        set_load: ``set_load(t)`` sets the load at the load factor t.
+        steps: the first increment is 1/`steps`.
+        adaptive: halve the increment of a failed step and grow it after an easy one (False:
+            the first failure raises LoadStepError).
+        min_step: the smallest increment; a step cut below it raises LoadStepError.
+        max_step: the largest increment an easy step grows to.
+        easy_iterations: a step converged in at most this many iterations is easy: the next
+            increment is 1.5 times larger.
+        predictor: start each step from the extrapolation of the last two converged states
+            (the secant predictor) rather than from the last one.
+        on_step: ``on_step(t, result)`` after each converged step, with its SolveResult.
+        progress: ``progress(message)``: a line for every `progress_every`-th converged step,
+            and one for every cut step.
+        progress_every: how many converged steps between two `progress` lines.
+        commit: ``commit()`` after each converged step (it may refuse the step by raising
+            SolveError: see the module).
+        restore: ``restore()`` when a step is cut (u itself is restored here).
+        start: go on from a converged state (a restart: `solver.u` and the internal
+            variables already hold it).
+        path_so_far: the path before `start` (the one returned goes on from it).
+        on_state: ``on_state(state, path)`` after each converged step, with what a restart
+            needs (a checkpoint) and the path so far.
+
+    Returns:
+        The path, its converged load factors with their SolveResults, the steps cut and the
+        work (`path_so_far` itself, if given, extended).
+
+    Raises:
+        LoadStepError: if a step fails and cannot be cut (below `min_step`, or not
+            `adaptive`); the load is set back to the last converged t.
     """
     if steps < 1:
         raise ValueError(f"steps must be >= 1, got {steps}")

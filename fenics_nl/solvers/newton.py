@@ -85,6 +85,12 @@ def forcing_term(relative_residual: float) -> float:
     wasted, tighter as the residual drops so that the last iterations stay close to
     exact Newton. Not looser than 1e-3: an inexact solve leaves its error in the soft
     (bending) modes, where a small linear residual hides a large displacement error.
+
+    Args:
+        relative_residual: ‖R_k‖/‖R_0‖.
+
+    Returns:
+        η, the Krylov solver's relative tolerance for the next correction δU.
     """
     return 1e-3 * min(1.0, max(relative_residual, 1e-11))
 
@@ -337,11 +343,14 @@ class NewtonSolver:
                 new_path: bool = False) -> None:
         """Replace the Dirichlet conditions (their rows change, so the tangent is stale).
 
-        `small_change`: only a few rows differ from the last factorized tangent, so with
-        `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
-        `new_path`: a change of unknown size (a load step's start): a linear material's
-        tangent is factorized afresh rather than updated (`solvers.row_update`), as a run
-        restarted there would: both then take the same path, work counts included.
+        Args:
+            bcs: the new Dirichlet conditions.
+            small_change: only a few rows differ from the last factorized tangent, so with
+                `reuse_factorization` CG on the new tangent, preconditioned by it, is cheap.
+            new_path: a change of unknown size (a load step's start): a linear material's
+                tangent is factorized afresh rather than updated (`solvers.row_update`), as a
+                run restarted there would: both then take the same path, work counts
+                included.
         """
         if new_path and self._rows is not None:
             self._rows.factor = None
@@ -416,9 +425,13 @@ class NewtonSolver:
         Within `reuse_residual_at_same_u`, an assembly at the same u serves again: the
         caller promises that nothing else R reads (a load factor, a state) changes there.
 
-        The norm is taken off the Dirichlet rows: a force, the equilibrium imbalance.
-        `lift`: also b −= K (u − g) on the Dirichlet columns, so that the correction
-        δU = −K⁻¹b moves the boundary to g and the interior with it.
+        Args:
+            work: the counts the assembly (and its time) is added to.
+            lift: also b −= K (u − g) on the Dirichlet columns, so that the correction
+                δU = −K⁻¹b moves the boundary to g and the interior with it.
+
+        Returns:
+            ‖R‖, taken off the Dirichlet rows (a force, the equilibrium imbalance).
         """
         with _Timer(work, "residual"):
             if not self._R_raw_is_current():
@@ -460,6 +473,12 @@ class NewtonSolver:
 
         Current within `reuse_residual_at_same_u` while u is where it was assembled; else the
         caller assembles it (collective: every rank answers alike).
+
+        Args:
+            out: receives R(u), without Dirichlet rows, lifting or `nodal` terms.
+
+        Returns:
+            Whether R(u) was current, and so copied.
         """
         if not self._R_raw_is_current():
             return False
@@ -493,7 +512,14 @@ class NewtonSolver:
         """Rebuild (and factorize) the tangent at iteration `k` if the variant says so.
 
         full: always; modified and bfgs: at k = 0 of a solve, or never (a tangent for the
-        solver's life); periodic: every `period` iterations. Returns whether it did.
+        solver's life); periodic: every `period` iterations.
+
+        Args:
+            k: the iteration within the solve (0: its first).
+            work: the counts the assembly and factorization are added to.
+
+        Returns:
+            Whether the tangent K was rebuilt.
         """
         if self.nodal.version != self._nodal_version:  # new springs: the tangent is stale
             # but near the last one (friction's springs follow the slip directions as they
@@ -511,6 +537,10 @@ class NewtonSolver:
 
         From ‖R_k‖/‖R_0‖ = rnorm/first (`forcing_term`); a frozen operator's (modified,
         BFGS) from 1: its own error is about its contraction, a tighter solve buys nothing.
+
+        Args:
+            rnorm: ‖R_k‖, the current residual's norm.
+            first: ‖R_0‖, the solve's first (0: taken as a frozen operator's).
         """
         if self._forcing:
             frozen = self.method in ("modified", "bfgs") or not first
@@ -519,7 +549,15 @@ class NewtonSolver:
     def solve_linear(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
         """out = K⁻¹ rhs with the current operator (BFGS: its corrected inverse H rhs).
 
-        The Newton correction of a residual b is −K⁻¹b. LinearSolveError if the KSP fails.
+        The Newton correction of a residual b is −K⁻¹b.
+
+        Args:
+            rhs: the right-hand side (a residual b, or the load vector q).
+            out: receives K⁻¹ rhs.
+            work: the counts the solve is added to.
+
+        Raises:
+            LinearSolveError: if the KSP fails.
         """
         if self.bfgs:
             self.bfgs.direction(rhs, self.du, lambda b: self._linear_solve(b, work))
@@ -532,10 +570,15 @@ class NewtonSolver:
         """K(u) at the current u for `tangent_solve` (factorized if the solver would).
 
         Assembled again: a converged solve's last tangent is at its last-but-one iterate,
-        off by the last correction (using it bends a Taylor test's slope from 2 to 1.7 at
-        relative steps of 1e-4, measured on the indentation). With
-        `reuse_factorization` the factorization already made preconditions CG on it:
-        back-solves only. ValueError for a tangent kept for the solver's life (not K(u)).
+        off by the last correction (using it bends a Taylor test's slope below 2 at small
+        relative steps, as seen on the indentation). With `reuse_factorization` the
+        factorization already made preconditions CG on it: back-solves only.
+
+        Args:
+            work: the counts the assembly and factorization are added to.
+
+        Raises:
+            ValueError: for a tangent kept for the solver's life (not K(u)).
         """
         if self._policy.for_life:
             raise ValueError("a constant tangent for the solver's life is not K(u): "
@@ -545,8 +588,13 @@ class NewtonSolver:
     def tangent_solve(self, rhs: PETSc.Vec, out: PETSc.Vec, work: WorkCounts) -> None:
         """out = K⁻¹ rhs with the tangent of `assemble_exact_tangent` and the current rows.
 
-        `rhs` must be zero on the Dirichlet rows (a homogeneous problem). LinearSolveError
-        if the KSP fails.
+        Args:
+            rhs: the right-hand side, zero on the Dirichlet rows (a homogeneous problem).
+            out: receives K⁻¹ rhs.
+            work: the counts the solve is added to.
+
+        Raises:
+            LinearSolveError: if the KSP fails.
         """
         self._linear_solve(rhs, work)
         self.du.copy(out)
@@ -555,6 +603,10 @@ class NewtonSolver:
         """BFGS: keep the pair of a correction, s = δu and y = δR.
 
         The solver then owns both vectors (the other variants destroy them).
+
+        Args:
+            s: δu, the correction made.
+            y: δR, the change of the residual it made.
         """
         if self.bfgs:
             self.bfgs.store_pair(s, y)
@@ -660,8 +712,8 @@ class NewtonSolver:
         The row update's solves read K and the base's factors, not A: while it may serve, A
         stays the base's matrix, the last one factorized (what the KSP solves with on the
         base's own rows), until the next factorization (`_apply_rows_to_fixed_tangent`): a
-        copy of K and a sweep of its columns saved per active-set iteration (10 % of a
-        linear solve on the axisymmetric punch, measured).
+        copy of K and a sweep of its columns saved per active-set iteration (a part of a
+        linear solve's time on the axisymmetric punch).
         """
         if self._K_fixed is None:
             self._matrix.assemble(self._K)
@@ -749,12 +801,13 @@ class NewtonSolver:
         is: the step is kept when ‖R‖ fell, else α goes to the energy's minimum along the
         line, where its slope s(α) = R(u − α du)·du vanishes, by secant steps on s (PETSc's
         critical-point search). The norm alone rejects good Newton steps: a cantilever's
-        linear predictor bends it by 20 % of its length, ‖R‖ is 200 times the first there,
-        and halving crawled (α ~ 1e-3, no convergence in 30 iterations; without a search,
-        5). Not for a residual with kinks (a penalty switching on, a yield surface): the
-        slope says nothing across a kink, and the norm's test is what keeps such iterations
-        from cycling. `full_step`: α = 1 whatever (the lifted step must reach the boundary
-        values). Returns α and the new ‖R‖.
+        linear predictor bends it by a fair part of its length, ‖R‖ is far above the first
+        there, and halving crawled (tiny α, no convergence, where the full steps without a
+        search converge; the figures are in docs/cases.md, "Newton takes the steps a
+        hyperelastic energy needs"). Not for a residual with kinks (a penalty switching on, a
+        yield surface): the slope says nothing across a kink, and the norm's test is what
+        keeps such iterations from cycling. `full_step`: α = 1 whatever (the lifted step must
+        reach the boundary values). Returns α and the new ‖R‖.
         """
         if full_step or not self._line_search:
             return 1.0, self._move(1.0, 0.0, work)

@@ -29,15 +29,23 @@ class NodalTerms:
         """Point forces F = `values` at `dofs`: R(u) − F.
 
         Replaces the previous ones; the tangent does not depend on them.
+
+        Args:
+            dofs: the local indices of the loaded dofs.
+            values: F at each of them.
         """
         self.load = (np.asarray(dofs, dtype=np.int32), np.asarray(values, dtype=float))
 
     def set_springs(self, dofs: np.ndarray, stiffness: np.ndarray, anchor: np.ndarray) -> None:
         """Nodal springs: R(u) + k (u − a) at each node's dofs, k added to the tangent.
 
-        `dofs` (n, m): n nodes' m components, `stiffness` (n, m, m) each node's symmetric
-        spring, `anchor` (n, m) where it is unstretched. Replaces the previous ones.
-        Collective: every rank's tangent is rebuilt if any rank has (or had) springs.
+        Replaces the previous ones. Collective: every rank's tangent is rebuilt if any rank
+        has (or had) springs.
+
+        Args:
+            dofs: (n, m), the local indices of n nodes' m components.
+            stiffness: (n, m, m), k, each node's symmetric spring.
+            anchor: (n, m), a, where each spring is unstretched.
         """
         dofs = np.asarray(dofs, dtype=np.int32)
         had, has = self.springs is not None, self.comm.allreduce(bool(dofs.size), op=MPI.LOR)
@@ -47,7 +55,12 @@ class NodalTerms:
                         np.asarray(anchor, dtype=float)) if has else None
 
     def add_to_residual(self, u: np.ndarray, b: np.ndarray) -> None:
-        """b −= F, b += k (u − a): on the local arrays, after the residual's assembly."""
+        """b −= F, b += k (u − a): on the local arrays, after the residual's assembly.
+
+        Args:
+            u: the local array of the unknown.
+            b: the local array of the residual R, changed in place.
+        """
         if self.load is not None:
             dofs, values = self.load
             b[dofs] -= values
@@ -56,7 +69,11 @@ class NodalTerms:
             b[dofs] += np.einsum("nij,nj->ni", k, u[dofs] - anchor)
 
     def add_to_tangent(self, A: PETSc.Mat) -> None:
-        """A += each spring's stiffness (collective, as A.assemble(); nothing without)."""
+        """A += each spring's stiffness (collective, as A.assemble(); nothing without).
+
+        Args:
+            A: the assembled tangent K, changed in place.
+        """
         if self.springs is None:
             return
         dofs, k, _ = self.springs

@@ -25,7 +25,11 @@ class WorkCounts:
     time: dict[str, float] = field(default_factory=lambda: dict.fromkeys(PHASES, 0.0))
 
     def add(self, other: WorkCounts) -> None:
-        """Accumulate `other` into self."""
+        """Accumulate `other` into self.
+
+        Args:
+            other: the counts and times added (a solve's, a step's).
+        """
         self.residual_assemblies += other.residual_assemblies
         self.tangent_assemblies += other.tangent_assemblies
         self.factorizations += other.factorizations
@@ -60,6 +64,12 @@ class SolveResult:
         """A step converged before a restart: its iteration count, no norms.
 
         Its work is in the totals of the path it came back with.
+
+        Args:
+            iterations: the step's iteration count, as the checkpoint recorded it.
+
+        Returns:
+            A converged result with that count, no residual norms and no work.
         """
         return cls(True, "converged (before the restart)", iterations, [], WorkCounts())
 

@@ -44,9 +44,15 @@ def columns_per_factorization(factor: PETSc.Mat) -> int:
     The elimination's flops (RINFOG(3)) over a forward and a backward substitution's,
     twice the entries of the factors (INFOG(29), −millions past 2³¹). Counted, not timed,
     so that a run and its restart, or its ranks, decide alike. Blocked, a column's
-    substitution runs at about the factorization's flop rate: measured on the punch,
-    this count is 1.1–1.6 times the ratio of their times (48, 114, 300, 440 columns on
-    the axisymmetric refinements 1 and 3 and the 3D ones 0 and 1).
+    substitution runs at about the factorization's flop rate: on the axisymmetric and 3D
+    punches this count is somewhat above the ratio of their times.
+
+    Args:
+        factor: MUMPS's factors (the factor matrix of the KSP's PC, factorized).
+
+    Returns:
+        The number of columns (back-solves) one factorization is worth; 0 if the factors
+        have no entries.
     """
     flops, entries = factor.getMumpsRinfog(3), factor.getMumpsInfog(29)
     entries = entries if entries >= 0 else -entries * 1e6
@@ -75,7 +81,13 @@ class RowUpdate:
         self._vecs = [K.createVecRight() for _ in range(3)]
 
     def rebase(self, factor: PETSc.Mat, rows: np.ndarray) -> None:
-        """`factor`: MUMPS's factors of M_b for the base rows `rows`."""
+        """A new base, M_b just factorized: the columns made on the old one are dropped.
+
+        Args:
+            factor: MUMPS's factors of M_b.
+            rows: the base rows B_b (owned local indices), the current rows until
+                `set_rows`.
+        """
         self.factor = factor
         self.base = np.zeros(self.n, dtype=bool)
         self.base[rows] = True
@@ -94,6 +106,14 @@ class RowUpdate:
         matrix is singular to working precision: see `_set`.)
 
         Collective. Makes the columns of the rows that changed and have none yet.
+
+        Args:
+            rows: the Dirichlet rows B (owned local indices).
+            work: the counts the columns made are added to (`update_columns`).
+
+        Returns:
+            True if `solve` serves the rows B from now on, False if a factorization pays
+            (or there is no base).
         """
         if self.factor is None:
             return False
@@ -109,7 +129,12 @@ class RowUpdate:
         return True
 
     def solve(self, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
-        """out = M_B⁻¹ rhs on the owned entries (collective)."""
+        """out = M_B⁻¹ rhs on the owned entries (collective).
+
+        Args:
+            rhs: the right-hand side r.
+            out: receives M_B⁻¹ r.
+        """
         r = rhs.array_r[: self.n]
         w, Kw, x0 = self._vecs
         # the base's right-hand side: the forces of the added rows' values on the free rows
@@ -202,8 +227,8 @@ class RowUpdate:
         Kept with K times them.
 
         The right-hand sides go to MUMPS as a sparse matrix (transposed, as MatMatSolve
-        takes it): its forward elimination then skips what they do not reach (1.7x faster
-        than dense ones on the axisymmetric punch, measured). On one rank only: on two,
+        takes it): its forward elimination then skips what they do not reach (faster than
+        dense ones on the axisymmetric punch). On one rank only: on two,
         MUMPS refuses distributed sparse ones (INFOG(1) = −27, PETSc 3.25), and gathered
         on rank 0 they gave zero columns for released rows (measured): dense there.
         """

@@ -71,8 +71,24 @@ def solve(r: Callable[[float], float], u0: float, method: str = "newton",
           tol: float = 1e-14, max_it: int = 100) -> ScalarResult:
     """Solve r(u) = 0 from u0; stop when |r(u)| <= tol or the update is below round-off.
 
-    `dr` is r' (central differences if omitted); `k` the constant slope of modified Newton.
     The secant method's second point is one Newton step from u0.
+
+    Args:
+        r: the residual r(u).
+        u0: the starting point (a float, or an `mpmath.mpf` for many digits).
+        method: ``newton``, ``modified`` or ``secant``.
+        dr: r' (central differences if omitted).
+        k: the constant slope K of modified Newton (default r'(u0)).
+        tol: converged when |r(u)| <= tol.
+        max_it: updates before ScalarSolveError.
+
+    Returns:
+        The iterates, their residuals and the observed orders.
+
+    Raises:
+        ScalarSolveError: on a zero or non-finite slope, a non-finite value, a failed
+            arithmetic, a divergence or no convergence in `max_it` updates; its `result`
+            holds the iterates up to the failure.
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")

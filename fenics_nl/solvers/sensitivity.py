@@ -44,6 +44,15 @@ def parameter_derivative(form_or_expr, constant: fem.Constant, weight=1.0):
 
     UFL differentiates forms with respect to Functions only: the constant is swapped for a
     `ufl.variable` of itself and each integrand differentiated with `ufl.diff`.
+
+    Args:
+        form_or_expr: a UFL form (the residual R) or expression (a state update A).
+        constant: c, the parameter θ_i (a scalar `fem.Constant` of the law).
+        weight: a factor of the derivative (a number or UFL: a component of a unit vector
+            picks one parameter of several in one compiled form).
+
+    Returns:
+        The derivative, a UFL form for a form, else a UFL expression.
     """
     c = ufl.variable(constant)
     swapped = ufl.replace(form_or_expr, {constant: c})

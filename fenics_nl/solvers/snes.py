@@ -68,7 +68,14 @@ class EventCounter:
 
 
 def petsc_work(counter: EventCounter) -> WorkCounts:
-    """WorkCounts read off PETSc's event log."""
+    """WorkCounts read off PETSc's event log.
+
+    Args:
+        counter: the events' counter, started at the solve's start.
+
+    Returns:
+        The counts and times of the events since `counter.start()`.
+    """
     ev = counter.stop()
     work = WorkCounts()
     for attr, names in EVENTS.items():
@@ -99,6 +106,13 @@ def solver_options(prefix: str, options: dict):
     user's (`unless_set`) and kept an earlier solver's method (a modified Newton that
     refactorized at every iteration, after a full one). Here they are deleted by their
     full names.
+
+    Args:
+        prefix: the problem's PETSc options prefix.
+        options: the options by their names without the prefix.
+
+    Yields:
+        The options the command line did not set under `prefix`.
     """
     passed = unless_set(prefix, options)
     try:
@@ -114,6 +128,13 @@ def unless_set(prefix: str, options: dict) -> dict:
 
     dolfinx's NonlinearProblem and LinearProblem write their `petsc_options` over the
     database and delete them afterwards; an option the user passed would be lost.
+
+    Args:
+        prefix: the problem's PETSc options prefix.
+        options: the options by their names without the prefix.
+
+    Returns:
+        The options whose ``{prefix}name`` is not in PETSc's options database.
     """
     db = PETSc.Options()
     return {k: v for k, v in options.items() if not db.hasName(prefix + k)}

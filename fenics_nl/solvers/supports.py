@@ -88,7 +88,12 @@ class RigidMotions:
     def of(cls, V: fem.FunctionSpace) -> RigidMotions | None:
         """The rigid motions of a displacement unknown, plain or mixed (its sub-space 0).
 
-        None for an unknown that is not a displacement (a scalar field).
+        Args:
+            V: the unknown's function space.
+
+        Returns:
+            Its rigid motions, or None for an unknown that is not a displacement (a scalar
+            field).
         """
         gdim = V.mesh.geometry.dim
         if V.ufl_element().is_mixed:
@@ -100,8 +105,12 @@ class RigidMotions:
     def unconstrained(self, constrained: np.ndarray) -> np.ndarray:
         """Columns (combinations of the modes) that vanish on the `constrained` owned dofs.
 
-        Returned in the modes' coefficients, one column each (an orthonormal basis of the
-        null space of the normalized Gram matrix of the constrained rows).
+        Args:
+            constrained: the owned local dofs (unrolled) the Dirichlet rows hold.
+
+        Returns:
+            The combinations in the modes' coefficients, one column each (an orthonormal
+            basis of the null space of the normalized Gram matrix of the constrained rows).
         """
         T = self.modes
         full = self.comm.allreduce(T.T @ T)
@@ -116,6 +125,12 @@ class RigidMotions:
 
         Translations along an axis first, then rotations about an axis (through whatever
         point the span gives), then whatever is left.
+
+        Args:
+            free: the motions' mode coefficients, one column each (as from `unconstrained`).
+
+        Returns:
+            The basis, one coefficient vector per column of `free`.
         """
         if free.shape[1] == 0:
             return []
@@ -139,7 +154,14 @@ class RigidMotions:
         return basis[: free.shape[1]]
 
     def describe(self, coefficients: np.ndarray) -> str:
-        """A free motion in words: 'translation along y', 'rotation about z through (..)'."""
+        """A free motion in words: 'translation along y', 'rotation about z through (..)'.
+
+        Args:
+            coefficients: the motion's mode coefficients.
+
+        Returns:
+            The motion in words.
+        """
         gdim = self.gdim
         t = np.zeros(3)
         t[:gdim] = coefficients[:gdim]
@@ -164,7 +186,14 @@ def _direction(v: np.ndarray) -> str:
 
 
 def constrained_dofs(bcs: Sequence[fem.DirichletBC]) -> np.ndarray:
-    """The owned local dofs (unrolled) that a Dirichlet condition holds."""
+    """The owned local dofs (unrolled) that a Dirichlet condition holds.
+
+    Args:
+        bcs: the Dirichlet conditions.
+
+    Returns:
+        Their owned local dofs, sorted, each once.
+    """
     rows = [bc.dof_indices()[0][: bc.dof_indices()[1]] for bc in bcs]
     return np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int32)
 
@@ -173,8 +202,16 @@ def free_motions(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirichle
                  ) -> list[str]:
     """The rigid motions that neither the Dirichlet rows of `bcs` nor `A` resist, named.
 
-    `A` is the tangent as assembled, with the Dirichlet rows set to the identity, or without
-    them: its Dirichlet rows and columns are not read. Collective.
+    Collective.
+
+    Args:
+        A: the tangent K as assembled, with the Dirichlet rows set to the identity, or
+            without them: its Dirichlet rows and columns are not read.
+        motions: the unknown's rigid motions.
+        bcs: the Dirichlet conditions.
+
+    Returns:
+        Each free motion in words (`RigidMotions.describe`); empty if the body is held.
     """
     held = constrained_dofs(bcs)
     C = motions.unconstrained(held)
@@ -210,7 +247,14 @@ def check_supports(A: PETSc.Mat, motions: RigidMotions, bcs: Sequence[fem.Dirich
                    context: str = "") -> None:
     """Raise SupportError naming every free rigid motion of the tangent `A` (collective).
 
-    `context` is added to the message (e.g. that contact does not hold the body yet).
+    Args:
+        A: the tangent K, as for `free_motions`.
+        motions: the unknown's rigid motions.
+        bcs: the Dirichlet conditions.
+        context: added to the message (e.g. that contact does not hold the body yet).
+
+    Raises:
+        SupportError: if a rigid motion is free.
     """
     free = free_motions(A, motions, bcs)
     if free:

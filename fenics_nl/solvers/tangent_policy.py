@@ -54,13 +54,25 @@ class TangentPolicy:
             self.factorization_current = False
 
     def bcs_changed(self, small: bool) -> None:
-        """New Dirichlet rows: rebuild the tangent; refactorize unless only a few changed."""
+        """New Dirichlet rows: rebuild the tangent; refactorize unless only a few changed.
+
+        Args:
+            small: only a few rows changed (or the springs): with `reuse` or `lag`, the
+                last factorization may serve the new tangent.
+        """
         self.ready = False
         if not small:
             self.factorization_current = False
 
     def needs_tangent(self, k: int) -> bool:
-        """At iteration k."""
+        """At iteration k.
+
+        Args:
+            k: the iteration within the solve (0: its first).
+
+        Returns:
+            Whether the tangent K is to be rebuilt now.
+        """
         if self.fixed and self.ready:
             return False  # a linear material: the tangent built for this solve is exact
         if self.method == "full":
@@ -88,6 +100,10 @@ class TangentPolicy:
 
         Lagged AMG: beyond twice the iterations per digit the hierarchy's own tangent took,
         set it up again (next time).
+
+        Args:
+            its: the Krylov iterations of the last solve.
+            rtol: the relative tolerance they were asked for.
         """
         if not self.lag:
             self.factorization_current = its <= self.REUSE_ITERATIONS
@@ -111,7 +127,13 @@ class InverseBFGS:
         self.pairs: list[tuple[PETSc.Vec, PETSc.Vec, float]] = []
 
     def direction(self, b: PETSc.Vec, du: PETSc.Vec, solve) -> None:
-        """du = H b; `solve(q)` puts K0⁻¹ q into du."""
+        """du = H b.
+
+        Args:
+            b: the right-hand side (the residual R).
+            du: receives H b.
+            solve: ``solve(q)`` puts K0⁻¹ q into du.
+        """
         q = b.copy()
         alphas = []
         for s, y, rho in reversed(self.pairs):
@@ -124,7 +146,14 @@ class InverseBFGS:
         q.destroy()
 
     def store(self, du: PETSc.Vec, alpha: float, b_old: PETSc.Vec, b_new: PETSc.Vec) -> None:
-        """Keep s = −α du and y = b_new − b_old if y·s > 0 (H stays positive definite)."""
+        """Keep s = −α du and y = b_new − b_old if y·s > 0 (H stays positive definite).
+
+        Args:
+            du: the correction's direction (u moved by −α du).
+            alpha: α, the step length taken.
+            b_old: the residual R before the step.
+            b_new: the residual R after it.
+        """
         s = du.copy()
         s.scale(-alpha)
         y = b_old.copy()
@@ -132,7 +161,12 @@ class InverseBFGS:
         self.store_pair(s, y)
 
     def store_pair(self, s: PETSc.Vec, y: PETSc.Vec) -> None:
-        """Keep the pair (s, y), which it now owns, if y·s > 0 (else destroy it)."""
+        """Keep the pair (s, y), which it now owns, if y·s > 0 (else destroy it).
+
+        Args:
+            s: the change of u.
+            y: the change of R it made.
+        """
         ys = y.dot(s)
         if not ys > 1e-12 * y.norm() * s.norm():
             s.destroy()
