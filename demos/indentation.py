@@ -129,7 +129,7 @@ solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=F
 loaded = list(load.states)
 nodes = punch.nodes_in_contact()
 warnings = check_contact_resolution(nodes, block.h, loaded[-1])
-check = punch_run.compare_with_hertz(punch, loaded)
+check = punch_run.compare_with_hertz(loaded, punch.hertz, punch.model, punch.block.h)
 warnings.append("j2 material: Hertz's values are the linear reference, not a check")
 p = material.cumulated_plastic_strain
 plastic_strain = global_max(block.mesh.comm,

@@ -38,9 +38,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact, StatusUpdate
-from fenics_nl.parallel import global_max
+from fenics_nl.parallel import gather_rows, global_max
 
 __all__ = ["FrictionalContact"]
 
@@ -179,6 +180,45 @@ class FrictionalContact(ActiveSetContact):
         """Σ T_t over S_C (every rank's owned nodes), one value per axis."""
         T_t = self.tangential_forces()
         return np.array([self.surface.total(T_t[:, k]) for k in range(len(self.axes))])
+
+    def force_within(self, distance: np.ndarray, radii) -> np.ndarray:
+        """Q(r): the tangential force along the first tangential axis inside each radius.
+
+        A sum of the nodal forces T_t of the S_C nodes at most r from an axis (every rank's
+        owned nodes).
+
+        Args:
+            distance: each S_C node's distance from the axis.
+            radii: the radii r.
+
+        Returns:
+            Q(r) for each r, of the modelled part.
+        """
+        T_x = np.where(self.owned, self.tangential_forces()[:, 0], 0.0)
+        inside = np.array([T_x[distance <= r].sum() for r in radii])
+        return self.comm.allreduce(inside, op=MPI.SUM)
+
+    def traction_profile(self, weight=1.0, on: np.ndarray | None = None):
+        """(x, p, q, status) of the S_C nodes `on`, gathered on rank 0 and sorted by x.
+
+        Args:
+            weight: the measure's weight (2πr in the axisymmetric model).
+            on: a mask of the nodes (default all); this rank's owned ones are taken.
+
+        Returns:
+            On rank 0: the first coordinate x, the contact pressure p, the tangential
+            traction q along the first tangential axis (nodal forces over nodal areas) and
+            the status (0 open, 1 stick, 2 slip) of each node; None on the other ranks.
+        """
+        on = self.owned if on is None else self.owned & on
+        areas = self.surface.nodal_areas(weight)
+        status = np.where(self.slip, 2, np.where(self.active, 1, 0))
+        rows = gather_rows(self.comm, self.x[on, 0], self.pressure(weight)[on],
+                           (self.tangential_forces()[:, 0] / areas)[on], status[on])
+        if rows is None:
+            return None
+        order = np.argsort(rows[0])
+        return tuple(r[order] for r in rows)
 
     # -- one iteration's conditions ---------------------------------------------------
 

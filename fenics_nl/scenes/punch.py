@@ -34,13 +34,12 @@ from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
-from fenics_nl.errors import SolveError
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.mixed import unknowns
-from fenics_nl.parallel import gather_rows, global_max
-from fenics_nl.solvers.force_control import reach_force
+from fenics_nl.parallel import global_max
+from fenics_nl.solvers.force_control import reach_force, reach_load
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz
 
@@ -334,20 +333,12 @@ class Punch:
             raise ValueError(f"tangential force {force:g} must be in [0, f P) = [0, "
                              f"{self.friction * P:.6g}): at f P the punch slides (no static "
                              "equilibrium under force control)")
-        d_prev = float(c.committed_motion[0])
-        q_prev = self.block.symmetry_factor * float(c.committed_tangential_force[0])
-        s1 = self._probe(1.0 if force >= q_prev else -1.0)  # the full-stick slope
-        for k in range(max_it):
-            if abs(s1.tangential_force - force) <= rtol * self.friction * P:
-                return s1, k + 1
-            slope = (s1.tangential_force - q_prev) / (s1.tangential_displacement - d_prev)
-            if not slope > 0:
-                raise SolveError(f"tangential force does not grow with the punch's position "
-                                 f"(slope {slope:.3g} at d = {s1.tangential_displacement:.6g})")
-            d_next = s1.tangential_displacement + (force - s1.tangential_force) / slope
-            d_prev, q_prev = s1.tangential_displacement, s1.tangential_force
-            s1 = self.shift(d_next)
-        raise SolveError(f"tangential force {force:g} not reached in {max_it} positions")
+        d0 = float(c.committed_motion[0])
+        q0 = self.block.symmetry_factor * float(c.committed_tangential_force[0])
+        first = d0 + (1.0 if force >= q0 else -1.0) * 1e-6 * self.block.a  # full stick
+        return reach_load(self.shift, force, (d0, q0), first, atol=rtol * self.friction * P,
+                          max_it=max_it,
+                          of=lambda t: (t.tangential_displacement, t.tangential_force))
 
     def _probe(self, sense: float = 1.0) -> Traction:
         """A move of 1e-6 a from the committed position: no node slips yet (full stick)."""
@@ -384,33 +375,16 @@ class Punch:
     def traction_profile(self):
         """(x, p, q, status) of the S_C nodes on y = 0 (3D) or all (2D), on rank 0 sorted by x.
 
-        Else None. x is signed (the block spans both sides of the punch), p the contact
-        pressure and q the tangential traction along x (the punch's on the block), nodal
-        forces over nodal areas; status 0 open, 1 stick, 2 slip.
+        Else None (`FrictionalContact.traction_profile`).
         """
         c = self._frictional()
-        on = c.owned
-        if self.model == "3d":  # the line y = 0 of the symmetry plane
-            on = on & (np.abs(c.x[:, 1]) <= 1e-9 * self.block.h)
-        areas = c.surface.nodal_areas(self.block.weight)
-        status = np.where(c.slip, 2, np.where(c.active, 1, 0))
-        rows = gather_rows(self.mesh.comm, c.x[on, 0], c.pressure(self.block.weight)[on],
-                           (c.tangential_forces()[:, 0] / areas)[on], status[on])
-        if rows is None:
-            return None
-        order = np.argsort(rows[0])
-        return tuple(r[order] for r in rows)
+        on = np.abs(c.x[:, 1]) <= 1e-9 * self.block.h if self.model == "3d" else None
+        return c.traction_profile(self.block.weight, on)
 
     def tangential_force_within(self, radii) -> np.ndarray:
-        """Q(r): the tangential force (along x, the whole body's) within each distance r.
-
-        A sum of the nodal forces of the S_C nodes at most r from the axis.
-        """
+        """Q(r): the tangential force (along x, the whole body's) within each distance r."""
         c = self._frictional()
-        r = self.block.radius_of(c.x.T)
-        T_x = np.where(c.owned, c.tangential_forces()[:, 0], 0.0)
-        inside = np.array([T_x[r <= rho].sum() for rho in radii])
-        return self.block.symmetry_factor * self.mesh.comm.allreduce(inside, op=MPI.SUM)
+        return self.block.symmetry_factor * c.force_within(self.block.radius_of(c.x.T), radii)
 
     def nodes_in_contact(self) -> int:
         """Global number of active S_C nodes."""

@@ -18,10 +18,10 @@ from fenics_nl.io import cli, indentation_pictures, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.scenes.punch import Punch, PunchBlock
-from fenics_nl.theory import hertz, mindlin
+from fenics_nl.theory import hertz
 
 __all__ = ["PunchParameters", "StepReport", "block_for", "checkpointing", "compare_with_hertz",
-           "compare_with_mindlin", "contact_radius_for", "pictures", "prefixes", "summary"]
+           "contact_radius_for", "pictures", "prefixes", "summary"]
 
 MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
 
@@ -146,29 +146,39 @@ class HertzCheck:
     exponent: float | None = None
 
 
-def compare_with_hertz(punch: Punch, loading: list) -> HertzCheck:
+def compare_with_hertz(loading: list, hertz_of, model: str, h: float) -> HertzCheck:
     """The last loading state's force, contact radius and largest pressure against Hertz.
 
     The force is not checked for the cylinder; the radius is the outermost active node's.
     Said in one line, and the fitted exponent in another.
+
+    Args:
+        loading: the converged loading states (`indentation`, `force`, `contact_radius`,
+            `max_pressure`).
+        hertz_of: Hertz's values for a state (`Punch.hertz`, or the demo's own).
+        model: ``axisymmetric``, ``3d`` or ``plane_strain``.
+        h: the element size under the punch.
+
+    Returns:
+        The check: Hertz's values, the relative errors, the fitted exponent.
     """
     last = loading[-1]
     if not last.force > 0:
         say("the punch does not touch the block: zero contact force")
         return HertzCheck(None)
-    ref = punch.hertz(last)
+    ref = hertz_of(last)
     errors = {k: getattr(last, k) / ref[k] - 1 for k in ("force", "contact_radius",
                                                          "max_pressure") if k in ref}
     checked = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
                f"{100 * e:+.3f} %)" for k, e in errors.items()]
-    if punch.model == "plane_strain":  # a cylinder: Hertz's a and p0 for the computed P
+    if model == "plane_strain":  # a cylinder: Hertz's a and p0 for the computed P
         checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
-    say("; ".join(checked) + f"; h = {punch.block.h:.2g}")
+    say("; ".join(checked) + f"; h = {h:.2g}")
     exponent = None
     if len(loading) >= 2 and all(s.force > 0 for s in loading):
         exponent = float(np.polyfit(np.log([s.indentation for s in loading]),
                                     np.log([s.force for s in loading]), 1)[0])
-        say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if punch.model == "plane_strain"
+        say(f"P ∝ δ^{exponent:.4f} over the steps" + ("" if model == "plane_strain"
                                                        else " (Hertz: 1.5)"))
     return HertzCheck(ref, errors, exponent)
 
@@ -270,66 +280,3 @@ def block_for(model: str, a: float, *, refine: int, block: float | None, mixed: 
     size = block_size(model, block)
     say(f"meshing the {model} block ({size:g} contact radii) ...")
     return PunchBlock(model, a, refine=refine, block=size, mixed=mixed, tangential=tangential)
-
-
-def compare_with_mindlin(punch: Punch, T, friction: float, bonded: float | None) -> dict:
-    """The partial slip of the tangential state `T` against Cattaneo–Mindlin, for its P.
-
-    The stick radius (half-width) c; in plane strain the tangential traction away from
-    the stick–slip edges (where the exact one has an infinite slope), in 3D the force
-    inside each radius r = k h, Q(r) (P2 nodal forces are no pointwise traction: a
-    vertex's is about 0), and δ_t with the far field's share taken out (`bonded`: the
-    computed compliance before any slip). Said in one line; returned for the JSON.
-    """
-    E, nu, R, h = punch.material.E, punch.material.nu, punch.R, punch.block.h
-    three_d = punch.model == "3d"
-    H = (hertz.sphere_from_force if three_d else hertz.cylinder_from_force)(
-        E, nu, R, T.normal_force)
-    a, p0, fP = H["contact_radius"], H["max_pressure"], friction * T.normal_force
-    if three_d:
-        c = mindlin.sphere_stick_radius(a, T.tangential_force, fP)
-        radii = np.arange(1, int(1.5 * a / h) + 1) * h
-        gap = (punch.tangential_force_within(radii)
-               - mindlin.sphere_tangential_force_within(radii, a, p0, friction, c))
-        out = {"tangential_force_profile_max_error": float(np.abs(gap).max()
-                                                           / T.tangential_force),
-               **_tangential_compliance(T, a, fP, bonded, E, nu)}
-        said = (f"tangential force inside r within "
-                f"{100 * out['tangential_force_profile_max_error']:.2f} % of Q")
-    else:
-        c = mindlin.cylinder_stick_half_width(a, T.tangential_force, fP)
-        x, _, q, _ = punch.traction_profile() or (None,) * 4  # gathered on rank 0
-        comm, out = punch.mesh.comm, {}
-        if comm.rank == 0:
-            away = (np.abs(np.abs(x) - c) > 2 * h) & (np.abs(x) < 1.5 * a)
-            q_exact = mindlin.traction(x, a, p0, friction, c)
-            out["tangential_traction_max_error"] = float(np.abs(q - q_exact)[away].max()
-                                                         / (friction * p0))
-        out = comm.bcast(out, root=0)
-        said = (f"tangential traction within {100 * out['tangential_traction_max_error']:.2f}"
-                f" % of f p0 (beyond 2 h of the stick-slip edges)")
-    out["stick_radius_exact"] = c
-    say(f"Cattaneo-Mindlin: stick {'radius' if three_d else 'half-width'} {c:.5g} (FE: "
-        f"(c - c_exact)/h = {(T.stick_radius - c) / h:+.2f}); " + said)
-    return out
-
-
-def _tangential_compliance(T, a, fP, bonded, E, nu) -> dict:
-    """δ_t against Mindlin's, with the far field's share taken out.
-
-    The finite block (clamped bottom, free sides) adds a far-field compliance C_far to the
-    half-space's; it does not depend on how the contact zone sticks or slips, so the
-    punch's displacement less C_far Q compares with Mindlin's δ_t. C_far is the computed
-    bonded compliance (a move before any slip) less the half-space's (2 − ν)/(8 G a).
-    """
-    G = E / (2 * (1 + nu))
-    exact_bonded = (2 - nu) / (8 * G * a)
-    delta = mindlin.sphere_tangential_displacement(a, T.tangential_force, fP, G, nu)
-    far = (bonded - exact_bonded) * T.tangential_force
-    local = T.tangential_displacement - far
-    say(f"Mindlin: δ_t = {delta:.5g}; FE {T.tangential_displacement:.5g}, less the far "
-        f"field's {far:.3g} (bonded compliance {bonded:.4g} against the half-space's "
-        f"{exact_bonded:.4g}): {100 * (local / delta - 1):+.2f} %")
-    return {"tangential_displacement_exact": delta, "bonded_compliance": bonded,
-            "bonded_compliance_exact": exact_bonded, "tangential_displacement_local": local,
-            "tangential_displacement_rel_error": local / delta - 1}

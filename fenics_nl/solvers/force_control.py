@@ -1,8 +1,10 @@
 """Force control of a problem driven by a prescribed displacement: the displacement of a force.
 
 A rigid punch, a die, a grip: the solver prescribes the displacement d and the force P(d)
-is the result. To reach a given force, d is found by secant steps on (ln d, ln P): exact in
-one step for a power law P ∝ d^m (Hertz's m = 3/2), and quick for laws close to one.
+is the result. To reach a given force, d is found by secant steps: on (ln d, ln P) from
+rest (`reach_force`: exact in one step for a power law P ∝ d^m, Hertz's m = 3/2, and quick
+for laws close to one), or on (d, Q) from a loaded state (`reach_load`: a tangential force
+that bends as the contact slips).
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from collections.abc import Callable
 
 from fenics_nl.errors import SolveError
 
-__all__ = ["reach_force"]
+__all__ = ["reach_force", "reach_load"]
 
 
 def reach_force(state_at: Callable[[float], object], force: float, guess: float, *,
@@ -50,3 +52,42 @@ def reach_force(state_at: Callable[[float], object], force: float, guess: float,
         d0, s0 = d1, s1
         d1 = d1 * (force / s1.force) ** (1 / slope)
     raise SolveError(f"force {force:g} not reached in {max_it} positions")
+
+
+def reach_load(state_at: Callable[[float], object], load: float, start: tuple[float, float],
+               first: float, *, of: Callable[[object], tuple[float, float]], atol: float,
+               max_it: int = 60) -> tuple[object, int]:
+    """The state whose load is `load`, by secant steps on the position from a known state.
+
+    For a load Q(d) that grows with the position d and bends as the body gives way (a
+    tangential force as nodes slip: concave from a full stick), secant steps from the
+    first slope approach the load from its side and do not overshoot.
+
+    Args:
+        state_at: the converged state at the position d.
+        load: the load to reach.
+        start: (d, Q) of the state the steps start from (the last committed one).
+        first: the first position tried (close to the start: the initial slope).
+        of: (d, Q) of a state.
+        atol: the tolerance on the load.
+        max_it: the positions tried at most.
+
+    Returns:
+        (the state at Q = load within atol, the number of `state_at` calls).
+
+    Raises:
+        SolveError: Q does not grow with d, or is not reached in `max_it` positions.
+    """
+    d_prev, q_prev = start
+    s = state_at(first)
+    for k in range(max_it):
+        d, q = of(s)
+        if abs(q - load) <= atol:
+            return s, k + 1
+        slope = (q - q_prev) / (d - d_prev)
+        if not slope > 0:
+            raise SolveError(f"the load does not grow with the position (slope {slope:.3g} "
+                             f"at d = {d:.6g})")
+        d_prev, q_prev = d, q
+        s = state_at(d + (load - q) / slope)
+    raise SolveError(f"load {load:g} not reached in {max_it} positions")
