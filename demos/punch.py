@@ -44,6 +44,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.contact import ContactError, ContactSurface, EliminationSystem, MultiplierSystem
+from fenics_nl.contact.obstacles import RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
@@ -185,30 +186,22 @@ else:
 
 # ### The contact surface and one active-set iteration
 #
-# `ContactSurface` holds the nodes of $S_C$ (the normal component's dofs on the `contact`
-# facets), their gap $\gamma$ and their areas. A *system* solves one iteration for a given
-# set: `set_active(active)` prescribes $u_n = \gamma$ on the active nodes (as Dirichlet
-# rows, or with `--formulation multiplier` through Lagrange multipliers on a facet
-# submesh, the course's saddle point $[K\ {-A};\ {-A^T}\ 0]$), `solve()` runs Newton on the
-# residual (one linear solve for the linear material; after the first iteration, a
-# factorization updated by the rows that changed), `normal_forces()` gives $T_n$ at the
-# nodes. Newton's absolute tolerance is scaled by Hertz's force for the expected $a$.
+# The punch (`RigidPunch`: its surface's height $h(r)$ above $S_C$ at the distance $r$ from
+# its axis) gives the gap $\gamma(x) = h(r) - \delta$. `ContactSurface` holds the nodes of
+# $S_C$ (the normal component's dofs on the `contact` facets), their gap and their areas.
+# A *system* solves one iteration for a given set: `set_active(active)` prescribes
+# $u_n = \gamma$ on the active nodes (as Dirichlet rows, or with `--formulation multiplier`
+# through Lagrange multipliers on a facet submesh, the course's saddle point
+# $[K\ {-A};\ {-A^T}\ 0]$), `solve()` runs Newton on the residual (one linear solve for the
+# linear material; after the first iteration, a factorization updated by the rows that
+# changed), `normal_forces()` gives $T_n$ at the nodes. Newton's absolute tolerance is
+# scaled by Hertz's force for the expected $a$.
 
 
 # +
-def gap(delta):
-    """γ(x): the punch's height above the undeformed surface, less δ."""
-    def at(x):
-        r = np.hypot(x[0], x[1]) if dim == 3 else np.abs(x[0])
-        if args.gap == "parabola":
-            return r**2 / (2 * R) - delta
-        return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
-    return at
-
-
-def radius_of(x):
-    """Distance of the points x (n × 3) from the punch's axis."""
-    return np.hypot(x[:, 0], x[:, 1]) if dim == 3 else np.abs(x[:, 0])
+punch = RigidPunch(R, dim, args.gap)  # its height h(r) above S_C: Hertz's r²/(2R), or the sphere
+gap = punch.gap  # γ(x) = h(r) − δ for the punch pressed by δ
+radius_of = punch.distance  # r, the distance of points (n × 3) from the punch's axis
 
 
 surface = ContactSurface(V, tagged("contact"), gap(0.0), normal_axis=vertical,
@@ -422,7 +415,7 @@ drawn = indentation_pictures.PunchRun(
     profile=surface.gathered(radius_of(surface.x), -T_n / areas, active),
     section=(output.section(w.sub(0).collapse() if args.mixed else w, von_mises(),
                             normal_axis=1 if dim == 3 else None) if args.png else None),
-    gap_at=lambda r, d: gap(d)(np.array([r, 0 * r, 0 * r])), h=h, mixed=args.mixed,
+    gap_at=lambda r, d: punch.height(r) - d, h=h, mixed=args.mixed,
     force_controlled=args.force is not None)
 cli.results(out, [*([lambda: indentation_pictures.curves(drawn, args.plot)] if args.plot
                     else []),

@@ -43,6 +43,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.contact import FrictionalContact
+from fenics_nl.contact.obstacles import RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
@@ -214,24 +215,15 @@ else:
 # punch, a slipping one carries $f|T_n|$ against its slip) and updates them: a closed node
 # in tension opens, a penetrating one closes, a sticking node whose $|T_t|$ exceeds
 # $f|T_n|$ slips, a slipping one whose slip turned back sticks; until they repeat. The
-# slip history is committed at each converged step. Newton's absolute tolerance is scaled
-# by Hertz's force for the expected $a$.
+# slip history is committed at each converged step. The gap is the punch's, as in
+# `punch.py` (`RigidPunch`); Newton's absolute tolerance is scaled by Hertz's force for the
+# expected $a$.
 
 
 # +
-def gap(delta):
-    """γ(x): the punch's height above the undeformed surface, less δ."""
-    def at(x):
-        r = np.hypot(x[0], x[1]) if dim == 3 else np.abs(x[0])
-        if args.gap == "parabola":
-            return r**2 / (2 * R) - delta
-        return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
-    return at
-
-
-def radius_of(x):
-    """Distance of the points x (n × 3) from the punch's axis."""
-    return np.hypot(x[:, 0], x[:, 1]) if dim == 3 else np.abs(x[:, 0])
+punch = RigidPunch(R, dim, args.gap)  # its height h(r) above S_C: Hertz's r²/(2R), or the sphere
+gap = punch.gap  # γ(x) = h(r) − δ for the punch pressed by δ
+radius_of = punch.distance  # r, the distance of points (n × 3) from the punch's axis
 
 
 E_star = hertz.effective_modulus(args.E, args.nu)
@@ -549,7 +541,7 @@ if args.png or args.plot:
                                          contact.active),
         section=(output.section(w.sub(0).collapse() if args.mixed else w, von_mises(),
                                 normal_axis=1 if dim == 3 else None) if args.png else None),
-        gap_at=lambda r, d: gap(d)(np.array([r, 0 * r, 0 * r])), h=h, tangential=args.moved,
+        gap_at=lambda r, d: punch.height(r) - d, h=h, tangential=args.moved,
         mixed=args.mixed, force_controlled=args.force is not None, friction=f, traction=T,
         traction_profile=(None if T is None else (rings, force_within(rings)) if dim == 3
                           else traction_profile()),

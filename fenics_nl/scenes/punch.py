@@ -31,6 +31,7 @@ from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.friction import FrictionalContact
+from fenics_nl.contact.obstacles import BERKOVICH, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
@@ -54,8 +55,6 @@ __all__ = [
 ]
 
 MODELS = ("axisymmetric", "3d", "plane_strain")
-SHAPES = ("parabola", "sphere", "cone")
-BERKOVICH = 70.3  # the half-angle of the cone of the Berkovich tip's area function (degrees)
 
 
 @dataclass
@@ -215,12 +214,7 @@ class Punch:
                  formulation: str = "elimination", gap: str = "parabola",
                  cone_angle: float = BERKOVICH, friction: float | None = None,
                  newton_options: dict | None = None):
-        if not radius > 0:
-            raise ValueError(f"radius must be > 0, got {radius}")
-        if gap not in SHAPES:
-            raise ValueError(f"gap must be one of {', '.join(SHAPES)}, got {gap!r}")
-        if gap == "cone" and not (0 < cone_angle < 90):
-            raise ValueError(f"cone_angle must be in (0, 90) degrees, got {cone_angle!r}")
+        self.obstacle = RigidPunch(radius, 3 if block.model == "3d" else 2, gap, cone_angle)
         if gap == "cone" and block.model == "plane_strain":
             raise ValueError("a cone is axisymmetric or 3D: use --model axisymmetric or 3d")
         self.block, self.material, self.residual = block, material, residual
@@ -264,17 +258,11 @@ class Punch:
 
     def gap_at(self, r, delta: float):
         """γ(r) = the punch's height above the undeformed surface at distance r, minus δ."""
-        R = self.R
-        r = np.asarray(r, dtype=float)
-        if self.gap_shape == "cone":
-            return r * self.cot - delta
-        if self.gap_shape == "parabola":
-            return r**2 / (2 * R) - delta
-        return np.where(r < R, R - np.sqrt(np.clip(R * R - r * r, 0, None)), R) - delta
+        return self.obstacle.height(r) - delta
 
     def gap(self, delta: float):
         """γ(x) of the punch pressed by δ, for the contact surface."""
-        return lambda x: self.gap_at(self.block.radius_of(x), delta)
+        return self.obstacle.gap(delta)
 
     def indent(self, delta: float) -> Indentation:
         """Press the punch down by δ (from the last state's active set)."""
