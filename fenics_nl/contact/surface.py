@@ -114,7 +114,7 @@ class ContactSurface:
         For a profile along the surface: `gathered(r, p, active)`. Collective.
 
         Args:
-            *columns: arrays of one value per node of S_C (this rank's view); the first is
+            columns: arrays of one value per node of S_C (this rank's view); the first is
                 the sort key.
 
         Returns:

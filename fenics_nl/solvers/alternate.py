@@ -56,7 +56,7 @@ class AlternateWork:
         """One load step's solves (a step solved again counts in the same step).
 
         Args:
-            *solves: the step's `AlternateResult`s, whose iterations are added up.
+            solves: the step's results (`AlternateResult`), whose iterations are added up.
         """
         self.iterations.append(sum(r.iterations for r in solves))
         self.newton_iterations += sum(r.newton_iterations for r in solves)
