@@ -32,14 +32,26 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.contact import ActiveSetContact
+from fenics_nl.contact.obstacles import Indentation, RigidPunch
+from fenics_nl.contact.surface import check_contact_resolution
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import graded_block
 from fenics_nl.domain.probes import Probes
-from fenics_nl.io import cli
+from fenics_nl.io import cli, indentation_pictures, indentation_record, output
 from fenics_nl.io.parameters import number, switch
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes import punch_run
-from fenics_nl.scenes.punch import Punch, PunchLoad, check_contact_resolution
+from fenics_nl.solvers.force_control import MotionPath
 from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.theory import hertz
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
 
@@ -52,7 +64,7 @@ cli.run_script(__name__)  # as a script: this file runs under the demo contract,
 
 # +
 @dataclass
-class Indentation(punch_run.PunchParameters):
+class Imprint(punch_run.PunchParameters):
     """Rigid spherical punch on a J2 elastoplastic block, loaded and unloaded: the
     load-depth curve and the residual imprint. Units are the user's, consistent."""
 
@@ -72,51 +84,156 @@ class Indentation(punch_run.PunchParameters):
                              "control: drop --force, or add --loading-only")
 
 
-args = cli.arguments(Indentation,
-                     prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
-unload = not args.loading_only
+args = cli.arguments(Imprint, prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
+R, model, unload = args.radius, args.model, not args.loading_only
 # -
 
-# ### The block and the plastic material
+# ### The mesh, the space and the supports
 #
-# The block of `punch.py`. `J2Plasticity` keeps its state (plastic strain, cumulated
-# plastic strain) at the quadrature points of the block's rule; its stress at a step is
-# the derivative of the step's condensed energy after the radial return, and its tangent
-# the consistent one, both by UFL.
+# The block of `punch.py`: graded from elements of $h = a/20$ under the punch (plane
+# strain $a/40$, 3D $a/6$, halved by each `--refine`) for Hertz's contact radius $a$ of
+# the load, 1000 contact radii wide (3D: 100); its bottom slides on a rigid base and the
+# symmetry planes hold their normal component. P1 displacements, or with `--mixed`
+# Taylor–Hood (P2 displacements, P1 pressure).
 
 # +
-a = punch_run.contact_radius_for(args.model, args.E, args.nu, args.radius, args.indentation,
-                                 args.force)
-block = punch_run.block_for(args.model, a, refine=args.refine, block=args.block,
-                            mixed=args.mixed)
+a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
+dim = 3 if model == "3d" else 2
+vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
+h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
+growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
+size = punch_run.block_size(model, args.block)
+cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
+mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth)
+msh = mesh_data.mesh
+
+
+def tagged(name):
+    """The facets of the physical group `name`."""
+    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+
+symmetry = {"axisymmetric": 1.0, "3d": 4.0, "plane_strain": 2.0}[model]  # whole / modelled
+degree = 2 if args.mixed else 1
+if args.mixed:
+    W = mixed.taylor_hood(msh, degree)
+    w = fem.Function(W, name="displacement_pressure")
+    (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(W)
+    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+else:
+    V = fem.functionspace(msh, ("Lagrange", degree, (dim,)))
+    w = u = fem.Function(V, name="displacement")
+    v = ufl.TestFunction(V)
+parts = mixed.unknown_of(w)  # u (and p) as Functions of their own, to write out
+bcs = [boundary.component(V, 0, tagged("symmetry_x")),
+       boundary.component(V, vertical, tagged("bottom"))]
+if dim == 3:
+    bcs.append(boundary.component(V, 1, tagged("symmetry_y")))
+# -
+
+# ### The plastic material and the residual
+#
+# `J2Plasticity` keeps its state (plastic strain, cumulated plastic strain) at the
+# quadrature points of the residual's rule. Its stress at a step is the derivative of the
+# step's condensed energy after the radial return, and its tangent the consistent one,
+# both by UFL; the residual is the same $\int_\Omega \sigma(\varepsilon(u)) :
+# \varepsilon(v)\,d\Omega$ as for the elastic punch.
+
+# +
 material = J2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
-material.bind(block.mesh, block.quadrature_degree)
-punch = Punch(block, material, block.residual(material), args.radius,
-              formulation=args.formulation, gap=args.gap)
-cli.say(f"{args.model} punch, {args.formulation}, {punch.dofs} unknowns, h = {block.h:.3g}")
+material.bind(msh, 2 * degree)
+kinematic = "3d" if dim == 3 else model  # the strain model: hoop strain if axisymmetric
+dx = kinematics.quadrature_measure("dx", msh, 2 * degree)
+weight = kinematics.measure_weight(msh, kinematic)  # 2πr, or 1
+if args.mixed:
+    residual = mixed.internal_work(material, u, p, v, q, kinematic) * dx
+else:
+    def eps(z):
+        return kinematics.small_strain(z, kinematic)
+
+    residual = ufl.inner(material.stress(eps(u)), eps(v)) * weight * dx
+# -
+
+# ### The contact on the `contact` tag
+#
+# The course's active set of `punch.py` (`ActiveSetContact` runs the loop written out
+# there) with the punch's gap $\gamma = h(r) - \delta$. Each of its iterations is now a
+# Newton solve of the plastic residual, with a line search; Newton's absolute tolerance is
+# scaled by Hertz's force for the expected $a$.
+
+# +
+punch = RigidPunch(R, dim, args.gap)
+E_star = hertz.effective_modulus(args.E, args.nu)
+P_scale = (np.pi / 4 * E_star * a * a / R if model == "plane_strain"
+           else 4 / 3 * E_star * a**3 / R)
+newton = {"line_search": True, "force_scale": P_scale / symmetry}
+if args.mixed and args.formulation == "elimination":  # a symmetric saddle point: LDLᵀ
+    newton["linear_solver"] = "cholesky"
+contact = ActiveSetContact(residual, w, bcs, tagged("contact"), punch.gap(0.0),
+                           normal_axis=vertical, formulation=args.formulation,
+                           initial="penetrating", newton_options=newton,
+                           prefix=f"punch_{model}_", displacement_space=V if args.mixed else None)
+cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unknowns, "
+        f"h = {h:.3g}")
 # -
 
 # ### Loading, then unloading
 #
-# Each load step is an active-set loop whose iterations are Newton solves of the plastic
-# residual; a converged step commits the plastic state (`commit`), which is where the next
-# step starts from. Unloading runs the load factor back from 1 to 0: the active set shrinks
-# and the punch leaves the block with no force.
+# Each load step is an active-set loop at the punch's depth $\delta$ (with `--force`, the
+# depth of the step's force); a converged step commits the plastic state, which is where
+# the next step starts from. Unloading runs the load factor back from 1 to 0: the active
+# set shrinks and the punch leaves the block with no force.
 
 # +
-load = PunchLoad(punch, indentation=args.indentation, force=args.force,
-                 first_guess=a * a / args.radius)
-report = punch_run.StepReport(load.states, args.steps, args.steps * (2 if unload else 1),
-                              punch.output_fields)
+def press(delta):
+    """The converged state of the punch pressed by δ, from the last active set."""
+    contact.set_gap(punch.gap(delta))
+    contact.add_penetrating()
+    with contact.reusing_residual():  # the forces below read the loop's last R(u)
+        res = contact.solve()
+        r = punch.distance(contact.x[contact.active])
+        p_max = global_max(msh.comm, contact.pressure(weight)[contact.active])
+    return Indentation(delta, symmetry * contact.force, global_max(msh.comm, r), p_max,
+                       res.active_set_iterations, res.iterations, res.work.factorizations)
+
+
+def von_mises():
+    """σ_eq per cell (DG0)."""
+    if args.mixed:
+        return mixed.von_mises(material, u, p, kinematic, msh)
+    return material.von_mises(u, kinematic)
+
+
+def fields():
+    """What --output writes: u (and p), the contact pressure and set, σ_eq, the plastic state."""
+    return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
+            *contact.fields(weight), von_mises(), *material.output_fields()]
+
+
+def report(t, result):
+    """Say and keep (JSON) the state just converged (unloading: t counts down)."""
+    s, k = load.states[-1], len(load.states)
+    cli.converged_step({"load_factor": t if k <= args.steps else 1 - t,
+                        "indentation": s.indentation, "force": s.force,
+                        "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
+                        "active_set_iterations": s.active_set_iterations}, fields=fields)
+    cli.say(f"step {k}/{args.steps * (2 if unload else 1)}: δ = {s.indentation:.5g}, P = "
+            f"{s.force:.6g}, a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
+            f"{s.active_set_iterations} active-set iterations")
 
 
 def commit():
-    material.commit(block.u, block.kinematics)
+    """The converged step's plastic state becomes the next step's start."""
+    material.commit(u, kinematic)
 
 
-# --restart: the displacement, the plastic state, the statuses and the states back;
-# --checkpoint: saved after each converged step of the loading
-checkpoints = punch_run.checkpointing(punch, load, material.state_functions())
+load = MotionPath(press, w, displacement=args.indentation, force=args.force, guess=a * a / R)
+# --checkpoint: the displacement, the plastic state, the active set and the states after
+# each converged step of the loading; --restart takes them back
+checkpoints = cli.checkpointing({"unknown": w, **material.state_functions()},
+                                newton=contact.newton, contact=contact, kept=load.record)
+if checkpoints.kept is not None:
+    load.take_back(checkpoints.kept, Indentation)
 solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
                     on_step=report, commit=commit, **checkpoints.options)
 # -
@@ -127,16 +244,34 @@ solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=F
 
 # +
 loaded = list(load.states)
-nodes = punch.nodes_in_contact()
-warnings = check_contact_resolution(nodes, block.h, loaded[-1])
-check = punch_run.compare_with_hertz(loaded, punch.hertz, punch.model, punch.block.h)
+nodes = contact.surface.count(contact.active)
+warnings = check_contact_resolution(nodes, h, loaded[-1])
+
+
+def hertz_of(state):
+    """Elastic Hertz for the state: the cylinder's for its P, the sphere's for its δ."""
+    if model == "plane_strain":
+        return hertz.cylinder_from_force(args.E, args.nu, R, state.force)
+    return hertz.sphere_from_indentation(args.E, args.nu, R, state.indentation)
+
+
+check = punch_run.compare_with_hertz(loaded, hertz_of, model, h)  # said in a line
 warnings.append("j2 material: Hertz's values are the linear reference, not a check")
-p = material.cumulated_plastic_strain
-plastic_strain = global_max(block.mesh.comm,
-                            p.x.array[:p.function_space.dofmap.index_map.size_local])
+p_cum = material.cumulated_plastic_strain
+plastic_strain = global_max(msh.comm,
+                            p_cum.x.array[:p_cum.function_space.dofmap.index_map.size_local])
 cli.say(f"largest cumulated plastic strain {plastic_strain:.4g}")
-drawn = punch_run.pictures(punch, load.states, check, png=args.png, plot=args.plot,
-                           force_controlled=args.force is not None, plastic=True)
+drawn = None
+if args.png or args.plot:  # the states unloaded later join the curve only
+    drawn = indentation_pictures.PunchRun(
+        model, load.states, check.ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
+        profile=contact.surface.gathered(punch.distance(contact.x), contact.pressure(weight),
+                                         contact.active),
+        section=(output.section(parts.displacement(), von_mises(),
+                                normal_axis=1 if dim == 3 else None) if args.png else None),
+        gap_at=lambda r, d: punch.height(r) - d, h=h, mixed=args.mixed,
+        force_controlled=args.force is not None, loading_steps=len(load.states),
+        plastic=True)
 # -
 
 # ### The imprint
@@ -148,22 +283,38 @@ imprint = None
 if unload:
     solve_incrementally(load, lambda t: load.set_load(1 - t), args.steps, adaptive=False,
                         predictor=False, on_step=report, commit=commit)
-    axis = [0.0] * (3 if args.model == "3d" else 2)
-    imprint = -Probes(block.mesh, [axis]).continuous(block.displacement())[0][block.vertical]
+    axis = [0.0] * dim
+    imprint = -Probes(msh, [axis]).continuous(parts.displacement())[0][vertical]
     cli.say(f"unloaded: residual imprint depth {imprint:.5g} at the axis (δ_max = "
             f"{loaded[-1].indentation:.5g})")
 
 # ## Outputs
 #
-# The JSON (the loaded state, the unloading path, the imprint), and when asked the fields
-# of every step for ParaView (with the plastic strains), the load–depth curve, loading and
-# unloading, and the block at the largest load coloured by the von Mises stress.
+# The JSON (the loaded state, the unloading path, the imprint, the supports' reactions),
+# and when asked the fields of every step for ParaView (with the plastic strains), the
+# load–depth curve, loading and unloading, and the block at the largest load coloured by
+# the von Mises stress.
 
-out = punch_run.summary(punch, load.states, loaded, nodes, check, "j2", warnings,
-                        formulation=args.formulation)
-out["max_cumulated_plastic_strain"] = plastic_strain
+# +
+out = indentation_record.record(load.states, loaded[-1], check, model=model,
+                                formulation=args.formulation, material="j2",
+                                mixed=args.mixed, h=h, nodes=nodes)
+if model == "plane_strain" and check.ref is not None:
+    warnings.append("plane strain: the force is not checked (a cylinder's indentation "
+                    "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
+                    "checked against Hertz for the computed P")
+groups = {name: tagged(name) for name in ("contact", "bottom", "symmetry_x")
+          + (("symmetry_y",) if dim == 3 else ())}
+out.update(reactions=boundary.reactions(residual, w, groups, space=V if args.mixed else None),
+           reactions_of=punch_run.REACTIONS_OF[model][False],
+           dofs=output.dofs(w.function_space), ranks=msh.comm.size, warnings=warnings,
+           max_cumulated_plastic_strain=plastic_strain)
 if imprint is not None:
     out["residual_imprint_depth"] = imprint
     out["unloading"] = [{"indentation": s.indentation, "force": s.force}
                         for s in load.states[args.steps:]]
-cli.results(out, drawn)
+cli.results(out, [*([lambda: indentation_pictures.curves(drawn, args.plot)] if args.plot
+                    else []),
+                  *([lambda: indentation_pictures.section_picture(drawn, args.png)]
+                    if args.png else [])])
+# -

@@ -145,6 +145,7 @@ else:
     V = fem.functionspace(msh, ("Lagrange", degree, (dim,)))
     w = u = fem.Function(V, name="displacement")
     v = ufl.TestFunction(V)
+parts = mixed.unknown_of(w)  # u (and p) as Functions of their own, to write out
 bcs = [boundary.component(V, vertical, tagged("bottom")),
        boundary.component(V, 0, tagged("symmetry_x"))]
 if dim == 3:
@@ -304,9 +305,7 @@ def press(delta, verbose=True):
 
 def fields():
     """What --output writes: u (and p), the contact pressure and set, σ_eq."""
-    u_out = w.sub(0).collapse() if args.mixed else w
-    u_out.name = "displacement"
-    return [u_out, *([w.sub(1).collapse()] if args.mixed else []),
+    return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
             surface.nodal_field(-T_n / areas, "contact_pressure"),
             surface.nodal_field(active.astype(float), "active_set"), von_mises()]
 
@@ -413,7 +412,7 @@ out.update(
 drawn = indentation_pictures.PunchRun(
     model, states, ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
     profile=surface.gathered(radius_of(surface.x), -T_n / areas, active),
-    section=(output.section(w.sub(0).collapse() if args.mixed else w, von_mises(),
+    section=(output.section(parts.displacement(), von_mises(),
                             normal_axis=1 if dim == 3 else None) if args.png else None),
     gap_at=lambda r, d: punch.height(r) - d, h=h, mixed=args.mixed,
     force_controlled=args.force is not None)

@@ -31,7 +31,7 @@
 # ## Implementation
 
 # +
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
 
@@ -43,19 +43,18 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.contact import FrictionalContact
-from fenics_nl.contact.obstacles import RigidPunch
+from fenics_nl.contact.obstacles import Indentation, RigidPunch, Traction
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
-from fenics_nl.io import cli, indentation_pictures, output
+from fenics_nl.io import cli, indentation_pictures, indentation_record, output
 from fenics_nl.io.parameters import choice, number
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.parallel import global_max
 from fenics_nl.scenes import punch_run
-from fenics_nl.solvers.force_control import reach_force, reach_load
+from fenics_nl.solvers.force_control import MotionPath, reach_load
 from fenics_nl.solvers.loading import solve_incrementally
-from fenics_nl.solvers.result import SolveResult, WorkCounts
 from fenics_nl.theory import hertz, mindlin
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
@@ -176,6 +175,7 @@ else:
     V = fem.functionspace(msh, ("Lagrange", degree, (dim,)))
     w = u = fem.Function(V, name="displacement")
     v = ufl.TestFunction(V)
+parts = mixed.unknown_of(w)  # u (and p) as Functions of their own, to write out
 if args.moved:
     bcs = [boundary.fixed(V, tagged("bottom"))]
 else:
@@ -246,21 +246,11 @@ cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unk
 # secant steps on $\ln P(\ln \delta)$), each from the last statuses plus every node that
 # penetrates now; the converged step is committed (the slip history). With friction the
 # surface under the punch is held back from its inward slip (Spence's problem) unless
-# $\nu = 1/2$. `solve_incrementally` drives the steps so that `--checkpoint` and
-# `--restart` can save and take back the state after each.
+# $\nu = 1/2$. `solve_incrementally` drives the steps (`MotionPath`: the load factor
+# scales $\delta$, or $P$), so that `--checkpoint` and `--restart` can save and take back
+# the state after each.
 
 # +
-@dataclass
-class State:
-    indentation: float
-    force: float  # the whole body's (per unit length in plane strain)
-    contact_radius: float  # the outermost closed node's distance from the axis
-    max_pressure: float
-    active_set_iterations: int
-    newton_iterations: int
-    factorizations: int
-
-
 def press(delta):
     """The converged state of the punch pressed by δ, from the last statuses."""
     contact.set_gap(gap(delta))
@@ -269,37 +259,14 @@ def press(delta):
         res = contact.solve()
         r = radius_of(contact.x[contact.active])
         p_max = global_max(msh.comm, contact.pressure(weight)[contact.active])
-    return State(delta, symmetry * contact.force, global_max(msh.comm, r), p_max,
-                 res.active_set_iterations, res.iterations, res.work.factorizations)
-
-
-class NormalLoad:
-    """The load path as `solve_incrementally` drives it: `u`, and `solve()` at factor `t`."""
-
-    def __init__(self):
-        self.u, self.t, self.t_last, self.states = w, 0.0, 0.0, []
-
-    def solve(self):
-        t, done = self.t, self.states
-        if args.force is None:
-            s = press(t * args.indentation)
-        else:  # Hertz's δ ∝ P^(2/3), from the last step (the first: from a²/R)
-            guess = (done[-1].indentation * (t / self.t_last) ** (2 / 3) if done
-                     else a * a / R * t ** (2 / 3))
-            s, _ = reach_force(press, t * args.force, guess)
-        done.append(s)
-        self.t_last = t
-        return SolveResult(True, "punch state", s.newton_iterations, [],
-                           WorkCounts(factorizations=s.factorizations),
-                           active_set_iterations=s.active_set_iterations)
+    return Indentation(delta, symmetry * contact.force, global_max(msh.comm, r), p_max,
+                       res.active_set_iterations, res.iterations, res.work.factorizations)
 
 
 def fields():
     """What --output writes: u (and p), the contact pressure and statuses, σ_eq."""
-    u_out = w.sub(0).collapse() if args.mixed else w
-    u_out.name = "displacement"
-    return [u_out, *([w.sub(1).collapse()] if args.mixed else []), *contact.fields(weight),
-            von_mises()]
+    return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
+            *contact.fields(weight), von_mises()]
 
 
 def von_mises():
@@ -320,17 +287,15 @@ def report(t, result):
             f"{s.active_set_iterations} active-set iterations")
 
 
-load = NormalLoad()
+# the load factor t scales δ (or P: δ by secant steps on ln P(ln δ), from δ ∝ t^(2/3))
+load = MotionPath(press, w, displacement=args.indentation, force=args.force, guess=a * a / R)
 # --checkpoint: the displacement, the statuses and slip history, the states after each step
 checkpoints = cli.checkpointing({"unknown": w}, newton=contact.newton, contact=contact,
-                                kept=lambda: {"states": [asdict(s) for s in load.states],
-                                              "t": load.t_last})
+                                kept=load.record)
 if checkpoints.kept is not None:  # --restart: they are back
-    load.states[:] = [State(**s) for s in checkpoints.kept["states"]]
-    load.t_last = checkpoints.kept["t"]
-solve_incrementally(load, lambda t: setattr(load, "t", t), args.steps, adaptive=False,
-                    predictor=False, on_step=report, commit=contact.commit,
-                    **checkpoints.options)
+    load.take_back(checkpoints.kept, Indentation)
+solve_incrementally(load, load.set_load, args.steps, adaptive=False, predictor=False,
+                    on_step=report, commit=contact.commit, **checkpoints.options)
 pressed = load.states[-1]
 nodes = contact.surface.count(contact.active)
 warnings = check_contact_resolution(nodes, h, pressed)
@@ -346,19 +311,6 @@ warnings = check_contact_resolution(nodes, h, pressed)
 # punch's displacement that Mindlin's half-space has not, and it is taken out below.
 
 # +
-@dataclass
-class Traction:
-    tangential_displacement: float  # the punch's d
-    tangential_force: float  # Q, the whole body's (per unit length in plane strain)
-    normal_force: float  # P, the same way
-    stick_radius: float  # the outermost sticking node's distance from the axis
-    stick_nodes: int
-    slip_nodes: int
-    status_iterations: int
-    newton_iterations: int
-    factorizations: int
-
-
 def shift(d):
     """The pressed punch moved to x = d: the statuses' loop from the last ones."""
     contact.set_motion([d] + [0.0] * (len(contact.axes) - 1))
@@ -422,17 +374,6 @@ if args.moved:
 # displacement $\delta_t(Q)$, less the far field's share.
 
 # +
-out = {"model": model, "formulation": args.formulation, "material": "linear",
-       "mixed": args.mixed, "elements": "P2-P1 (Taylor-Hood)" if args.mixed else "P1",
-       **{k: getattr(pressed, k) for k in ("force", "indentation", "contact_radius",
-                                           "max_pressure")},
-       "element_size": h, "nodes_in_contact": nodes,
-       **{k: sum(getattr(s, k) for s in load.states)
-          for k in ("active_set_iterations", "newton_iterations", "factorizations")},
-       "indentation_history": [s.indentation for s in load.states],
-       "force_history": [s.force for s in load.states]}
-
-
 def hertz_of(state):
     """Hertz's values: the cylinder's for the computed P, the sphere's for δ."""
     if model == "plane_strain":
@@ -442,10 +383,9 @@ def hertz_of(state):
 
 check = punch_run.compare_with_hertz(load.states, hertz_of, model, h)  # said in a line
 ref = check.ref
-for k, error in check.errors.items():
-    out[f"hertz_{k}"], out[f"{k}_rel_error"] = ref[k], error
-if check.exponent is not None:
-    out["fitted_exponent"] = check.exponent
+out = indentation_record.record(load.states, pressed, check, model=model,
+                                formulation=args.formulation, material="linear",
+                                mixed=args.mixed, h=h, nodes=nodes)
 
 
 def traction_profile():
@@ -523,8 +463,6 @@ if model == "plane_strain" and ref is not None:
 groups = {name: tagged(name) for name in ("contact", "bottom")
           + (() if args.moved else ("symmetry_x",)) + (("symmetry_y",) if dim == 3 else ())}
 out.update(
-    steps=[{k: getattr(s, k) for k in ("indentation", "force", "contact_radius",
-                                       "active_set_iterations")} for s in load.states],
     reactions=boundary.reactions(residual, w, groups, space=V if args.mixed else None),
     reactions_of=punch_run.REACTIONS_OF[model][args.moved],
     dofs=output.dofs(w.function_space), ranks=msh.comm.size, warnings=warnings, friction=f)
@@ -539,7 +477,7 @@ if args.png or args.plot:
         model, load.states, ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
         profile=contact.surface.gathered(radius_of(contact.x), contact.pressure(weight),
                                          contact.active),
-        section=(output.section(w.sub(0).collapse() if args.mixed else w, von_mises(),
+        section=(output.section(parts.displacement(), von_mises(),
                                 normal_axis=1 if dim == 3 else None) if args.png else None),
         gap_at=lambda r, d: punch.height(r) - d, h=h, tangential=args.moved,
         mixed=args.mixed, force_controlled=args.force is not None, friction=f, traction=T,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BERKOVICH", "SHAPES", "RigidPunch"]
+__all__ = ["BERKOVICH", "SHAPES", "Indentation", "RigidPunch", "Traction"]
 
 SHAPES = ("parabola", "sphere", "cone")
 BERKOVICH = 70.3  # the half-angle of the cone of the Berkovich tip's area function (degrees)
@@ -83,3 +83,31 @@ class RigidPunch:
             γ(x) = h(r) − δ for points x given as 3 × n.
         """
         return lambda x: self.height(self.distance(np.asarray(x).T)) - delta
+
+
+@dataclass
+class Indentation:
+    """One converged state of a punch pressed into a body (the whole body's force)."""
+
+    indentation: float
+    force: float  # total (axisymmetric, 3D) or per unit length (plane strain)
+    contact_radius: float  # radius (half-width in plane strain) of the last active node
+    max_pressure: float
+    active_set_iterations: int
+    newton_iterations: int
+    factorizations: int
+
+
+@dataclass
+class Traction:
+    """One converged state of a punch moved along x after pressing it (with friction)."""
+
+    tangential_displacement: float  # the punch's, since the unloaded state
+    tangential_force: float  # Q, total (3D) or per unit length (plane strain)
+    normal_force: float  # P, the same way
+    stick_radius: float  # the outermost sticking node's distance from the axis
+    stick_nodes: int
+    slip_nodes: int
+    status_iterations: int
+    newton_iterations: int
+    factorizations: int

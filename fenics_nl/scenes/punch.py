@@ -20,9 +20,7 @@ at 10 % (the default, L = 100a, h = a/12).
 
 from __future__ import annotations
 
-import dataclasses
 import math
-from dataclasses import dataclass
 
 import numpy as np
 import ufl
@@ -31,58 +29,27 @@ from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.friction import FrictionalContact
-from fenics_nl.contact.obstacles import BERKOVICH, RigidPunch
+from fenics_nl.contact.obstacles import BERKOVICH, Indentation, RigidPunch, Traction
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
-from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.mixed import unknowns
 from fenics_nl.parallel import global_max
-from fenics_nl.solvers.force_control import reach_force, reach_load
-from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.force_control import reach_load
 from fenics_nl.theory import hertz
 
 __all__ = [
     "Indentation",
     "Punch",
     "PunchBlock",
-    "PunchLoad",
     "Traction",
     "build_punch",
     "check_contact_resolution",
 ]
 
 MODELS = ("axisymmetric", "3d", "plane_strain")
-
-
-@dataclass
-class Indentation:
-    """One converged state of the punch."""
-
-    indentation: float
-    force: float  # total (axisymmetric, 3D) or per unit length (plane strain)
-    contact_radius: float  # radius (half-width in plane strain) of the last active node
-    max_pressure: float
-    active_set_iterations: int
-    newton_iterations: int
-    factorizations: int
-
-
-@dataclass
-class Traction:
-    """One converged state of the punch moved tangentially (along x) after pressing it."""
-
-    tangential_displacement: float  # the punch's, since the unloaded state
-    tangential_force: float  # Q, total (3D) or per unit length (plane strain)
-    normal_force: float  # P, the same way
-    stick_radius: float  # the outermost sticking node's distance from the axis
-    stick_nodes: int
-    slip_nodes: int
-    status_iterations: int
-    newton_iterations: int
-    factorizations: int
 
 
 class PunchBlock:
@@ -346,20 +313,6 @@ class Punch:
         r = self.block.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
         return global_max(self.mesh.comm, r)
 
-    def push(self, force: float, delta0: float) -> tuple[Indentation, int]:
-        """Force control: δ with P(δ) = force (`solvers.force_control.reach_force`)."""
-        return reach_force(self.indent, force, delta0)
-
-    def surface_profile(self):
-        """(r, p, active) of every S_C node, gathered on rank 0 and sorted by r (else None).
-
-        p is the nodal contact pressure (positive in compression), r the distance from the
-        axis (the half-width coordinate in plane strain).
-        """
-        c = self.contact
-        return c.surface.gathered(self.block.radius_of(c.x.T), c.pressure(self.block.weight),
-                                  c.active)
-
     def traction_profile(self):
         """(x, p, q, status) of the S_C nodes on y = 0 (3D) or all (2D), on rank 0 sorted by x.
 
@@ -373,91 +326,3 @@ class Punch:
         """Q(r): the tangential force (along x, the whole body's) within each distance r."""
         c = self._frictional()
         return self.block.symmetry_factor * c.force_within(self.block.radius_of(c.x.T), radii)
-
-    def nodes_in_contact(self) -> int:
-        """Global number of active S_C nodes."""
-        return self.contact.surface.count(self.contact.active)
-
-    def von_mises(self) -> fem.Function:
-        """σ_eq per cell (DG0), with the hoop strain in the axisymmetric model."""
-        b = self.block
-        if b.mixed:
-            return mixed_form.von_mises(self.material, b.u, b.p, b.kinematics, b.mesh)
-        return self.material.von_mises(self.u, b.kinematics)
-
-    def contact_fields(self) -> list[fem.Function]:
-        """Nodal contact pressure and active set (1/0) on S_C, to write out."""
-        return self.contact.fields(self.block.weight)
-
-    def output_fields(self) -> list[fem.Function]:
-        """What --output writes of a state.
-
-        The displacement (and the pressure if mixed), the contact pressure and active set,
-        σ_eq, and a path-dependent law's state.
-        """
-        b = self.block
-        return [b.displacement(), *([b.fields.pressure()] if b.mixed else []),
-                *self.contact_fields(), self.von_mises(),
-                *(self.material.output_fields() if self.material.path_dependent else [])]
-
-    def reactions(self) -> dict[str, list[float]]:
-        """Resultant force on each constrained group of the modelled part (`boundary`).
-
-        A node shared by two groups (a corner) counts in the first: contact, bottom, symmetry.
-        """
-        return boundary.reactions(self.residual, self.u, self.block.groups, space=self.block.V)
-
-    def hertz(self, state: Indentation) -> dict[str, float]:
-        """Hertz's values for this state (sphere: from δ; cylinder: a, p0 from the computed P)."""
-        E, nu = float(self.material.E), float(self.material.nu)
-        if self.model == "plane_strain":  # a cylinder: no force-indentation law to check
-            return hertz.cylinder_from_force(E, nu, self.R, state.force)
-        if self.gap_shape == "cone":
-            return hertz.cone_from_indentation(E, nu, self.cot, state.indentation)
-        return hertz.sphere_from_indentation(E, nu, self.R, state.indentation)
-
-
-class PunchLoad:
-    """The punch's load path as a solver for `loading.solve_incrementally`.
-
-    The load factor t scales the indentation δ (displacement control) or the force P
-    (force control: δ found by `Punch.push`, started from δ ∝ t^(2/3) as in Hertz).
-    Each converged state is kept in `states`.
-    """
-
-    def __init__(self, punch: Punch, *, indentation: float | None = None,
-                 force: float | None = None, first_guess: float | None = None):
-        if (indentation is None) == (force is None):
-            raise ValueError("give either an indentation or a force")
-        self.punch, self.u = punch, punch.u
-        self.indentation, self.force, self.first_guess = indentation, force, first_guess
-        self.states: list[Indentation] = []
-        self.t, self._t_last = 0.0, 0.0
-
-    def set_load(self, t: float) -> None:
-        """The load factor of the next solve."""
-        self.t = t
-
-    def record(self) -> dict:
-        """The converged states and the last load factor, JSON-able (for a checkpoint)."""
-        return {"states": [dataclasses.asdict(s) for s in self.states], "t": self._t_last}
-
-    def take_back(self, record: dict) -> None:
-        """The states of `record()` back, the next solve's guess from the last of them."""
-        self.states[:] = [Indentation(**s) for s in record["states"]]
-        self._t_last = record["t"]
-
-    def solve(self) -> SolveResult:
-        """The state at the current load factor, from the last one."""
-        if self.force is None:
-            s = self.punch.indent(self.t * self.indentation)
-        else:
-            guess = (self.states[-1].indentation * (self.t / self._t_last) ** (2 / 3)
-                     if self.states else self.first_guess * self.t ** (2 / 3))
-            s, _ = self.punch.push(self.t * self.force, guess)
-        self.punch.commit()  # the start of the next step (friction's slip history)
-        self.states.append(s)
-        self._t_last = self.t
-        work = WorkCounts(factorizations=s.factorizations)
-        return SolveResult(True, "punch state", s.newton_iterations, [], work,
-                           active_set_iterations=s.active_set_iterations)

@@ -1,9 +1,10 @@
-"""What the three punch demos share: flags, step report, Hertz's check, JSON, pictures.
+"""What the three punch demos share: their flags, the block's size, Hertz's check.
 
 `demos/punch.py` (Hertz), `demos/punch_friction.py` (Cattaneo–Mindlin) and
-`demos/indentation.py` (J2: load, unload, imprint) each tell their own story; the block,
-the load path and its report, the comparison with Hertz and the outputs are the same in
-all three, and live here.
+`demos/indentation.py` (J2: load, unload, imprint) each build their block, residual,
+contact and load steps in their own cells; their flags (`PunchParameters`), the contact
+radius and block size the mesh is made for, and the comparison of a loaded state with
+Hertz are the same in all three.
 """
 
 from __future__ import annotations
@@ -14,14 +15,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from fenics_nl.io import cli, indentation_pictures, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
-from fenics_nl.scenes.punch import Punch, PunchBlock
 from fenics_nl.theory import hertz
 
-__all__ = ["PunchParameters", "StepReport", "block_for", "checkpointing", "compare_with_hertz",
-           "contact_radius_for", "pictures", "prefixes", "summary"]
+__all__ = ["REACTIONS_OF", "HertzCheck", "PunchParameters", "block_size", "compare_with_hertz",
+           "contact_radius_for", "prefixes"]
 
 MAX_REFINE = 6  # a/1280 under the punch (plane strain a/2560): ~1e6 unknowns
 
@@ -108,32 +107,6 @@ def block_size(model: str, block: float | None) -> float:
 
 
 @dataclass
-class StepReport:
-    """The `on_step` of `solve_incrementally`: each converged state said and kept in the JSON.
-
-    `loading_steps` steps load the punch; those after them (an unloading) count the load
-    factor down. `fields()` gives what --output writes at the step.
-    """
-
-    states: list
-    loading_steps: int
-    total_steps: int
-    fields: object
-
-    def __call__(self, t, result) -> None:
-        """Say and keep the state just converged at load factor `t`."""
-        s = self.states[-1]
-        cli.converged_step({"load_factor": t if len(self.states) <= self.loading_steps else 1 - t,
-                            "indentation": s.indentation, "force": s.force,
-                            "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,
-                            "active_set_iterations": s.active_set_iterations},
-                           fields=self.fields)
-        say(f"step {len(self.states)}/{self.total_steps}: δ = {s.indentation:.5g}, P = "
-            f"{s.force:.6g}, a = {s.contact_radius:.5g}, p0 = {s.max_pressure:.5g}, "
-            f"{s.active_set_iterations} active-set iterations")
-
-
-@dataclass
 class HertzCheck:
     """The loaded state against Hertz.
 
@@ -189,94 +162,3 @@ REACTIONS_OF = {"axisymmetric": ("the whole body (2πr in the residual)",) * 2,
                                  "the whole block, per unit length")}
 
 
-def summary(punch: Punch, states: list, loading: list, nodes: int, check: HertzCheck,
-            material: str, warnings: list[str], *, formulation: str) -> dict:
-    """The JSON every punch run has: the loaded state, its check, the steps, the work."""
-    block, last, mixed = punch.block, loading[-1], punch.block.mixed is not None
-    out = {"model": punch.model, "formulation": formulation, "material": material,
-           "mixed": mixed, "elements": "P2-P1 (Taylor-Hood)" if mixed else "P1",
-           "force": last.force, "indentation": last.indentation,
-           "contact_radius": last.contact_radius, "max_pressure": last.max_pressure,
-           "element_size": block.h, "nodes_in_contact": nodes,
-           "active_set_iterations": sum(s.active_set_iterations for s in states),
-           "newton_iterations": sum(s.newton_iterations for s in states),
-           "factorizations": sum(s.factorizations for s in states),
-           # every converged step, loading and unloading: the curve P(δ)
-           "indentation_history": [s.indentation for s in states],
-           "force_history": [s.force for s in states],
-           "steps": [{"indentation": s.indentation, "force": s.force,
-                      "contact_radius": s.contact_radius,
-                      "active_set_iterations": s.active_set_iterations} for s in states],
-           "reactions": punch.reactions(),
-           "reactions_of": REACTIONS_OF[punch.model][block.tangential],
-           "dofs": punch.dofs, "ranks": punch.mesh.comm.size, "warnings": warnings}
-    if check.exponent is not None:
-        out["fitted_exponent"] = check.exponent
-    for k, e in check.errors.items():
-        out[f"hertz_{k}"], out[f"{k}_rel_error"] = check.ref[k], e
-    if punch.model == "plane_strain" and check.ref is not None:
-        warnings.append("plane strain: the force is not checked (a cylinder's indentation "
-                        "depends on the block, Hertz gives no P(δ)); half-width and p0 are "
-                        "checked against Hertz for the computed P")
-    return out
-
-
-def pictures(punch: Punch, states: list, check: HertzCheck, *, png: str | None,
-             plot: str | None, force_controlled: bool = False, friction=None, traction=None,
-             stick_radius_exact=None, plastic: bool = False) -> list:
-    """The writers of the pictures asked for (`png`, `plot`: their paths, or None).
-
-    They draw the state at hand (gathered now: collective); states added to `states` later
-    (an unloading) join the curve only.
-    """
-    if not (png or plot):
-        return []
-    profile = None
-    if traction is not None:
-        if punch.model == "3d":  # Q(r), the force inside r
-            rings = np.linspace(0.0, 1.5, 301) * states[-1].contact_radius
-            profile = (rings, punch.tangential_force_within(rings))
-        else:
-            profile = punch.traction_profile()
-    block = punch.block
-    section = (output.section(block.displacement(), punch.von_mises(),
-                              normal_axis=1 if block.vertical == 2 else None)
-               if png else None)
-    material = punch.material
-    run = indentation_pictures.PunchRun(
-        punch.model, states, check.ref, float(material.E), float(material.nu), punch.R,
-        rank0=punch.mesh.comm.rank == 0, profile=punch.surface_profile(), section=section,
-        gap_at=punch.gap_at, h=block.h, tangential=block.tangential,
-        mixed=block.mixed is not None, force_controlled=force_controlled,
-        friction=friction, traction=traction,
-        traction_profile=profile, stick_radius_exact=stick_radius_exact,
-        loading_steps=len(states), plastic=plastic)
-    writers = []
-    if plot:  # (--output: the fields of every step were written as they converged)
-        writers.append(lambda: indentation_pictures.curves(run, plot))
-    if png:
-        writers.append(lambda: indentation_pictures.section_picture(run, png))
-    return writers
-
-
-def checkpointing(punch: Punch, load, state: dict | None = None) -> cli.Checkpointing:
-    """--checkpoint / --restart of a punch's loading (`cli.checkpointing`).
-
-    Saved after each converged step: the unknown, the law's `state` functions, the contact
-    statuses (with friction its slip history) and the load's states; with --restart they
-    are put back now, the states into `load`.
-    """
-    checkpoints = cli.checkpointing({"unknown": punch.block.unknown, **(state or {})},
-                                    newton=punch.contact.newton, contact=punch.contact,
-                                    kept=load.record)
-    if checkpoints.kept is not None:
-        load.take_back(checkpoints.kept)
-    return checkpoints
-
-
-def block_for(model: str, a: float, *, refine: int, block: float | None, mixed: bool,
-              tangential: bool = False) -> PunchBlock:
-    """The graded block for the expected contact radius `a` (said while it is made)."""
-    size = block_size(model, block)
-    say(f"meshing the {model} block ({size:g} contact radii) ...")
-    return PunchBlock(model, a, refine=refine, block=size, mixed=mixed, tangential=tangential)

@@ -9,12 +9,14 @@ that bends as the contact slips).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 
 from fenics_nl.errors import SolveError
+from fenics_nl.solvers.result import SolveResult, WorkCounts
 
-__all__ = ["reach_force", "reach_load"]
+__all__ = ["MotionPath", "reach_force", "reach_load"]
 
 
 def reach_force(state_at: Callable[[float], object], force: float, guess: float, *,
@@ -91,3 +93,87 @@ def reach_load(state_at: Callable[[float], object], load: float, start: tuple[fl
         d_prev, q_prev = d, q
         s = state_at(d + (load - q) / slope)
     raise SolveError(f"load {load:g} not reached in {max_it} positions")
+
+
+class MotionPath:
+    """A load path by a prescribed motion, as `loading.solve_incrementally` drives a solver.
+
+    The load factor t scales the displacement, d = t `displacement`, or the force,
+    P = t `force`: d is then found by `reach_force`, from d ∝ t^(1/m) (the last step's d,
+    or `guess` at t = 1 for the first). Each converged state is kept in `states`.
+
+    Args:
+        state_at: the converged state at the displacement d: a dataclass record with its
+            `force` and the work it took (`newton_iterations`, `factorizations`,
+            `active_set_iterations`).
+        u: the unknown the states are solved for (the driver restores it after a failure).
+        displacement: the displacement at t = 1 (displacement control), or None.
+        force: the force at t = 1 (force control), or None.
+        guess: force control: the displacement expected at t = 1.
+        exponent: force control: the m of P ∝ d^m expected (Hertz's 3/2).
+    """
+
+    def __init__(self, state_at: Callable[[float], object], u, *,
+                 displacement: float | None = None, force: float | None = None,
+                 guess: float | None = None, exponent: float = 1.5):
+        if (displacement is None) == (force is None):
+            raise ValueError("give either a displacement or a force")
+        self.state_at, self.u = state_at, u
+        self.displacement, self.force, self.guess = displacement, force, guess
+        self.exponent = exponent
+        self.states: list = []
+        self.positions: list[float] = []  # the displacement of each state
+        self.t, self.t_last = 0.0, 0.0
+
+    def set_load(self, t: float) -> None:
+        """The load factor of the next solve.
+
+        Args:
+            t: the load factor.
+        """
+        self.t = t
+
+    def solve(self) -> SolveResult:
+        """The state at the current load factor, from the last one.
+
+        Returns:
+            Its work as a converged SolveResult (iterations: Newton's).
+        """
+        t, tried = self.t, []
+
+        def at(d):  # the state at d; the last d tried is the answer's
+            tried.append(d)
+            return self.state_at(d)
+
+        if self.force is None:
+            s = at(t * self.displacement)
+        else:
+            d0, t0 = (self.positions[-1], self.t_last) if self.positions else (self.guess, 1.0)
+            s, _ = reach_force(at, t * self.force, d0 * (t / t0) ** (1 / self.exponent),
+                               exponent=self.exponent)
+        self.states.append(s)
+        self.positions.append(tried[-1])
+        self.t_last = t
+        return SolveResult(True, "prescribed motion", s.newton_iterations, [],
+                           WorkCounts(factorizations=s.factorizations),
+                           active_set_iterations=s.active_set_iterations)
+
+    def record(self) -> dict:
+        """The converged states, their displacements and the last load factor, JSON-able.
+
+        Returns:
+            What `take_back` takes (a checkpoint's).
+        """
+        return {"states": [dataclasses.asdict(s) for s in self.states],
+                "positions": self.positions, "t": self.t_last}
+
+    def take_back(self, record: dict, state_type: type) -> None:
+        """The states of `record()` back: the next solve goes on from the last of them.
+
+        Args:
+            record: what `record` gave.
+            state_type: the states' dataclass.
+        """
+        self.states[:] = [state_type(**s) for s in record["states"]]
+        self.positions[:] = record["positions"]
+        self.t_last = record["t"]
