@@ -124,7 +124,7 @@ def tagged(name):
     return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
 
 
-# the modelled part's share of the whole body (2πr is in the axisymmetric residual)
+# the whole body's force over the modelled part's (2πr is in the axisymmetric residual)
 symmetry = {"axisymmetric": 1.0, "3d": 4.0, "plane_strain": 2.0}[model]
 # -
 

@@ -78,18 +78,19 @@ class CattaneoMindlin(punch_run.PunchParameters):
                         "(normal load only)", spelling=True)
     nu: float = number(0.5, "Poisson's ratio (at 1/2, where Cattaneo-Mindlin is exact, with "
                        "Taylor-Hood elements)", unit="-")
-    refine: int = number(0, "element size under the punch a/(40·2^refine) (3D: a/(6·2^refine))",
-                         at_least=0, at_most=punch_run.MAX_REFINE)
+    refine: int = number(0, "element size under the punch a/(20·2^refine) (plane strain: "
+                         "a/(40·2^refine), 3D: a/(6·2^refine))", at_least=0,
+                         at_most=punch_run.MAX_REFINE)
     block: float = number(100.0, "block size in contact radii, >= 10 (on both sides of the "
                           "punch with a tangential load)", above=0)
     friction: float = number(0.3, "Coulomb friction coefficient f (statuses open / stick / "
                              "slip)", at_least=0, metavar="F")
     tangential_ratio: float | None = number(
-        None, "after the normal load, a tangential force Q = R f P along x, 0 <= R < 1 "
-        "(default 0.5; axisymmetric: none)", at_least=0, group="tangential", metavar="R")
+        None, "after the normal load, a tangential force Q = R f P along x, 0 < R < 1 "
+        "(default 0.5; axisymmetric: none)", above=0, group="tangential", metavar="R")
     tangential_force: float | None = number(
         None, "after the normal load, the tangential force Q (per unit length in plane "
-        "strain), below f P", unit="force", at_least=0, group="tangential", metavar="Q")
+        "strain), below f P", unit="force", above=0, group="tangential", metavar="Q")
     tangential_displacement: float | None = number(
         None, "after the normal load, move the punch by D along +x", unit="length", above=0,
         group="tangential", metavar="D")
@@ -153,7 +154,7 @@ def tagged(name):
     return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
 
 
-# the modelled part's share of the whole body (2πr is in the axisymmetric residual)
+# the whole body's force over the modelled part's (2πr is in the axisymmetric residual)
 symmetry = {"axisymmetric": 1.0, "3d": 4.0, "plane_strain": 2.0}[model] / (1 + args.moved)
 # -
 

@@ -94,6 +94,17 @@ def test_a_script_that_never_reports_its_results_fails(tmp_path):
     assert helped.returncode == 0 and "never reports" in helped.stdout, helped.stderr
 
 
+def test_a_script_that_forgot_run_script_refuses_its_flags(tmp_path):
+    # without the run, the flags would be ignored and nothing written, with status 0
+    import subprocess
+
+    script = tmp_path / "norun.py"
+    script.write_text(FORGETFUL.replace("cli.run_script(__name__)\n", ""))
+    proc = subprocess.run([sys.executable, script, "--x", "2"], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode != 0 and "cli.run_script(__name__)" in proc.stderr, proc.stderr
+
+
 LONELY = '''from dataclasses import dataclass
 
 import fenics_nl  # noqa: F401

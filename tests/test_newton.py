@@ -9,6 +9,7 @@ from petsc4py import PETSc
 from problems import cantilever_3d
 
 from fenics_nl.materials.laws import PowerLaw
+from fenics_nl.solvers.convergence import ConvergenceTest
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
 from fenics_nl.solvers.snes import EventCounter, SnesSolver
@@ -273,3 +274,16 @@ def test_a_snes_solver_leaves_no_option_behind_for_the_next_one():
     modified = SnesSolver(p.residual, p.u, p.bcs, prefix="reused_", method="modified",
                           max_it=200).solve()
     assert modified.converged and modified.work.factorizations == 1
+
+
+def test_the_convergence_test_newton_arc_length_and_snes_share():
+    # ‖R‖ ≤ max(rtol ‖R0‖, atol F); max_it; divergence after the first iteration only, and
+    # off for a tolerance <= 0 (PETSc's -snes_divergence_tolerance -1)
+    t = ConvergenceTest(rtol=1e-6, atol=1e-8, max_it=3, divergence_tol=1e4)
+    assert t.reason([1.0], 1.0) is None
+    assert t.reason([1.0, 2e-6, 9e-7], 1.0) == "converged"  # rtol ‖R0‖
+    assert t.reason([1.0, 2e-3], 1e5) is None and t.reason([1.0, 9e-4], 1e5) == "converged"
+    assert t.reason([1.0, 0.5, 0.4, 0.3], 1.0) == "max_it"
+    assert t.reason([1.0, 2e4], 1.0) == "diverged" and t.reason([1.0, 9e3], 1.0) is None
+    assert t.reason([1.0, math.nan], 1.0) == "nan" and t.reason([math.inf], 1.0) == "nan"
+    assert ConvergenceTest(divergence_tol=-1).reason([1.0, 1e12], 1.0) is None

@@ -206,7 +206,7 @@ class FrictionalContact(ActiveSetContact):
             on: a mask of the nodes (default all); this rank's owned ones are taken.
 
         Returns:
-            On rank 0: the first coordinate x, the contact pressure p, the tangential
+            On rank 0, the first coordinate x, the contact pressure p, the tangential
             traction q along the first tangential axis (nodal forces over nodal areas) and
             the status (0 open, 1 stick, 2 slip) of each node; None on the other ranks.
         """

@@ -42,7 +42,8 @@ class RigidPunch:
         if not self.radius > 0:
             raise ValueError(f"radius must be > 0, got {self.radius}")
         if self.shape not in SHAPES:
-            raise ValueError(f"gap must be one of {', '.join(SHAPES)}, got {self.shape!r}")
+            raise ValueError(f"the punch's shape (--gap) must be one of {', '.join(SHAPES)}, "
+                             f"got {self.shape!r}")
         if self.shape == "cone" and not (0 < self.cone_angle < 90):
             raise ValueError(f"cone_angle must be in (0, 90) degrees, got {self.cone_angle!r}")
 

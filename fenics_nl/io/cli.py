@@ -330,8 +330,8 @@ def run_script(name: str) -> None:
     """``python demos/x.py ...``: run the demo under the scene contract, then end the process.
 
     A demo calls ``cli.run_script(__name__)`` after its imports. Run as a script (`name` is
-    ``__main__`` outside IPython), it executes the demo file (``sys.argv[0]``) once more in
-    this process, as `run_file` does, on every rank, and ends the process with the run's
+    ``__main__`` outside IPython), it executes the script's file (``__main__``'s) once more
+    in this process, as `run_file` does, on every rank, and ends the process with the run's
     status: 0; 1 for a failed output or a bug (its traceback); 2 for a library error (one
     line, the JSON of the converged steps first) or a PETSc option that no solver read.
     Anywhere else (a notebook, `run_file`, an import) it does nothing.
@@ -339,9 +339,10 @@ def run_script(name: str) -> None:
     Args:
         name: the calling module's ``__name__``.
     """
-    if name != "__main__" or _current is not None or _in_ipython():
+    path = getattr(sys.modules.get("__main__"), "__file__", None)
+    if name != "__main__" or _current is not None or _in_ipython() or path is None:
         return
-    status = _run(Path(sys.argv[0]), sys.argv[1:], script=True)
+    status = _run(Path(path), sys.argv[1:], script=True)
     sys.stdout.flush()
     sys.stderr.flush()
     if status == 2 and MPI.Is_initialized() and not MPI.Is_finalized():
@@ -378,6 +379,10 @@ def _run(path: Path, argv: Sequence[str], script: bool) -> int:
             sys.stdout.flush()
             _abort(2)
         return _failed(run, err)
+    except KeyboardInterrupt:
+        if script and MPI.COMM_WORLD.size > 1:  # no collective clean-up: end every rank
+            _abort(130)
+        raise
     except Exception:
         if not script:
             raise
@@ -420,6 +425,9 @@ def arguments(parser, prefixes: dict[str, str] | Callable[[argparse.Namespace], 
     cls, parser = (parser, parameters.parser_of(parser)) if declared else (None, parser)
     global _notebook_args
     run = _current
+    if run is None and not _in_ipython() and sys.argv[1:]:
+        raise RuntimeError("a demo's flags are read within its run: call "
+                           "cli.run_script(__name__) after the imports")
     argv = run.argv if run else shlex.split(os.environ.get(NOTEBOOK_ARGS, ""))
     args, petsc = parse_with_petsc_options(parser, argv)
     if declared:

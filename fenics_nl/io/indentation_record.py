@@ -28,8 +28,8 @@ def record(states: list, loaded, check, *, model: str, formulation: str, materia
         nodes: the nodes in contact at the largest load.
 
     Returns:
-        The record: the loaded state, the work, the histories, the steps, Hertz's values
-        and the relative errors (``hertz_<k>``, ``<k>_rel_error``), the fitted exponent.
+        The record of the loaded state, the work, the histories, the steps, Hertz's values
+        and the relative errors (``hertz_<k>``, ``<k>_rel_error``) and the fitted exponent.
     """
     out = {"model": model, "formulation": formulation, "material": material,
            "mixed": mixed, "elements": "P2-P1 (Taylor-Hood)" if mixed else "P1",

@@ -34,9 +34,10 @@ class PunchParameters(Parameters):
     """
 
     EPILOG = ("PETSc options of this run's solver take the prefix -punch_<model>_<form>_, "
-              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (KSP of each "
-              "active-set iteration) | mult (SNES and KSP of the saddle point), e.g. "
-              "-punch_axisymmetric_elim_ksp_view. An option no solver reads is an error.")
+              "<model> = axisymmetric | 3d | plane_strain, <form> = elim (the KSP and "
+              "-snes_* options of each active-set iteration's Newton) | mult (SNES and KSP of "
+              "the saddle point), e.g. -punch_axisymmetric_elim_ksp_view. An option no solver "
+              "reads is an error.")
     OUTPUTS: ClassVar = {
         "output": "displacement, von Mises stress (j2: plastic strains), contact pressure and "
                   "active set",
@@ -85,7 +86,8 @@ class PunchParameters(Parameters):
 def prefixes(model: str, formulation: str) -> dict[str, str]:
     """The PETSc prefix of a punch's solver, and what reads it (`cli.arguments`)."""
     return {f"punch_{model}_{formulation[:4]}_":
-            "KSP" if formulation == "elimination" else "SNES and KSP"}
+            "Newton's KSP and -snes_* options" if formulation == "elimination"
+            else "SNES and KSP"}
 
 
 def contact_radius_for(model: str, E: float, nu: float, radius: float,
@@ -133,7 +135,7 @@ def compare_with_hertz(loading: list, hertz_of, model: str, h: float) -> HertzCh
         h: the element size under the punch.
 
     Returns:
-        The check: Hertz's values, the relative errors, the fitted exponent.
+        The check (Hertz's values, the relative errors, the fitted exponent).
     """
     last = loading[-1]
     if not last.force > 0:

@@ -464,7 +464,8 @@ class ArcLength:
                     b_old.destroy()
                     b_old = None
                 k = len(norms) - 1
-                self._largest = max(self._largest, norms[0])
+                if math.isfinite(norms[0]):
+                    self._largest = max(self._largest, norms[0])
                 reason = test.reason(norms, c.q_norm)  # F: the reference load's ‖q‖
                 if reason in ("nan", "diverged"):
                     raise _StepFailed(f"the corrector diverged: |R| = {rnorm:.3e} at "
@@ -472,7 +473,7 @@ class ArcLength:
                 if on_arc and (reason == "converged" or at_round_off(
                         norms, self._largest, test.threshold(norms[0], c.q_norm))):
                     return _Increment(du, dlam, k, c.ds)
-                if reason == "max_it":
+                if k >= test.max_it:  # converged off the arc counts too: no endless loop
                     raise _StepFailed(f"no convergence in {k} iterations (|R| = {rnorm:.3e})")
                 s.set_forcing(rnorm, norms[0])  # an iterative solver's tolerance
                 if s.update_tangent(k, work):

@@ -35,9 +35,10 @@ class ConvergenceTest:
         rtol: tolerance relative to the first residual of the solve.
         atol: tolerance relative to the force scale F (dimensionless too).
         max_it: iterations before the solve fails (PETSc's ``max_it``).
-        divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ fails the solve (PETSc's
-            ``-snes_divergence_tolerance``; larger than PETSc's 1e4: a first iteration of a
-            large load step may rise that much and still converge).
+        divergence_tol: ‖R‖ > divergence_tol ‖R₀‖ after the first iteration fails the solve
+            (PETSc's ``-snes_divergence_tolerance``, and as in PETSc a value <= 0 turns the
+            test off; larger than PETSc's 1e4: a first iteration of a large load step may
+            rise that much and still converge).
     """
 
     rtol: float = 1e-10
@@ -75,7 +76,7 @@ class ConvergenceTest:
             return "converged"
         if k >= self.max_it:
             return "max_it"
-        if r > self.divergence_tol * norms[0]:
+        if k > 0 and self.divergence_tol > 0 and r > self.divergence_tol * norms[0]:
             return "diverged"
         return None
 
@@ -105,7 +106,8 @@ class ConvergenceTest:
             fnorm = xyf_norms[2]
             if it == 0:
                 norms.clear()
-                largest[0] = max(largest[0], fnorm)
+                if math.isfinite(fnorm):  # an infinite one would make every test pass
+                    largest[0] = max(largest[0], fnorm)
             norms.append(fnorm)
             force = 1.0 if absolute else (force_scale or largest[0])
             reason = test.reason(norms, force)
@@ -122,8 +124,8 @@ _SNES_REASONS = {None: _R.ITERATING, "nan": _R.DIVERGED_FUNCTION_NANORINF,
                  "max_it": _R.DIVERGED_MAX_IT, "diverged": _R.DIVERGED_DTOL}
 
 
-def at_round_off(norms: Sequence[float], largest: float, threshold: float) -> bool:
-    """‖R‖ has stopped falling, 1e6 below the run's largest and within 1e4 of the tolerance.
+def at_round_off(norms: Sequence[float], largest: float, threshold: float = math.inf) -> bool:
+    """‖R‖ has stopped falling, 1e6 below the run's largest (and within 1e4 of the tolerance).
 
     A slender body's internal forces are far larger than its load (membrane forces), and
     near a critical point K is nearly singular and amplifies the round-off of each
@@ -137,11 +139,12 @@ def at_round_off(norms: Sequence[float], largest: float, threshold: float) -> bo
     Args:
         norms: ‖R‖ at iterations 0, 1, ..., k.
         largest: the largest first residual of the run (the internal forces' scale).
-        threshold: the residual norm the test asks for.
+        threshold: the residual norm the test asks for: arc-length accepts a step whose ‖R‖
+            stalls within 1e4 of it; by default none (Newton's diagnosis of a failed solve,
+            whatever its tolerance).
 
     Returns:
-        Whether ‖R‖ stalls at round-off (arc-length accepts such a step; Newton fails with
-        the advice to raise atol).
+        Whether ‖R‖ stalls at round-off.
     """
     low = min(1e-6 * largest, 1e4 * threshold)
     if (len(norms) >= 3 and norms[-2] <= 1e-2 * norms[-3] and norms[-1] > 0.5 * norms[-2]

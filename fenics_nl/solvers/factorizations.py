@@ -35,7 +35,7 @@ class Factorizations:
     residual is exact). A restarted run has no factorization in memory: where the
     uninterrupted one kept one across the restart point, the restart makes one more, on
     the same path. `ksp` is the solver of the tangent last assembled (the solver's own,
-    or the copy's): solve through it, not through `NewtonSolver.ksp`.
+    or the copy's): solve through it, not through the solver's own KSP.
     """
 
     def __init__(self, A: PETSc.Mat, ksp: PETSc.KSP, make_ksp):

@@ -118,6 +118,8 @@ class MotionPath:
                  guess: float | None = None, exponent: float = 1.5):
         if (displacement is None) == (force is None):
             raise ValueError("give either a displacement or a force")
+        if force is not None and not (guess is not None and guess > 0):
+            raise ValueError("force control needs the displacement expected at t = 1 (guess)")
         self.state_at, self.u = state_at, u
         self.displacement, self.force, self.guess = displacement, force, guess
         self.exponent = exponent
@@ -137,7 +139,7 @@ class MotionPath:
         """The state at the current load factor, from the last one.
 
         Returns:
-            Its work as a converged SolveResult (iterations: Newton's).
+            Its work as a converged SolveResult, whose iterations are Newton's.
         """
         t, tried = self.t, []
 

@@ -184,8 +184,9 @@ class NewtonSolver:
             preconditions GMRES, not CG, which may diverge there.
         preconditioner: with ``gamg`` on a mixed (u, p) unknown, the block-diagonal
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
-        prefix: PETSc options prefix of the KSP (``-{prefix}ksp_view``, ...): every choice
-            above can be overridden from the command line.
+        prefix: PETSc options prefix of the linear solver (``-{prefix}ksp_view``,
+            ``-{prefix}pc_type``, ...: the command line overrides the linear solver's choices)
+            and of the three ``-{prefix}snes_*`` options above.
 
     Terms that no integral gives (point forces, the springs of friction's slip) reach the
     tangent and the residual through one hook, `nodal` (`solvers.nodal.NodalTerms`), owned
@@ -617,8 +618,9 @@ class NewtonSolver:
     # -- pieces ----------------------------------------------------------------------
 
     def _force(self, r0: float) -> float:
-        """F: `force_scale`, or the largest first residual seen (this one included)."""
-        self._largest_r0 = max(self._largest_r0, r0)
+        """F: `force_scale`, or the largest finite first residual seen (this one included)."""
+        if math.isfinite(r0):  # an infinite one would make every later test pass
+            self._largest_r0 = max(self._largest_r0, r0)
         return self._force_scale or self._largest_r0
 
     def _failure(self, reason: str, norms: list[float]) -> str:

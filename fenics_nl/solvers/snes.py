@@ -184,8 +184,7 @@ class SnesSolver:
             self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.A.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         self.snes.setConvergenceHistory(reset=True)
-        self.convergence = ConvergenceTest(rtol, atol, max_it)  # NewtonSolver's test
-        self.convergence.attach(self.snes, force_scale)
+        ConvergenceTest(rtol, atol, max_it).attach(self.snes, force_scale)  # Newton's test
         # time of each residual norm, as SolveResult.elapsed. The monitor holds the list,
         # not self: a cycle self → snes → monitor → self would leave the PETSc objects to the
         # garbage collector, which destroys them in a different order on each rank (hang).
