@@ -44,7 +44,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from fenics_nl.contact import ContactError, ContactSurface, EliminationSystem, MultiplierSystem
-from fenics_nl.contact.obstacles import RigidPunch
+from fenics_nl.contact.obstacles import Indentation, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import graded_block
@@ -270,20 +270,10 @@ def active_set_loop(active, verbose):
 # whole body's), the radius of the outermost active node and the largest nodal pressure
 # $p_j = -T_{n,j}/m_j$ ($m_j$ the node's area). With `--force`, the δ of each step's force
 # is found by secant steps on $\ln P(\ln\delta)$ (`reach_force`; Hertz: a slope of 3/2),
-# each an active-set loop.
+# each an active-set loop whose work counts in the step's. The states are
+# `contact.obstacles.Indentation` records.
 
 # +
-@dataclass
-class State:
-    indentation: float
-    force: float
-    contact_radius: float
-    max_pressure: float
-    active_set_iterations: int
-    newton_iterations: int
-    factorizations: int
-
-
 active = surface.sync(surface.normal_gap(w) >= 0)  # S_C^(0): what touches already
 areas = surface.nodal_areas(weight)
 
@@ -298,9 +288,9 @@ def press(delta, verbose=True):
     active = surface.sync(active | (surface.normal_gap(w) > 0))
     active, T_n, work = active_set_loop(active, verbose)
     r = radius_of(surface.x[active])
-    return State(delta, -symmetry * surface.total(T_n), global_max(msh.comm, r),
-                 global_max(msh.comm, (-T_n / areas)[active]), work["iterations"],
-                 work["newton"], work["factorizations"])
+    return Indentation(delta, -symmetry * surface.total(T_n), global_max(msh.comm, r),
+                       global_max(msh.comm, (-T_n / areas)[active]), work["iterations"],
+                       work["newton"], work["factorizations"])
 
 
 def fields():
@@ -325,7 +315,8 @@ for step in range(1, args.steps + 1):
     else:  # Hertz's δ ∝ P^(2/3) from the last step (the first: from a² / R)
         guess = (states[-1].indentation * (step / (step - 1)) ** (2 / 3) if states
                  else a * a / R * t ** (2 / 3))
-        s, _ = reach_force(lambda d: press(d, verbose=False), t * args.force, guess)
+        s, tried = reach_force(lambda d: press(d, verbose=False), t * args.force, guess)
+        s = s.plus_work_of(x for _, x in tried[:-1])  # the work of every δ tried counts
     states.append(s)
     cli.converged_step({"load_factor": t, "indentation": s.indentation, "force": s.force,
                         "contact_radius": s.contact_radius, "max_pressure": s.max_pressure,

@@ -8,6 +8,7 @@ height of its surface above the flat one at the distance r from its axis.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -97,6 +98,21 @@ class Indentation:
     active_set_iterations: int
     newton_iterations: int
     factorizations: int
+
+    def plus_work_of(self, others) -> Indentation:
+        """This state with the work of `others` added (the states tried before it).
+
+        Args:
+            others: states whose work led to this one (force control's positions).
+
+        Returns:
+            A copy of this state whose iteration and factorization counts are the sums.
+        """
+        others = list(others)
+        return dataclasses.replace(self, **{k: getattr(self, k) + sum(getattr(o, k)
+                                                                     for o in others)
+                                            for k in ("active_set_iterations",
+                                                      "newton_iterations", "factorizations")})
 
 
 @dataclass

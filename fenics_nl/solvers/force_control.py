@@ -22,7 +22,7 @@ __all__ = ["MotionPath", "reach_force", "reach_load"]
 def reach_force(state_at: Callable[[float], object], force: float, guess: float, *,
                 exponent: float = 1.5, rtol: float = 1e-10, max_it: int = 30
                 ) -> tuple[object, int]:
-    """The state whose `force` is `force`, and the number of states it took.
+    """The state whose `force` is `force`, and the states it took.
 
     Args:
         state_at: the converged state at a prescribed displacement d (a record with its
@@ -34,19 +34,26 @@ def reach_force(state_at: Callable[[float], object], force: float, guess: float,
         max_it: the states tried at most.
 
     Returns:
-        (the state at P = force within rtol, the number of `state_at` calls).
+        (the state at P = force within rtol, every (d, state) tried, in order: the work
+        spent is theirs all).
 
     Raises:
         SolveError: the force is not reached in `max_it` states.
     """
     if not force > 0:
         raise ValueError(f"force must be > 0, got {force}")
-    d0, s0 = guess, state_at(guess)
+    tried = []
+
+    def at(d):
+        tried.append((d, state_at(d)))
+        return tried[-1][1]
+
+    d0, s0 = guess, at(guess)
     d1 = d0 * (force / s0.force) ** (1 / exponent) if s0.force > 0 else 2 * d0
-    for k in range(max_it - 1):
-        s1 = state_at(d1)
+    for _ in range(max_it - 1):
+        s1 = at(d1)
         if abs(s1.force / force - 1) < rtol:
-            return s1, k + 2
+            return s1, tried
         if s1.force <= 0 or s0.force <= 0 or s1.force == s0.force:  # not touching yet
             d0, s0, d1 = d1, s1, 1.5 * d1
             continue
@@ -103,9 +110,9 @@ class MotionPath:
     or `guess` at t = 1 for the first). Each converged state is kept in `states`.
 
     Args:
-        state_at: the converged state at the displacement d: a dataclass record with its
-            `force` and the work it took (`newton_iterations`, `factorizations`,
-            `active_set_iterations`).
+        state_at: the converged state at the displacement d: a record with its `force`, the
+            work it took (`newton_iterations`, `factorizations`, `active_set_iterations`)
+            and `plus_work_of(states)` (`contact.obstacles.Indentation`).
         u: the unknown the states are solved for (the driver restores it after a failure).
         displacement: the displacement at t = 1 (displacement control), or None.
         force: the force at t = 1 (force control), or None.
@@ -141,20 +148,17 @@ class MotionPath:
         Returns:
             Its work as a converged SolveResult, whose iterations are Newton's.
         """
-        t, tried = self.t, []
-
-        def at(d):  # the state at d; the last d tried is the answer's
-            tried.append(d)
-            return self.state_at(d)
-
+        t = self.t
         if self.force is None:
-            s = at(t * self.displacement)
-        else:
+            d = t * self.displacement
+            s = self.state_at(d)
+        else:  # the step's state, with the work of every position tried to reach its force
             d0, t0 = (self.positions[-1], self.t_last) if self.positions else (self.guess, 1.0)
-            s, _ = reach_force(at, t * self.force, d0 * (t / t0) ** (1 / self.exponent),
-                               exponent=self.exponent)
+            s, tried = reach_force(self.state_at, t * self.force,
+                                   d0 * (t / t0) ** (1 / self.exponent), exponent=self.exponent)
+            d, s = tried[-1][0], s.plus_work_of(x for _, x in tried[:-1])
         self.states.append(s)
-        self.positions.append(tried[-1])
+        self.positions.append(d)
         self.t_last = t
         return SolveResult(True, "prescribed motion", s.newton_iterations, [],
                            WorkCounts(factorizations=s.factorizations),
