@@ -41,7 +41,7 @@ from fenics_nl.contact import ActiveSetContact
 from fenics_nl.contact.obstacles import Indentation, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import graded_block
+from fenics_nl.domain.meshes import punch_block
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import cli, indentation_pictures, indentation_record, output
 from fenics_nl.io.parameters import number, switch
@@ -100,11 +100,9 @@ R, model, unload = args.radius, args.model, not args.loading_only
 a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
-growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
 size = punch_run.block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
-mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth)
+mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size)
 msh = mesh_data.mesh
 
 

@@ -47,7 +47,7 @@ from fenics_nl.contact import ContactError, ContactSurface, EliminationSystem, M
 from fenics_nl.contact.obstacles import Indentation, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import graded_block
+from fenics_nl.domain.meshes import punch_block
 from fenics_nl.io import cli, indentation_pictures, output
 from fenics_nl.io.parameters import choice, number
 from fenics_nl.materials import kinematics, mixed
@@ -104,18 +104,17 @@ R, model = args.radius, args.model
 # 1.5 a of the axis, growing by 5 % of the distance away from it (plane strain 20 %, 3D
 # 10 %). On the axisymmetric model this keeps the block-size and far-field error near
 # 0.15 %, below the 0.5 % asked of the force (measured in `benchmarks/contact.py`). The
-# mesh is made for Hertz's contact radius of the load. gmsh tags its facets: `contact`
-# (the top, $S_C$), `bottom`, `symmetry_x`, `symmetry_y` (3D) and `side`.
+# mesh is made for Hertz's contact radius of the load by `punch_block` (gmsh), which tags
+# its facets: `contact` (the top, $S_C$), `bottom`, `symmetry_x`, `symmetry_y` (3D) and
+# `side`.
 
 # +
 a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
-growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
 size = punch_run.block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
-mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth)
+mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size)
 msh = mesh_data.mesh
 
 

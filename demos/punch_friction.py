@@ -46,7 +46,7 @@ from fenics_nl.contact import FrictionalContact
 from fenics_nl.contact.obstacles import Indentation, RigidPunch, Traction
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import graded_block
+from fenics_nl.domain.meshes import punch_block
 from fenics_nl.io import cli, indentation_pictures, indentation_record, output
 from fenics_nl.io.parameters import choice, number
 from fenics_nl.materials import kinematics, mixed
@@ -132,7 +132,7 @@ R, model, f = args.radius, args.model, args.friction
 # As for Hertz (`punch.py`): a block graded from elements of $h$ under the punch ($a/20$,
 # plane strain $a/40$, 3D $a/6$, halved by each `--refine`), made for Hertz's contact
 # radius $a$ of the load. A tangential load needs the block on both sides of the punch: it
-# spans $-L \le x \le L$ and the 3D model is the half $y \ge 0$. gmsh tags the facets:
+# spans $-L \le x \le L$ and the 3D model is the half $y \ge 0$. `punch_block` tags the facets:
 # `contact` ($S_C$), `bottom`, `symmetry_y` (3D), `side` (and `symmetry_x` without a
 # tangential load).
 
@@ -140,12 +140,10 @@ R, model, f = args.radius, args.model, args.friction
 a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**args.refine)
-growth = {"axisymmetric": 0.05, "3d": 0.10, "plane_strain": 0.20}[model]
 size = punch_run.block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
-mesh_data = graded_block(MPI.COMM_WORLD, dim, size * a, size * a, h, 1.5 * a, growth,
-                         both_sides=args.moved)
+mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size,
+                           both_sides=args.moved)
 msh = mesh_data.mesh
 
 

@@ -32,7 +32,7 @@ from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.contact.obstacles import BERKOVICH, Indentation, RigidPunch, Traction
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import graded_block
+from fenics_nl.domain.meshes import PUNCH_GROWTH, punch_block
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.mixed import unknowns
@@ -84,18 +84,9 @@ class PunchBlock:
         self.model, self.a = model, a
         dim = 3 if model == "3d" else 2
         self.vertical = dim - 1
-        # plane strain: the half-width is about half of √(Rδ), so the mesh is twice as fine
-        self.h = a / ({"axisymmetric": 20, "3d": 6, "plane_strain": 40}[model] * 2**refine)
-        # the far field's grading: what the axisymmetric force-indentation law (the
-        # half-space's) needs, 5 % (at 10 % its error doubles to 0.28 %, 0.92 % at 20 %);
-        # plane strain has no such law (the indentation depends on the block), and what it
-        # checks is local, so 20 % (Cattaneo-Mindlin: 76k unknowns instead of 160k, the
-        # same errors); 3D 10 %
-        if growth is None:
-            growth = {"axisymmetric": 0.05, "plane_strain": 0.20, "3d": 0.10}[model]
-        self.growth = growth
-        L = block * a
-        data = graded_block(comm, dim, L, L, self.h, 1.5 * a, growth, both_sides=tangential)
+        self.growth = PUNCH_GROWTH[model] if growth is None else growth
+        data, self.h = punch_block(comm, model, a, refine=refine, size=block,
+                                   growth=self.growth, both_sides=tangential)
         self.tangential = tangential
         self.mesh = data.mesh
         degree = degree or (2 if mixed else 1)
