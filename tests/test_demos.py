@@ -229,6 +229,17 @@ def test_punch_two_ranks_match_serial(demo):
         assert np.allclose(p["reactions"][group], r, rtol=1e-8, atol=1e-10 * s["force"])
 
 
+@pytest.mark.mpi
+def test_indentation_two_ranks_match_serial(demo):
+    # J2 under the punch, loaded and unloaded: the plastic state, the active set and the
+    # imprint of 2 ranks are the serial run's
+    args = ("--refine", "0", "--steps", "2")
+    s, p = demo.indentation(*args), demo.indentation(*args, ranks=2)
+    assert p["ranks"] == 2 and p["nodes_in_contact"] == s["nodes_in_contact"]
+    for k in ("force", "residual_imprint_depth", "max_cumulated_plastic_strain"):
+        assert p[k] == pytest.approx(s[k], rel=1e-8)
+
+
 def test_punch_that_never_touches_gives_zero_force(tmp_path, demo):
     proc = demo.run(["punch.py", "--indentation", "-0.01", "--json", tmp_path / "z.json"])
     d = json.loads((tmp_path / "z.json").read_text())
