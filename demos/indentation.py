@@ -183,18 +183,6 @@ cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unk
 # set shrinks and the punch leaves the block with no force.
 
 # +
-def press(delta):
-    """The converged state of the punch pressed by δ, from the last active set."""
-    contact.set_gap(punch.gap(delta))
-    contact.add_penetrating()
-    with contact.reusing_residual():  # the forces below read the loop's last R(u)
-        res = contact.solve()
-        r = punch.distance(contact.x[contact.active])
-        p_max = global_max(msh.comm, contact.pressure(weight)[contact.active])
-    return Indentation(delta, symmetry * contact.force, global_max(msh.comm, r), p_max,
-                       res.active_set_iterations, res.iterations, res.work.factorizations)
-
-
 def von_mises():
     """σ_eq per cell (DG0)."""
     if args.mixed:
@@ -223,6 +211,11 @@ def report(t, result):
 def commit():
     """The converged step's plastic state becomes the next step's start."""
     material.commit(u, kinematic)
+
+
+def press(delta):
+    """The state of the punch pressed by δ: the active-set loop, from the last set."""
+    return punch.press(contact, delta, weight=weight, symmetry=symmetry)
 
 
 load = MotionPath(press, w, displacement=args.indentation, force=args.force, guess=a * a / R)

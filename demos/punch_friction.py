@@ -250,18 +250,6 @@ cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unk
 # the state after each.
 
 # +
-def press(delta):
-    """The converged state of the punch pressed by δ, from the last statuses."""
-    contact.set_gap(gap(delta))
-    contact.add_penetrating()
-    with contact.reusing_residual():  # the forces below read the loop's last R(u)
-        res = contact.solve()
-        r = radius_of(contact.x[contact.active])
-        p_max = global_max(msh.comm, contact.pressure(weight)[contact.active])
-    return Indentation(delta, symmetry * contact.force, global_max(msh.comm, r), p_max,
-                       res.active_set_iterations, res.iterations, res.work.factorizations)
-
-
 def fields():
     """What --output writes: u (and p), the contact pressure and statuses, σ_eq."""
     return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
@@ -287,6 +275,11 @@ def report(t, result):
 
 
 # the load factor t scales δ (or P: δ by secant steps on ln P(ln δ), from δ ∝ t^(2/3))
+def press(delta):
+    """The state of the punch pressed by δ: the active-set loop, from the last set."""
+    return punch.press(contact, delta, weight=weight, symmetry=symmetry)
+
+
 load = MotionPath(press, w, displacement=args.indentation, force=args.force, guess=a * a / R)
 # --checkpoint: the displacement, the statuses and slip history, the states after each step
 checkpoints = cli.checkpointing({"unknown": w}, newton=contact.newton, contact=contact,

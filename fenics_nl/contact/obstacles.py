@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fenics_nl.parallel import global_max
+
 __all__ = ["BERKOVICH", "SHAPES", "Indentation", "RigidPunch", "Traction"]
 
 SHAPES = ("parabola", "sphere", "cone")
@@ -85,6 +87,32 @@ class RigidPunch:
             γ(x) = h(r) − δ for points x given as 3 × n.
         """
         return lambda x: self.height(self.distance(np.asarray(x).T)) - delta
+
+    def press(self, contact, delta: float, *, weight=1.0, symmetry: float = 1.0
+              ) -> Indentation:
+        """The converged state of the punch pressed by δ: the contact's active-set loop.
+
+        From the last state's set and every node that penetrates now (a warm start).
+
+        Args:
+            contact: the active-set loop on S_C (`ActiveSetContact`, `FrictionalContact`).
+            delta: the indentation δ.
+            weight: the measure's weight (2πr in the axisymmetric model).
+            symmetry: the whole body's force over the modelled part's.
+
+        Returns:
+            The state: its force, the outermost active node's distance from the axis, the
+            largest nodal pressure and the work (collective).
+        """
+        contact.set_gap(self.gap(delta))
+        contact.add_penetrating()
+        comm = contact.comm
+        with contact.reusing_residual():  # the forces below read the loop's last R(u)
+            res = contact.solve()
+            radius = global_max(comm, self.distance(contact.x[contact.active]))
+            p_max = global_max(comm, contact.pressure(weight)[contact.active])
+        return Indentation(delta, symmetry * contact.force, radius, p_max,
+                           res.active_set_iterations, res.iterations, res.work.factorizations)
 
 
 @dataclass

@@ -224,16 +224,8 @@ class Punch:
 
     def indent(self, delta: float) -> Indentation:
         """Press the punch down by δ (from the last state's active set)."""
-        c = self.contact
-        c.set_gap(self.gap(delta))
-        c.add_penetrating()  # warm start: the last set and what penetrates now
-        # (the pressure below reads the loop's last R(u), not a new assembly)
-        with c.reusing_residual():
-            res = c.solve()
-            radius = self._contact_radius()
-            p_max = global_max(self.mesh.comm, c.pressure(self.block.weight)[c.active])
-        return Indentation(delta, self.block.symmetry_factor * c.force, radius, p_max,
-                           res.active_set_iterations, res.iterations, res.work.factorizations)
+        return self.obstacle.press(self.contact, delta, weight=self.block.weight,
+                                   symmetry=self.block.symmetry_factor)
 
     # -- tangential load (with friction) ----------------------------------------------
 
@@ -297,12 +289,6 @@ class Punch:
         q0 = self.block.symmetry_factor * float(c.committed_tangential_force[0])
         return (s.tangential_displacement - float(c.committed_motion[0])) / (
             s.tangential_force - q0)
-
-    def _contact_radius(self) -> float:
-        """Distance of the outermost active node from the axis (within h of the true edge)."""
-        c = self.contact
-        r = self.block.radius_of(c.x[c.active].T) if c.active.any() else np.zeros(0)
-        return global_max(self.mesh.comm, r)
 
     def traction_profile(self):
         """(x, p, q, status) of the S_C nodes on y = 0 (3D) or all (2D), on rank 0 sorted by x.
