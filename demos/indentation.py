@@ -183,17 +183,11 @@ cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unk
 # set shrinks and the punch leaves the block with no force.
 
 # +
-def von_mises():
-    """σ_eq per cell (DG0)."""
-    if args.mixed:
-        return mixed.von_mises(material, u, p, kinematic, msh)
-    return material.von_mises(u, kinematic)
-
-
 def fields():
     """What --output writes: u (and p), the contact pressure and set, σ_eq, the plastic state."""
     return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
-            *contact.fields(weight), von_mises(), *material.output_fields()]
+            *contact.fields(weight), parts.von_mises(material, kinematic),
+            *material.output_fields()]
 
 
 def report(t, result):
@@ -258,7 +252,7 @@ if args.png or args.plot:  # the states unloaded later join the curve only
         model, load.states, check.ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
         profile=contact.surface.gathered(punch.distance(contact.x), contact.pressure(weight),
                                          contact.active),
-        section=(output.section(parts.displacement(), von_mises(),
+        section=(output.section(parts.displacement(), parts.von_mises(material, kinematic),
                                 normal_axis=1 if dim == 3 else None) if args.png else None),
         gap_at=lambda r, d: punch.height(r) - d, h=h, mixed=args.mixed,
         force_controlled=args.force is not None, loading_steps=len(load.states),

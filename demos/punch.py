@@ -296,14 +296,8 @@ def fields():
     """What --output writes: u (and p), the contact pressure and set, σ_eq."""
     return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
             surface.nodal_field(-T_n / areas, "contact_pressure"),
-            surface.nodal_field(active.astype(float), "active_set"), von_mises()]
-
-
-def von_mises():
-    """σ_eq per cell (DG0)."""
-    if args.mixed:
-        return mixed.von_mises(material, u, p, kinematic, msh)
-    return material.von_mises(u, kinematic)
+            surface.nodal_field(active.astype(float), "active_set"),
+            parts.von_mises(material, kinematic)]
 
 
 states = []
@@ -402,7 +396,7 @@ out.update(
 drawn = indentation_pictures.PunchRun(
     model, states, ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
     profile=surface.gathered(radius_of(surface.x), -T_n / areas, active),
-    section=(output.section(parts.displacement(), von_mises(),
+    section=(output.section(parts.displacement(), parts.von_mises(material, kinematic),
                             normal_axis=1 if dim == 3 else None) if args.png else None),
     gap_at=lambda r, d: punch.height(r) - d, h=h, mixed=args.mixed,
     force_controlled=args.force is not None)

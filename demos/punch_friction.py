@@ -253,14 +253,7 @@ cli.say(f"{model} punch, {args.formulation}, {output.dofs(w.function_space)} unk
 def fields():
     """What --output writes: u (and p), the contact pressure and statuses, σ_eq."""
     return [parts.displacement(), *([parts.pressure()] if args.mixed else []),
-            *contact.fields(weight), von_mises()]
-
-
-def von_mises():
-    """σ_eq per cell (DG0)."""
-    if args.mixed:
-        return mixed.von_mises(material, u, p, kinematic, msh)
-    return material.von_mises(u, kinematic)
+            *contact.fields(weight), parts.von_mises(material, kinematic)]
 
 
 def report(t, result):
@@ -469,7 +462,7 @@ if args.png or args.plot:
         model, load.states, ref, args.E, args.nu, R, rank0=msh.comm.rank == 0,
         profile=contact.surface.gathered(radius_of(contact.x), contact.pressure(weight),
                                          contact.active),
-        section=(output.section(parts.displacement(), von_mises(),
+        section=(output.section(parts.displacement(), parts.von_mises(material, kinematic),
                                 normal_axis=1 if dim == 3 else None) if args.png else None),
         gap_at=lambda r, d: punch.height(r) - d, h=h, tangential=args.moved,
         mixed=args.mixed, force_controlled=args.force is not None, friction=f, traction=T,

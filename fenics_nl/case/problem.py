@@ -418,8 +418,7 @@ class CaseProblem:
     def von_mises(self) -> fem.Function:
         """σ_eq per cell (Cauchy stress; DG0)."""
         if self.mixed:
-            return mixed_form.von_mises(self.material, self.u, self.mixed.p, self.model,
-                                        self.mesh)
+            return self.mixed.von_mises(self.material, self.model)
         if self.plane_stress:  # J2: at its quadrature points
             return self.material.cell_mean(von_mises_of(self._stress()), "von_mises")
         return self.material.von_mises(self.u, self.model)

@@ -260,6 +260,18 @@ class DisplacementUnknown:
         """The displacement Function itself."""
         return self.w
 
+    def von_mises(self, material, model: str) -> fem.Function:
+        """σ_eq per cell (DG0) of the current state (`Material.von_mises`).
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+        Returns:
+            σ_eq, a DG0 Function named "von_mises".
+        """
+        return material.von_mises(self.u, model)
+
     def internal_work(self, material, model: str):
         """Integrand of the internal virtual work in the direction of the test function.
 
@@ -318,6 +330,18 @@ class MixedUnknown:
         """The current pressure field p (a copy in the collapsed P1 space)."""
         self._p.x.array[:] = self.w.x.array[self._p_dofs]
         return self._p
+
+    def von_mises(self, material, model: str) -> fem.Function:
+        """σ_eq per cell (DG0) of the current state, its pressure the unknown p.
+
+        Args:
+            material: the law.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+        Returns:
+            σ_eq, a DG0 Function named "von_mises" (`von_mises` of this module).
+        """
+        return von_mises(material, self.u, self.p, model, self.W.mesh)
 
     def internal_work(self, material, model: str):
         """Integrand of δΠ(u, p; v, q) (`internal_work` of this module).
