@@ -206,13 +206,6 @@ class Bracket:
         """Nodal floor pressure and active set (1/0) on the base (contact support only)."""
         return self.solver.fields()
 
-    def von_mises(self) -> fem.Function:
-        """σ_eq = √(3/2) ‖dev σ‖ per cell (DG0)."""
-        p = self.part
-        if p.mixed:
-            return mixed_form.von_mises(self.material, p.u, p.p, "3d", self.mesh)
-        return self.material.von_mises(self.u)
-
     def reactions(self) -> dict[str, list[float]]:
         """Resultant force on the bolts (and on the base from the floor), see `boundary`."""
         return boundary.reactions(self.residual, self.u, self.part.groups, space=self.V)

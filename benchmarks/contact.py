@@ -25,9 +25,9 @@ from common import elapsed, machine, pyplot, save_figure, timed_linear_solve, up
 from dolfinx import fem
 from mpi4py import MPI
 from peers import solve_penalty, solve_snes_vi
+from punch_problem import build_punch
 
 from fenics_nl.materials.laws import LinearElastic
-from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz
 
 HERE = Path(__file__).resolve().parent

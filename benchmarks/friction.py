@@ -29,9 +29,9 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from common import machine, options, publish
 from peers import solve_friction_penalty
+from punch_problem import build_punch
 
 from fenics_nl.materials.laws import LinearElastic
-from fenics_nl.scenes.punch import build_punch
 from fenics_nl.theory import hertz, mindlin
 
 R, DELTA, F, SHIFT = 1.0, 0.01, 0.3, 0.0023

@@ -8,7 +8,7 @@ its check's: refine 2 (h = a/80 under the sphere; the fit's is refine 0, its che
 refine 1) with the far field graded by 7 % per element (the fit's: 10 %, its check's: 5 %).
 (Graded by 5 %, the same mesh's active set cycles at δ = 0.02 on the first unloading step:
 `ContactError`, measured, not resolved here.) Fitted by the
-demo's fit (`scenes.identification`: Levenberg–Marquardt on the refine-0 model, then the
+demo's fit (`fenics_nl.identification.fit`: Levenberg–Marquardt on the refine-0 model, then the
 shift to the refine-1 model, `refined_estimate`), from a factor 2 off (σ0 = 0.04, H = 0.05),
 without noise and with 1 % noise (seed 1): the fit model's parameters, the reported ones, and
 the reported standard deviations. A reported deviation covers the truth when the error is
@@ -42,13 +42,13 @@ from common import machine, options, publish
 from scipy.optimize import least_squares
 
 from fenics_nl.errors import SolveError
-from fenics_nl.scenes.identification import (
+from fenics_nl.identification.fit import (
     MeasuredCurve,
     fit_curve,
     refined_estimate,
     report,
 )
-from fenics_nl.scenes.indentation_test import IndentationTest
+from fenics_nl.identification.indentation_test import IndentationTest
 
 TRUE = {"sigma0": 0.02, "hardening": 0.1}
 START = {"sigma0": 0.04, "hardening": 0.05}

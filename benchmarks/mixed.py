@@ -34,7 +34,7 @@ from common import machine, options, publish
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean
 from fenics_nl.scenes.beam import build_beam
-from fenics_nl.scenes.punch import build_punch
+from punch_problem import build_punch
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import hertz

@@ -198,6 +198,7 @@ else:
     V = fem.functionspace(msh, ("Lagrange", args.degree, (3,)))
     w = u = fem.Function(V, name="displacement")
     v = ufl.TestFunction(V)
+parts = mixed.unknown_of(w)  # u (and p) as Functions of their own, to write out and draw
 bcs = [boundary.fixed(V, tagged("bolts"))]
 ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
 ds_load = ds(data.physical_groups["load"].tag)
@@ -327,18 +328,14 @@ def floor_gap(x):
 # +
 def fields(solver):
     """What --output writes at every converged step (a time series)."""
-    u_out = w.sub(0).collapse() if args.mixed else w
-    u_out.name = "displacement"
-    return [u_out, *([w.sub(1).collapse()] if args.mixed else []), von_mises(),
+    return [parts.displacement(), *([parts.pressure()] if args.mixed else []), von_mises(),
             *(solver.fields() if args.support == "contact" else []),
             *(material.output_fields() if plastic else [])]
 
 
 def von_mises():
-    """σ_eq per cell (DG0)."""
-    if args.mixed:
-        return mixed.von_mises(material, u, p, "3d", msh)
-    return material.von_mises(u)
+    """σ_eq per cell (DG0); the mixed form's from its pressure unknown."""
+    return parts.von_mises(material, "3d")
 
 
 def solve(variant):
@@ -529,7 +526,7 @@ else:
         """The deformed part, coloured by σ_eq (J2: by the cumulated plastic strain)."""
         field = material.cumulated_plastic_strain_per_cell() if plastic else von_mises()
         pictures.bracket_picture(
-            w.sub(0).collapse() if args.mixed else w, field, args.png,
+            parts.displacement(), field, args.png,
             clamped=tagged("bolts"), loaded=tagged("load"), load_motion=load_point_motion(),
             units=args.units, force=args.force, support=args.support, unloaded=args.unload,
             floor=(solver.x[solver.owned], solver.active[solver.owned])

@@ -41,14 +41,15 @@ from fenics_nl.contact import ActiveSetContact
 from fenics_nl.contact.obstacles import Indentation, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import punch_block
+from fenics_nl.domain.meshes import punch_block, punch_block_size
 from fenics_nl.domain.probes import Probes
-from fenics_nl.io import cli, indentation_pictures, indentation_record, output
+from fenics_nl.io import cli, indentation_record, output
 from fenics_nl.io.parameters import number, switch
+from fenics_nl.io.punch_parameters import PunchParameters, prefixes
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
-from fenics_nl.scenes import punch_run
+from fenics_nl.plots import indentation as indentation_pictures
 from fenics_nl.solvers.force_control import MotionPath
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz
@@ -59,12 +60,12 @@ cli.run_script(__name__)  # as a script: this file runs under the demo contract,
 
 # ### Parameters
 #
-# The punch demos' common flags (`punch_run.PunchParameters`) and the plastic material;
+# The punch demos' common flags (`PunchParameters`) and the plastic material;
 # the punch is taken back up in as many steps as it went down.
 
 # +
 @dataclass
-class Imprint(punch_run.PunchParameters):
+class Imprint(PunchParameters):
     """Rigid spherical punch on a J2 elastoplastic block, loaded and unloaded: the
     load-depth curve and the residual imprint. Units are the user's, consistent."""
 
@@ -84,7 +85,7 @@ class Imprint(punch_run.PunchParameters):
                              "control: drop --force, or add --loading-only")
 
 
-args = cli.arguments(Imprint, prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
+args = cli.arguments(Imprint, prefixes=lambda a: prefixes(a.model, a.formulation))
 R, model, unload = args.radius, args.model, not args.loading_only
 # -
 
@@ -97,10 +98,10 @@ R, model, unload = args.radius, args.model, not args.loading_only
 # Taylor–Hood (P2 displacements, P1 pressure).
 
 # +
-a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
+a = hertz.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-size = punch_run.block_size(model, args.block)
+size = punch_block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
 mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size)
 msh = mesh_data.mesh
@@ -240,7 +241,9 @@ def hertz_of(state):
     return hertz.sphere_from_indentation(args.E, args.nu, R, state.indentation)
 
 
-check = punch_run.compare_with_hertz(loaded, hertz_of, model, h)  # said in a line
+check = hertz.compare_with_hertz(loaded, hertz_of, model, h)
+for line in check.lines:
+    cli.say(line)
 warnings.append("j2 material: Hertz's values are the linear reference, not a check")
 p_cum = material.cumulated_plastic_strain
 plastic_strain = global_max(msh.comm,
@@ -291,7 +294,7 @@ if model == "plane_strain" and check.ref is not None:
 groups = {name: tagged(name) for name in ("contact", "bottom", "symmetry_x")
           + (("symmetry_y",) if dim == 3 else ())}
 out.update(reactions=boundary.reactions(residual, w, groups, space=V if args.mixed else None),
-           reactions_of=punch_run.REACTIONS_OF[model][False],
+           reactions_of=indentation_record.REACTIONS_OF[model][False],
            dofs=output.dofs(w.function_space), ranks=msh.comm.size, warnings=warnings,
            max_cumulated_plastic_strain=plastic_strain)
 if imprint is not None:

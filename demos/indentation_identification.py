@@ -50,10 +50,7 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl.io import cli
-from fenics_nl.io.parameters import Parameters, choice, number, text
-from fenics_nl.scenes import identification_pictures
-from fenics_nl.scenes.identification import (
+from fenics_nl.identification.fit import (
     MeasuredCurve,
     fit_curve,
     initial_guess,
@@ -62,7 +59,10 @@ from fenics_nl.scenes.identification import (
     refined_estimate,
     report,
 )
-from fenics_nl.scenes.indentation_test import IndentationTest
+from fenics_nl.identification.indentation_test import IndentationTest
+from fenics_nl.io import cli
+from fenics_nl.io.parameters import Parameters, choice, number, text
+from fenics_nl.plots import indentation as indentation_pictures
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
 
@@ -300,9 +300,9 @@ def draw():
     pair = args.names == ["sigma0", "hardening"] and args.map > 0
     spread = [max(3 * (out[f"{n}_std"] or 0), 0.05 * abs(x)) for n, x in
               zip(args.names, fit.x, strict=True)]
-    grid = (identification_pictures.misfit_grid(model, measured, np.array(fit.iterates),
+    grid = (indentation_pictures.misfit_grid(model, measured, np.array(fit.iterates),
                                                 np.array(spread), args.map) if pair else None)
-    identification_pictures.identification_figure(out, args.plot, grid,
+    indentation_pictures.identification_figure(out, args.plot, grid,
                                                   labels=measured.labels)
 
 

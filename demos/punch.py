@@ -47,13 +47,14 @@ from fenics_nl.contact import ContactError, ContactSurface, EliminationSystem, M
 from fenics_nl.contact.obstacles import Indentation, RigidPunch
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import punch_block
-from fenics_nl.io import cli, indentation_pictures, output
+from fenics_nl.domain.meshes import punch_block, punch_block_size
+from fenics_nl.io import cli, output
 from fenics_nl.io.parameters import choice, number
+from fenics_nl.io.punch_parameters import PunchParameters, prefixes
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.parallel import global_max
-from fenics_nl.scenes import punch_run
+from fenics_nl.plots import indentation as indentation_pictures
 from fenics_nl.solvers.force_control import reach_force
 from fenics_nl.theory import hertz
 
@@ -66,11 +67,11 @@ cli.run_script(__name__)  # as a script: this file runs under the demo contract,
 # From the command line (`python demos/punch.py --help` lists them); in a notebook, the
 # defaults (R = 1, δ = 0.01 R, E = 1, ν = 0.3, axisymmetric, one load step). The flags
 # every punch demo has (the block, the load, the formulation) are
-# `punch_run.PunchParameters`; this one adds the material.
+# `PunchParameters`; this one adds the material.
 
 # +
 @dataclass
-class Hertz(punch_run.PunchParameters):
+class Hertz(PunchParameters):
     """Rigid spherical punch on an elastic block (Hertz contact, the course's active set).
     Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa)."""
 
@@ -93,7 +94,7 @@ class Hertz(punch_run.PunchParameters):
         self.material_flags(power_law={"sigma0": 0.01, "n": 0.3})
 
 
-args = cli.arguments(Hertz, prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
+args = cli.arguments(Hertz, prefixes=lambda a: prefixes(a.model, a.formulation))
 R, model = args.radius, args.model
 # -
 
@@ -109,10 +110,10 @@ R, model = args.radius, args.model
 # `side`.
 
 # +
-a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
+a = hertz.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-size = punch_run.block_size(model, args.block)
+size = punch_block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
 mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size)
 msh = mesh_data.mesh

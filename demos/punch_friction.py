@@ -46,13 +46,14 @@ from fenics_nl.contact import FrictionalContact
 from fenics_nl.contact.obstacles import Indentation, RigidPunch, Traction
 from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
-from fenics_nl.domain.meshes import punch_block
-from fenics_nl.io import cli, indentation_pictures, indentation_record, output
+from fenics_nl.domain.meshes import punch_block, punch_block_size
+from fenics_nl.io import cli, indentation_record, output
 from fenics_nl.io.parameters import choice, number
+from fenics_nl.io.punch_parameters import MAX_REFINE, PunchParameters, prefixes
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.parallel import global_max
-from fenics_nl.scenes import punch_run
+from fenics_nl.plots import indentation as indentation_pictures
 from fenics_nl.solvers.force_control import MotionPath, reach_load
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import hertz, mindlin
@@ -63,13 +64,13 @@ cli.run_script(__name__)  # as a script: this file runs under the demo contract,
 
 # ### Parameters
 #
-# The punch demos' common flags (`punch_run.PunchParameters`: the block, the normal load,
+# The punch demos' common flags (`PunchParameters`: the block, the normal load,
 # the solver) and the friction and tangential load. By default the plane-strain cylinder on
 # an incompressible block, pulled to $Q = fP/2$.
 
 # +
 @dataclass
-class CattaneoMindlin(punch_run.PunchParameters):
+class CattaneoMindlin(PunchParameters):
     """A rigid punch pressed, then pulled sideways, with Coulomb friction (Cattaneo–Mindlin
     partial slip). Units are the user's, consistent (e.g. N, m, Pa or N, mm, MPa)."""
 
@@ -80,7 +81,7 @@ class CattaneoMindlin(punch_run.PunchParameters):
                        "Taylor-Hood elements)", unit="-")
     refine: int = number(0, "element size under the punch a/(20·2^refine) (plane strain: "
                          "a/(40·2^refine), 3D: a/(6·2^refine))", at_least=0,
-                         at_most=punch_run.MAX_REFINE)
+                         at_most=MAX_REFINE)
     block: float = number(100.0, "block size in contact radii, >= 10 (on both sides of the "
                           "punch with a tangential load)", above=0)
     friction: float = number(0.3, "Coulomb friction coefficient f (statuses open / stick / "
@@ -123,7 +124,7 @@ class CattaneoMindlin(punch_run.PunchParameters):
 
 
 args = cli.arguments(CattaneoMindlin,
-                     prefixes=lambda a: punch_run.prefixes(a.model, a.formulation))
+                     prefixes=lambda a: prefixes(a.model, a.formulation))
 R, model, f = args.radius, args.model, args.friction
 # -
 
@@ -137,10 +138,10 @@ R, model, f = args.radius, args.model, args.friction
 # tangential load).
 
 # +
-a = punch_run.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
+a = hertz.contact_radius_for(model, args.E, args.nu, R, args.indentation, args.force)
 dim = 3 if model == "3d" else 2
 vertical = dim - 1  # z in 3D, y in 2D: S_C's normal axis
-size = punch_run.block_size(model, args.block)
+size = punch_block_size(model, args.block)
 cli.say(f"meshing the {model} block ({size:g} contact radii) ...")
 mesh_data, h = punch_block(MPI.COMM_WORLD, model, a, refine=args.refine, size=size,
                            both_sides=args.moved)
@@ -366,7 +367,9 @@ def hertz_of(state):
     return hertz.sphere_from_indentation(args.E, args.nu, R, state.indentation)
 
 
-check = punch_run.compare_with_hertz(load.states, hertz_of, model, h)  # said in a line
+check = hertz.compare_with_hertz(load.states, hertz_of, model, h)
+for line in check.lines:
+    cli.say(line)
 ref = check.ref
 out = indentation_record.record(load.states, pressed, check, model=model,
                                 formulation=args.formulation, material="linear",
@@ -449,7 +452,7 @@ groups = {name: tagged(name) for name in ("contact", "bottom")
           + (() if args.moved else ("symmetry_x",)) + (("symmetry_y",) if dim == 3 else ())}
 out.update(
     reactions=boundary.reactions(residual, w, groups, space=V if args.mixed else None),
-    reactions_of=punch_run.REACTIONS_OF[model][args.moved],
+    reactions_of=indentation_record.REACTIONS_OF[model][args.moved],
     dofs=output.dofs(w.function_space), ranks=msh.comm.size, warnings=warnings, friction=f)
 if T is not None:
     out.update({k: getattr(T, k) for k in ("tangential_force", "tangential_displacement",

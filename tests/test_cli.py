@@ -162,3 +162,22 @@ def test_several_ranks_get_one_blas_thread_each_unless_the_user_set_it():
     assert two["OPENBLAS_NUM_THREADS"] == two["OMP_NUM_THREADS"] == "1"
     mine = {"OMPI_COMM_WORLD_SIZE": "4", "OMP_NUM_THREADS": "2"}
     assert one_thread_per_rank(mine) and mine["OMP_NUM_THREADS"] == "2"
+
+
+def test_an_integer_flag_whose_default_is_none_reads_an_integer():
+    # `steps: int | None = number(None, ...)`: the default says nothing of the type, the
+    # annotation does; read as a float, `--steps 3` broke np.linspace with a traceback
+    from dataclasses import dataclass
+
+    from fenics_nl.io.parameters import Parameters, number, parser_of
+
+    @dataclass
+    class Run(Parameters):
+        steps: int | None = number(None, "steps", at_least=2)
+        scale: float | None = number(None, "a scale", above=0)
+
+    ns = parser_of(Run).parse_args(["--steps", "3", "--scale", "2"])
+    assert type(ns.steps) is int and ns.steps == 3
+    assert type(ns.scale) is float
+    with pytest.raises(SystemExit):
+        parser_of(Run).parse_args(["--steps", "2.5"])

@@ -167,8 +167,9 @@ def test_a_cone_matches_sneddon():
     # 300a): Sneddon's P = 2 E* δ² tan α / π and a = 2 δ tan α / π; the tip's pressure is
     # singular (logarithmically), the force is not: measured +0.34 % (the block's finite
     # size and mesh, as for the sphere), radius −0.3 %
+    from punch_problem import BERKOVICH, build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import BERKOVICH, build_punch
 
     delta = 0.01
     ref = hertz.cone_from_indentation(1.0, 0.3, 1 / np.tan(np.radians(BERKOVICH)), delta)

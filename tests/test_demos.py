@@ -674,8 +674,9 @@ def test_indentation_identification_bad_input_one_clear_line(args, message, demo
 def test_punch_demos_loop_is_the_librarys_active_set(demo):
     # the demo writes the course's loop out; `ActiveSetContact.solve` (the friction, case
     # and identification runs' loop) must settle on the same set, force and iterations
+    from punch_problem import build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
 
     d = demo.punch("--refine", "0")
     state = build_punch("axisymmetric", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0).indent(0.01)

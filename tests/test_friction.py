@@ -104,8 +104,9 @@ def test_force_control_reaches_the_tangential_force_and_coulombs_law_holds():
     # Q = f P / 2 by secant steps, then Coulomb's law node by node: |T_t| <= f |T_n| where
     # the node sticks, = f |T_n| and against its slip where it slips, compression where
     # closed, no penetration where open
+    from punch_problem import build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
 
     f = 0.3
     punch = build_punch("plane_strain", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0,
@@ -135,8 +136,9 @@ def test_cattaneo_mindlin_partial_slip_of_a_sphere():
     # * the displacement, less the far field's share, 0.59 % from Mindlin's δ_t (raw: +4.7 %;
     #   the share, C_far Q, is the block's bonded compliance less the half-space's, since
     #   the far field does not see how the contact zone slips)
+    from punch_problem import build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
     from fenics_nl.theory import hertz, mindlin
 
     f, nu, E = 0.3, 0.5, 1.0
@@ -169,8 +171,9 @@ def test_coulombs_law_holds_node_by_node_in_3d():
     # ν = 0.3: the normal load alone makes the surface slip inward (Spence), and in 3D the
     # slip directions are vectors, found by Newton's method (the spring across the slip);
     # two normal steps and a tangential move settle, and every node obeys Coulomb's law
+    from punch_problem import build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
 
     f = 0.3
     punch = build_punch("3d", LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0, block=10.0,
@@ -251,9 +254,9 @@ def test_the_penalty_peer_converges_to_the_active_set(model, block, growth, Q_bo
     # pressed in one step (ν = 0.3), then moved: the nodal traction and Q of the penalty
     # peer approach the active set's answer as k grows
     from peers import solve_friction_penalty  # benchmarks/peers.py
+    from punch_problem import build_punch
 
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
 
     punch = build_punch(model, LinearElastic(1.0, 0.3), 1.0, 0.1, refine=0, block=block,
                         growth=growth, tangential=True, friction=0.3)
@@ -277,8 +280,9 @@ def test_friction_on_a_cut_contact_zone(model):
     # plane strain: the partition cuts S_C inside the contact zone, so sticking and
     # slipping nodes are owned by both ranks and ghosts carry statuses; the answer is the
     # serial one
+    from punch_problem import build_punch
+
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.punch import build_punch
 
     assert MPI.COMM_WORLD.size > 1
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from fenics_nl.scenes.identification import (
+from fenics_nl.identification.fit import (
     IDENTIFIABLE_SPREAD,
     MeasuredCurve,
     Refinement,
@@ -17,7 +17,7 @@ from fenics_nl.scenes.identification import (
     refined_estimate,
     report,
 )
-from fenics_nl.scenes.indentation_test import IndentationTest
+from fenics_nl.identification.indentation_test import IndentationTest
 from fenics_nl.solvers.least_squares import FitResult
 
 DEEPEST = 0.05  # R = 1, E = 1: a/R = 0.22, plastic strains up to about 0.1

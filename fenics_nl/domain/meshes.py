@@ -6,7 +6,8 @@ import gmsh
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-__all__ = ["PUNCH_GROWTH", "graded_block", "punch_block", "quarter_annulus", "start_model"]
+__all__ = ["PUNCH_GROWTH", "graded_block", "punch_block", "punch_block_size", "quarter_annulus",
+           "start_model"]
 
 
 def start_model(name: str) -> None:
@@ -137,6 +138,19 @@ def punch_block(comm: MPI.Comm, model: str, a: float, *, refine: int = 1, size: 
     growth = PUNCH_GROWTH[model] if growth is None else growth
     return graded_block(comm, dim, size * a, size * a, h, 1.5 * a, growth,
                         both_sides=both_sides), h
+
+
+def punch_block_size(model: str, block: float | None = None) -> float:
+    """The punch's block size in contact radii.
+
+    Args:
+        model: ``axisymmetric``, ``3d`` or ``plane_strain``.
+        block: the size asked for, or None.
+
+    Returns:
+        `block`, else 1000 (3D: 100, where the far field's tetrahedra cost the most).
+    """
+    return block or (100.0 if model == "3d" else 1000.0)
 
 
 def quarter_annulus(comm: MPI.Comm, a: float, b: float, size: float, order: int = 2

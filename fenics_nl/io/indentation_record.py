@@ -7,7 +7,14 @@ at the largest load, the work summed over the steps, the curve P(δ) of every co
 
 from __future__ import annotations
 
-__all__ = ["record"]
+__all__ = ["REACTIONS_OF", "record"]
+
+# what a punch's reactions are the forces of, by model and [tangential load]: the modelled
+# part's, or the whole body's where the residual carries it (2πr)
+REACTIONS_OF = {"axisymmetric": ("the whole body (2πr in the residual)",) * 2,
+                "3d": ("the modelled quarter", "the modelled half"),
+                "plane_strain": ("the modelled half, per unit length",
+                                 "the whole block, per unit length")}
 
 
 def record(states: list, loaded, check, *, model: str, formulation: str, material: str,

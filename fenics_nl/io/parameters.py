@@ -100,8 +100,15 @@ class Parameters:
             raise ValueError(f"--hardening must be >= 0, got {self.hardening:g}")
 
 
+def _declared_integer(f: dataclasses.Field) -> bool:
+    """Whether the field is declared `int` (or `int | None`: a default of None says nothing)."""
+    declared = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+    return declared.replace(" ", "").split("|")[0] == "int" or (
+        isinstance(f.default, int) and not isinstance(f.default, bool))
+
+
 def _number_type(f: dataclasses.Field):
-    m, integer = f.metadata, isinstance(f.default, int) and not isinstance(f.default, bool)
+    m, integer = f.metadata, _declared_integer(f)
 
     def parse(word: str):
         try:

@@ -6,9 +6,15 @@ And Sneddon's for a rigid cone, the other axisymmetric indenter of instrumented 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+
+import numpy as np
 
 __all__ = [
+    "HertzCheck",
+    "compare_with_hertz",
     "cone_from_indentation",
+    "contact_radius_for",
     "cylinder_from_force",
     "effective_modulus",
     "pressure_profile",
@@ -62,3 +68,77 @@ def pressure_profile(p0: float, a: float, r):
 
     r = np.asarray(r, dtype=float)
     return p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0.0, None))
+
+
+def contact_radius_for(model: str, E: float, nu: float, radius: float,
+                       indentation: float | None, force: float | None) -> float:
+    """The contact radius a punch's block is meshed for.
+
+    Args:
+        model: ``axisymmetric``, ``3d`` (a sphere) or ``plane_strain`` (a cylinder).
+        E: Young's modulus.
+        nu: Poisson's ratio.
+        radius: the punch's radius R.
+        indentation: the depth δ prescribed (used when `force` is None).
+        force: the force P prescribed (per unit length for the cylinder), or None.
+
+    Returns:
+        Hertz's a for the force (the cylinder's half-width), else √(R |δ|) (for a cylinder,
+        a safe overestimate of its half-width).
+    """
+    if force is None:
+        return math.sqrt(radius * abs(indentation))
+    law = cylinder_from_force if model == "plane_strain" else sphere_from_force
+    return law(E, nu, radius, force)["contact_radius"]
+
+
+@dataclass
+class HertzCheck:
+    """A loaded state against Hertz, and the lines that say it.
+
+    `ref`: Hertz's values (None: no contact); `errors`: the relative ones; `exponent`: m of
+    P ∝ δ^m fitted over the loading steps (None with fewer than two); `lines`: the check in
+    words, for the run's output.
+    """
+
+    ref: dict | None
+    errors: dict = field(default_factory=dict)
+    exponent: float | None = None
+    lines: list[str] = field(default_factory=list)
+
+
+def compare_with_hertz(loading: list, hertz_of, model: str, h: float) -> HertzCheck:
+    """The last loading state's force, contact radius and largest pressure against Hertz.
+
+    The force is not checked for the cylinder; the radius is the outermost active node's.
+
+    Args:
+        loading: the converged loading states (`indentation`, `force`, `contact_radius`,
+            `max_pressure`).
+        hertz_of: Hertz's values for a state (a dict with some of those keys).
+        model: ``axisymmetric``, ``3d`` or ``plane_strain``.
+        h: the element size under the punch.
+
+    Returns:
+        The check: Hertz's values, the relative errors, the fitted exponent, and its lines
+        (the errors in one, the exponent in another).
+    """
+    last = loading[-1]
+    if not last.force > 0:
+        return HertzCheck(None, lines=["the punch does not touch the block: zero contact "
+                                       "force"])
+    ref = hertz_of(last)
+    errors = {k: getattr(last, k) / ref[k] - 1 for k in ("force", "contact_radius",
+                                                         "max_pressure") if k in ref}
+    checked = [f"{k.replace('_', ' ')} {getattr(last, k):.6g} (Hertz {ref[k]:.6g}, "
+               f"{100 * e:+.3f} %)" for k, e in errors.items()]
+    if model == "plane_strain":  # a cylinder: Hertz's a and p0 for the computed P
+        checked.insert(0, f"P = {last.force:.6g} per unit length (not checked)")
+    lines = ["; ".join(checked) + f"; h = {h:.2g}"]
+    exponent = None
+    if len(loading) >= 2 and all(s.force > 0 for s in loading):
+        exponent = float(np.polyfit(np.log([s.indentation for s in loading]),
+                                    np.log([s.force for s in loading]), 1)[0])
+        lines.append(f"P ∝ δ^{exponent:.4f} over the steps" + (
+            "" if model == "plane_strain" else " (Hertz: 1.5)"))
+    return HertzCheck(ref, errors, exponent, lines)

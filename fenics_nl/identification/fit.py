@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fenics_nl.scenes.indentation_test import (
+from fenics_nl.identification.indentation_test import (
     PARAMETERS,
     POSITIVE,
     IndentationTest,

@@ -3,12 +3,13 @@
 The derivatives with respect to the law's parameters are taken through the whole load path.
 
 A rigid sphere (radius R) or cone (half-angle α) is pressed into an axisymmetric J2 block
-(`punch.Punch`, the course's active set) through a list of depths, loading then unloading; the
-force P at each converged step is the curve. The law's parameters — E, σ0, the isotropic
-hardening H and the kinematic C — are `fem.Constant` objects, so one compiled set of forms serves
-every run of an identification, and each run from the virgin state may carry the
-sensitivities dP/dθ by direct differentiation (`solvers.sensitivity`): for each parameter one
-solve per step with the step's converged tangent.
+(the course's active set, `contact.ActiveSetContact`, on the block of
+`domain.meshes.punch_block`) through a list of depths, loading then unloading; the force P
+at each converged step is the curve. The law's parameters — E, σ0, the isotropic hardening H
+and the kinematic C — are `fem.Constant` objects, so one compiled set of forms serves every
+run of an identification, and each run from the virgin state may carry the sensitivities
+dP/dθ by direct differentiation (`solvers.sensitivity`): for each parameter one solve per
+step with the step's converged tangent.
 """
 
 from __future__ import annotations
@@ -21,10 +22,16 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.contact.obstacles import BERKOVICH, Indentation, RigidPunch
+from fenics_nl.domain import boundary
+from fenics_nl.domain.meshes import PUNCH_GROWTH, punch_block
+from fenics_nl.io import output
 from fenics_nl.materials import kinematics
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.scenes.punch import BERKOVICH, Indentation, Punch, PunchBlock
 from fenics_nl.solvers.sensitivity import PathSensitivity
+from fenics_nl.theory import hertz
 
 __all__ = ["PARAMETERS", "POSITIVE", "Curve", "IndentationTest", "check_value"]
 
@@ -66,8 +73,8 @@ class IndentationTest:
         radius: the sphere's radius R; `cone_angle`: a cone of this half-angle (degrees)
             instead of the sphere. `gap`: the sphere's shape, ``parabola`` (Hertz's, as
             `demos/indentation.py` by default) or ``sphere`` (exact).
-        refine, block: the block's mesh (`punch.PunchBlock`: h = a/(20·2^refine) under the
-            indenter, the block `block` contact radii deep and wide).
+        refine, block: the block's mesh (`domain.meshes.punch_block`: h = a/(20·2^refine)
+            under the indenter, the block `block` contact radii deep and wide).
         differentiate: the parameters whose dP/dθ a run with sensitivities carries.
     """
 
@@ -94,24 +101,45 @@ class IndentationTest:
             a = math.sqrt(radius * max_depth)
         else:
             a = 2 * max_depth * math.tan(math.radians(cone_angle)) / math.pi
-        self.block = b = PunchBlock("axisymmetric", a, refine=refine, block=block,
-                                    growth=growth, quadrature_degree=quadrature_degree,
-                                    comm=comm)
+        self.growth = PUNCH_GROWTH["axisymmetric"] if growth is None else growth
+        data, _ = punch_block(comm, "axisymmetric", a, refine=refine, size=block,
+                              growth=self.growth)
+        msh = data.mesh
+
+        def tagged(name):
+            return data.facet_tags.find(data.physical_groups[name].tag)
+
+        self.fields = unknowns(msh, 1)  # P1 displacements
+        self.u = u = self.fields.u
+        V = u.function_space
+        bcs = [boundary.component(V, 0, tagged("symmetry_x")),
+               boundary.component(V, 1, tagged("bottom"))]
         values = {"E": E, "sigma0": sigma0, "hardening": hardening, "kinematic": kinematic}
-        self.constants = {k: fem.Constant(b.mesh, float(v)) for k, v in values.items()}
+        self.constants = {k: fem.Constant(msh, float(v)) for k, v in values.items()}
         c = self.constants
         # checked at their current values; later ones by `set`
         self.material = J2Plasticity(c["E"], nu, sigma0=c["sigma0"], H=c["hardening"],
                                      C=c["kinematic"])
-        self.material.bind(b.mesh, b.quadrature_degree)
-        residual = b.residual(self.material)
-        self.punch = Punch(b, self.material, residual, radius,
-                           gap=gap if cone_angle is None else "cone",
-                           cone_angle=cone_angle or BERKOVICH)
+        degree = quadrature_degree or 2
+        self.material.bind(msh, degree)
+        dx = kinematics.quadrature_measure("dx", msh, degree)
+        residual = self.fields.internal_work(self.material, "axisymmetric") * dx
+        self.weight = kinematics.measure_weight(msh, "axisymmetric")  # 2πr
+        self.obstacle = RigidPunch(radius, 2, gap if cone_angle is None else "cone",
+                                   cone_angle or BERKOVICH)
+        # Newton's force scale: Hertz's force for the expected a (sphere P = 4/3 E* a³/R,
+        # cone P = π/2 E* a² cot α)
+        E_star = hertz.effective_modulus(E, nu)
+        force = (4 / 3 * E_star * a**3 / radius if cone_angle is None
+                 else np.pi / 2 * E_star * a * a / math.tan(math.radians(cone_angle)))
+        self.contact = ActiveSetContact(
+            residual, u, bcs, tagged("contact"), self.obstacle.gap(0.0), normal_axis=1,
+            initial="penetrating", newton_options={"line_search": True, "force_scale": force},
+            prefix="punch_axisymmetric_")
         self.differentiate = tuple(differentiate)
         self.sensitivity = PathSensitivity(
-            residual, b.u, self.punch.contact.newton, self.material.state_functions(),
-            self.material.state_update(kinematics.small_strain(b.u, b.kinematics)),
+            residual, u, self.contact.newton, self.material.state_functions(),
+            self.material.state_update(kinematics.small_strain(u, "axisymmetric")),
             {k: c[k] for k in self.differentiate}) if differentiate else None
 
     def finer(self) -> IndentationTest:
@@ -121,14 +149,14 @@ class IndentationTest:
         (growth / 2).
         """
         o = dict(self._options)
-        o["growth"] = (o["growth"] or self.block.growth) / 2
+        o["growth"] = self.growth / 2
         o["refine"] += 1
         return IndentationTest(**o, differentiate=())
 
     @property
     def dofs(self) -> int:
         """Global number of unknowns of the block."""
-        return self.punch.dofs
+        return output.dofs(self.u.function_space)
 
     def values(self) -> dict[str, float]:
         """The parameters' current values by name."""
@@ -146,11 +174,10 @@ class IndentationTest:
         SolveError (from the active set or Newton) if a step does not converge.
         """
         t0 = time.perf_counter()
-        b, punch, material = self.block, self.punch, self.material
-        contact = punch.contact
-        b.unknown.x.array[:] = 0.0
+        material, contact = self.material, self.contact
+        self.u.x.array[:] = 0.0
         material.reset()
-        contact.set_gap(punch.gap(0.0))
+        contact.set_gap(self.obstacle.gap(0.0))
         contact.restart()
         sens = self.sensitivity if sensitivities else None
         if sens is not None:
@@ -158,18 +185,17 @@ class IndentationTest:
         curve = Curve(np.asarray(depths, dtype=float), np.zeros(len(depths)),
                       {k: np.zeros(len(depths)) for k in (self.differentiate if sens else ())})
         for n, delta in enumerate(curve.depth):
-            state = punch.indent(float(delta))
+            state = self.obstacle.press(contact, float(delta), weight=self.weight)
             curve.states.append(state)
             curve.force[n] = state.force
             if sens is not None:
                 for name, dR in zip(sens.names, sens.step(), strict=True):
                     curve.derivatives[name][n] = self._force_of(dR)
-            material.commit(b.u, b.kinematics)
+            material.commit(self.u, "axisymmetric")
         curve.wall_time = time.perf_counter() - t0
         return curve
 
     def _force_of(self, reactions: np.ndarray) -> float:
         """The whole body's contact force of the nodal reactions `reactions` (as P)."""
-        c = self.punch.contact
-        return self.block.symmetry_factor * c.total_force(c.surface.sign
-                                                          * reactions[c.surface.dofs_V])
+        c = self.contact  # axisymmetric: the whole body's (2πr in the residual)
+        return c.total_force(c.surface.sign * reactions[c.surface.dofs_V])

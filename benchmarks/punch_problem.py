@@ -1,4 +1,12 @@
-"""A rigid punch (sphere, or cylinder in plane strain) on an elastic block: the Hertz scene.
+"""A rigid punch on an elastic block in one object, for the tests and the benchmarks.
+
+The demos write this construction out in their own cells (`demos/punch.py`,
+`punch_friction.py`, `indentation.py`): the block of `domain.meshes.punch_block`, its space
+and supports, the residual, `contact.obstacles.RigidPunch` and the active set. The tests
+and benchmarks that press a punch many times (mesh studies, friction's tangential path,
+the mixed form's locking) build it here from those same public pieces.
+
+A sphere, or a cylinder in plane strain.
 
 Models: ``axisymmetric`` (r, z), ``3d`` (quarter block, symmetry planes x = 0 and y = 0),
 ``plane_strain`` (half block, symmetry x = 0; a cylinder). The block's top z = 0 (y = 0 in
@@ -140,7 +148,7 @@ def build_punch(model: str, material, radius: float, a: float, *, refine: int = 
                 block: float = 1000.0, growth: float | None = None, mixed: bool = False,
                 degree: int | None = None, tangential: bool = False,
                 comm: MPI.Comm = MPI.COMM_WORLD, **options) -> Punch:
-    """The punch scene in one call (as `demos/punch.py` composes it), for tests and benchmarks.
+    """The block and the punch's active set in one call (as `demos/punch.py` composes them).
 
     `options` go to `Punch` (formulation, gap, friction, newton_options).
     """
