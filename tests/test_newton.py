@@ -1,8 +1,10 @@
 import dataclasses
 import math
 
+import dolfinx
 import numpy as np
 import pytest
+import ufl
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -287,3 +289,23 @@ def test_the_convergence_test_newton_arc_length_and_snes_share():
     assert t.reason([1.0, 2e4], 1.0) == "diverged" and t.reason([1.0, 9e3], 1.0) is None
     assert t.reason([1.0, math.nan], 1.0) == "nan" and t.reason([math.inf], 1.0) == "nan"
     assert ConvergenceTest(divergence_tol=-1).reason([1.0, 1e12], 1.0) is None
+
+
+def test_the_command_line_tolerances_are_petscs_for_newton_and_snes():
+    # -<prefix>snes_rtol, snes_max_it override the code's values for the hand-written Newton
+    # as for SNES; -<prefix>snes_atol is then a force, as PETSc's (F = 1)
+    opts = PETSc.Options()
+    opts["cl_snes_rtol"], opts["cl_snes_max_it"], opts["cl_snes_atol"] = 1e-3, 7, 2.0
+    try:
+        t = ConvergenceTest(rtol=1e-10, atol=1e-10, max_it=50).with_options("cl_")
+        assert (t.rtol, t.max_it, t.atol, t.absolute) == (1e-3, 7, 2.0, True)
+        assert t.threshold(1.0, 1e6) == 2.0  # not atol · F
+        interval = dolfinx.mesh.create_unit_interval(MPI.COMM_WORLD, 2)
+        u = fem.Function(fem.functionspace(interval, ("Lagrange", 1)))
+        v = ufl.TestFunction(u.function_space)
+        newton = NewtonSolver((u - 1.0) * v * ufl.dx, u, prefix="cl_")
+        assert newton.convergence == t
+        assert ConvergenceTest().with_options("other_") == ConvergenceTest()
+    finally:
+        for k in ("rtol", "max_it", "atol"):
+            opts.delValue(f"cl_snes_{k}")

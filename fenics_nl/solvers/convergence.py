@@ -39,12 +39,36 @@ class ConvergenceTest:
             (PETSc's ``-snes_divergence_tolerance``, and as in PETSc a value <= 0 turns the
             test off; larger than PETSc's 1e4: a first iteration of a large load step may
             rise that much and still converge).
+        absolute: `atol` is a force itself (F = 1), as PETSc's ``-snes_atol`` is.
     """
 
     rtol: float = 1e-10
     atol: float = 1e-10
     max_it: int = 50
     divergence_tol: float = 1e8
+    absolute: bool = False
+
+    def with_options(self, prefix: str) -> ConvergenceTest:
+        """This test, with what the command line gives under `prefix` taking precedence.
+
+        ``-{prefix}snes_rtol``, ``snes_max_it``, ``snes_divergence_tolerance`` and
+        ``snes_atol`` (then absolute, as in PETSc): the same names for `NewtonSolver` and
+        for SNES.
+
+        Args:
+            prefix: the solver's PETSc options prefix.
+
+        Returns:
+            The test the solver stops by.
+        """
+        options = PETSc.Options()
+        absolute = options.hasName(f"{prefix}snes_atol")
+        return ConvergenceTest(
+            options.getReal(f"{prefix}snes_rtol", self.rtol),
+            options.getReal(f"{prefix}snes_atol") if absolute else self.atol,
+            options.getInt(f"{prefix}snes_max_it", self.max_it),
+            options.getReal(f"{prefix}snes_divergence_tolerance", self.divergence_tol),
+            absolute or self.absolute)
 
     def threshold(self, r0: float, force: float) -> float:
         """The residual norm to reach.
@@ -54,9 +78,9 @@ class ConvergenceTest:
             force: F, the force scale.
 
         Returns:
-            max(rtol ‖R₀‖, atol F).
+            max(rtol ‖R₀‖, atol F), F = 1 if `absolute`.
         """
-        return max(self.rtol * r0, self.atol * force)
+        return max(self.rtol * r0, self.atol * (1.0 if self.absolute else force))
 
     def reason(self, norms: Sequence[float], force: float) -> Reason | None:
         """Whether the iterations stop after the residual norms so far, and why.
@@ -89,14 +113,8 @@ class ConvergenceTest:
                 absolute, as PETSc's).
             force_scale: F; None for the largest first residual of this SNES's solves.
         """
-        prefix = snes.getOptionsPrefix() or ""
-        options = PETSc.Options()
-        absolute = options.hasName(f"{prefix}snes_atol")
-        test = ConvergenceTest(
-            options.getReal(f"{prefix}snes_rtol", self.rtol),
-            options.getReal(f"{prefix}snes_atol") if absolute else self.atol,
-            options.getInt(f"{prefix}snes_max_it", self.max_it),
-            options.getReal(f"{prefix}snes_divergence_tolerance", self.divergence_tol))
+        test = self.with_options(snes.getOptionsPrefix() or "")
+        absolute = test.absolute
         # the callback holds plain lists, not a Python solver object: a cycle through SNES
         # would leave PETSc objects to the garbage collector (destroyed in any order: a hang)
         norms, largest = [], [0.0]

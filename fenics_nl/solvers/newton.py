@@ -152,7 +152,9 @@ class NewtonSolver:
     options under `prefix`, with PETSc's names: ``-{prefix}ksp_*``, ``-{prefix}pc_*``,
     ``-{prefix}snes_qn_m`` (the pairs BFGS keeps, 30), ``-{prefix}snes_divergence_tolerance``
     (1e8), ``-{prefix}snes_lag_preconditioner 1`` (with ``gamg``, an AMG set-up for every
-    tangent instead of the adaptive lag below).
+    tangent instead of the adaptive lag below); ``-{prefix}snes_rtol``, ``snes_max_it`` and
+    ``snes_atol`` (then an absolute force, as PETSc's) override `rtol`, `max_it`, `atol`
+    (`ConvergenceTest.with_options`, which SNES reads too).
 
     Args:
         residual: the residual form R(u; v), linear in the test function v.
@@ -186,7 +188,7 @@ class NewtonSolver:
             preconditioner's form (`materials.mixed.preconditioner`): MINRES on it.
         prefix: PETSc options prefix of the linear solver (``-{prefix}ksp_view``,
             ``-{prefix}pc_type``, ...: the command line overrides the linear solver's choices)
-            and of the three ``-{prefix}snes_*`` options above.
+            and of the ``-{prefix}snes_*`` options above.
 
     Terms that no integral gives (point forces, the springs of friction's slip) reach the
     tangent and the residual through one hook, `nodal` (`solvers.nodal.NodalTerms`), owned
@@ -237,8 +239,7 @@ class NewtonSolver:
         self._force_scale = force_scale
         self._largest_r0 = 0.0  # the default force scale
         opts = PETSc.Options()
-        self.convergence = ConvergenceTest(
-            rtol, atol, max_it, opts.getReal(f"{prefix}snes_divergence_tolerance", 1e8))
+        self.convergence = ConvergenceTest(rtol, atol, max_it).with_options(prefix)
         if line_search not in (False, True, "residual", "slope"):
             raise ValueError("line_search must be False, True, 'residual' or 'slope', got "
                              f"{line_search!r}")
