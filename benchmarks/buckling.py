@@ -22,9 +22,9 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 from common import elapsed, machine, pyplot, save_figure, update_docs
+from continuation_problems import BucklingBeam
 from mpi4py import MPI
 
-from fenics_nl.scenes.beam import build_beam
 from fenics_nl.solvers.loading import LoadStepError
 from fenics_nl.theory import elastica
 
@@ -43,7 +43,7 @@ def refinement(degrees, refines, ratio=1.5):
     for degree in degrees:
         for r in refines:
             t0 = time.perf_counter()
-            b = build_beam(L, H, E, NU, refine=r, degree=degree)
+            b = BucklingBeam(L, H, E, NU, refine=r, degree=degree)
             P_cr = b.critical_loads(1)[0][0]
             t1 = time.perf_counter()
             path, _ = b.solve_path(ratio, 40)
@@ -65,7 +65,7 @@ def refinement(degrees, refines, ratio=1.5):
 def variants(ratio=2.0, steps=40):
     out = {}
     for method in ("full", "modified", "periodic", "bfgs"):
-        b = build_beam(L, H, E, NU)
+        b = BucklingBeam(L, H, E, NU)
         per_step = []
         t0 = time.perf_counter()
         try:
@@ -99,7 +99,7 @@ def step_control(ratio=2.0):
     for label, steps, grow in [("fixed, 40 steps", 40, False), ("fixed, 10 steps", 10, False),
                                ("growing from 10 steps", 10, True),
                                ("one step + stability check", 1, False)]:
-        b = build_beam(L, H, E, NU)
+        b = BucklingBeam(L, H, E, NU)
         t0 = time.perf_counter()
         path, switched = b.solve_path(ratio, steps, grow=grow)
         alpha = math.degrees(abs(b.tip()["rotation"]))
@@ -175,8 +175,8 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--update-docs", action="store_true")
     args = ap.parse_args()
-    build_beam(L, H, E, NU).solve_path(1.5, 10)  # warm-up: JIT
-    build_beam(L, H, E, NU, degree=1).critical_loads(1)
+    BucklingBeam(L, H, E, NU).solve_path(1.5, 10)  # warm-up: JIT
+    BucklingBeam(L, H, E, NU, degree=1).critical_loads(1)
     result = {
         "refinement": refinement([2] if args.quick else [1, 2], [0] if args.quick else [0, 1, 2]),
         "variants": variants(),

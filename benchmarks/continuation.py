@@ -4,10 +4,11 @@ A. The shallow arch (snap-through at a limit point, `arch_model.py`, the closed 
    `theory.arch`): to 1.5 times the limit load, on the inverted branch. Arc-length with
    each Newton variant; load control with step cut-back, which has no state beyond the
    limit point to go to.
-B. The buckling beam (`scenes.beam`), perfect (no imperfection): to 1.5 P_cr. Arc-length
-   with each variant (the bifurcation is found by the tangent's inertia and left along its
-   mode); load control with cut-back as the beam scene does it (the end state checked and,
-   if unstable, kicked along its mode by the elastica's deflection: a closed form).
+B. The buckling beam (`continuation_problems.py`), perfect (no imperfection): to 1.5
+   P_cr. Arc-length with each variant (the bifurcation is found by the tangent's inertia
+   and left along its mode); load control with cut-back as the buckling demo does it (the
+   end state checked and, if unstable, kicked along its mode by the elastica's deflection:
+   a closed form).
 
 Per run: steps, iterations, factorizations (and the stability checks' own), wall time and
 the error against the reference. Writes benchmarks/results/continuation.json and, with
@@ -23,10 +24,10 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 from arch_model import ShallowArch
 from common import machine, options, publish
+from continuation_problems import BucklingBeam
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
-from fenics_nl.scenes.beam import build_beam
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
@@ -99,7 +100,7 @@ def beam_runs():
     rows = []
     for control in ("arc-length", "load"):
         for method in VARIANTS:
-            b = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
+            b = BucklingBeam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
             t0 = time.perf_counter()
             try:
                 if control == "arc-length":

@@ -30,10 +30,10 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import ufl
 from common import machine, options, publish
+from continuation_problems import BucklingBeam
 
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean
-from fenics_nl.scenes.beam import build_beam
 from punch_problem import build_punch
 from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
@@ -76,7 +76,7 @@ def punch_factorizations(nu: float, refine: int) -> list[dict]:
 
 
 def beam(nu: float, use_mixed: bool, refine: int) -> dict:
-    b = build_beam(1.0, 0.02, 1e3, nu, plane="strain", refine=refine, mixed=use_mixed)
+    b = BucklingBeam(1.0, 0.02, 1e3, nu, plane="strain", refine=refine, mixed=use_mixed)
     t0 = time.perf_counter()
     P_cr = b.critical_loads(1)[0][0]
     return {"dofs": b.dofs, "time_s": time.perf_counter() - t0,

@@ -46,17 +46,25 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import fem
+from dolfinx.fem.petsc import LinearProblem
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
-from fenics_nl.io import cli
+from fenics_nl.domain.strips import CLAMPED, END, cantilever_strip
+from fenics_nl.errors import SolveError
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials import kinematics, mixed
+from fenics_nl.materials.laws import LinearElastic, NeoHookean, StVenantKirchhoff
 from fenics_nl.parallel import gather_rows
-from fenics_nl.scenes import beam_pictures
-from fenics_nl.scenes.beam import MATERIALS, Beam
+from fenics_nl.plots import continuation as plots
+from fenics_nl.solvers.arclength import ArcLength
+from fenics_nl.solvers.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
+from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.solvers.newton import ConvergenceError, NewtonSolver
+from fenics_nl.solvers.snes import solver_options
 from fenics_nl.theory import elastica
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
@@ -77,8 +85,9 @@ class Buckling(Parameters):
 
     EPILOG = ("PETSc options take the prefix -beam_<newton>_ (Newton's KSP, e.g. "
               "-beam_full_ksp_view), -beam_buckling_ (SLEPc EPS of the critical loads), "
-              "-beam_stability_ (EPS of the end state's stability), -beam_prestress_ (KSP of "
-              "the pre-stress). An option no solver reads is an error.")
+              "-beam_stability_ (EPS of the end state's stability), -beam_continuation_ "
+              "(the arc-length path's stability checks), -beam_prestress_ (KSP of the "
+              "pre-stress). An option no solver reads is an error.")
     OUTPUTS: ClassVar = {"output": "the displacement",
                          "png": "deformed shapes along the path, with the elastica's",
                          "plot": "P/P_cr against tip rotation and deflection"}
@@ -130,23 +139,13 @@ args = cli.arguments(Buckling, prefixes={"beam_": "Newton, SLEPc and pre-stress 
 
 # ### The mesh and its tags
 #
-# Q2 quadrilaterals, 2·2^refine through the height and twice as long as high; the facets
-# of the clamped end
-# x = 0 and of the loaded end x = L are tagged CLAMPED and END.
+# Quadrilaterals, 2·2^refine through the height and twice as long as high
+# (`fenics_nl.domain.strips`); the facets of the clamped end x = 0 and of the loaded end
+# x = L are tagged CLAMPED and END.
 
 # +
 L, h = args.length, args.thickness
-CLAMPED, END = 1, 2  # the facet tags
-ny = 2 * 2**args.refine
-nx = max(4, round(L / h * ny / 2))
-msh = mesh.create_rectangle(comm, [[0, -h / 2], [L, h / 2]], [nx, ny],
-                            mesh.CellType.quadrilateral)
-clamped = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], 0.0))
-end = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], L))
-facets = np.concatenate([clamped, end])
-values = np.hstack([np.full_like(clamped, CLAMPED), np.full_like(end, END)])
-order = np.argsort(facets)  # meshtags takes sorted entities
-facet_tags = mesh.meshtags(msh, 1, facets[order], values[order])
+msh, facet_tags = cantilever_strip(comm, L, h, args.refine)
 # -
 
 # ### The function space and the boundary conditions
@@ -156,16 +155,21 @@ facet_tags = mesh.meshtags(msh, 1, facets[order], values[order])
 # `fem.Constant` the load steps set.
 
 # +
+clamped = facet_tags.find(CLAMPED)
 if args.mixed:
     W = mixed.taylor_hood(msh, 2)
     w = fem.Function(W, name="displacement_pressure")
     (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(W)
-    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+    du = ufl.split(ufl.TrialFunction(W))[0]
+    V, (V0, _) = W.sub(0), W.sub(0).collapse()  # the displacement part, numbered in w
+    dofs = fem.locate_dofs_topological((V, V0), 1, clamped)
+    bcs = [fem.dirichletbc(fem.Function(V0), dofs, V)]
 else:
-    V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    W = V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
     w = u = fem.Function(V, name="displacement")
-    v = ufl.TestFunction(V)
-bcs = [boundary.fixed(V, facet_tags.find(CLAMPED))]
+    v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
+    bcs = [fem.dirichletbc(np.zeros(2), fem.locate_dofs_topological(V, 1, clamped), V)]
+fields = mixed.unknown_of(w)  # where the displacement's and pressure's dofs are in w
 ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
 t = fem.Constant(msh, np.zeros(2))
 
@@ -190,7 +194,8 @@ def set_load(P):
 
 # +
 model = "plane_stress" if args.plane == "stress" else "plane_strain"
-material = MATERIALS[args.material](args.E, args.nu)  # E, ν checked; the neo-Hookean's φ
+law = {"svk": StVenantKirchhoff, "neo-hookean": NeoHookean}[args.material]
+material = law(args.E, args.nu)  # E, ν checked; the neo-Hookean's φ
 mu, lmbda = material.mu, material.lmbda  # Lamé's constants (λ = ∞ at ν = 1/2)
 if model == "plane_stress":  # σ_zz = 0: λ* = 2λμ/(λ + 2μ), 2μ at ν = 1/2
     lmbda = 2 * mu if math.isinf(lmbda) else 2 * lmbda * mu / (lmbda + 2 * mu)
@@ -225,6 +230,7 @@ else:
     S = ufl.diff(phi(e), e)
     internal = ufl.inner(F * S, kinematics.displacement_gradient(v, model))
 residual = internal * dx - ufl.dot(t, v) * ds(END)
+tangent = ufl.derivative(residual, w)  # K_T, for the stability checks
 # -
 
 # ### What is measured: the tip
@@ -243,29 +249,79 @@ def tip():
     return {"axial": ux, "lateral": uy, "rotation": math.atan2(-t0, t1)}
 
 
-beam = Beam(residual, mixed.unknown_of(w), bcs, material=material, model=model, length=L,
-            thickness=h, dx=dx, ds_end=ds(END), set_load=set_load, tip=tip, clamp=clamped)
-say(f"beam L/h = {L / h:g}, {beam.dofs} unknowns, {args.material}, plane {args.plane}"
+E_bending = args.E if model == "plane_stress" else args.E / (1 - args.nu**2)
+P_euler = elastica.euler_load(E_bending, h**3 / 12, L)
+say(f"beam L/h = {L / h:g}, {output.dofs(W)} unknowns, {args.material}, plane {args.plane}"
     f"{', mixed Q2-Q1' if args.mixed else ''}")
 # -
 
 # ### Linear buckling (SLEPc) against Euler
 #
-# $(K + \lambda K_G)\varphi = 0$ around the straight state: $K$ is the residual's tangent at
-# $u = 0$ (Hooke's law: the small-strain limit of the energy), $K_G$ the geometric stiffness of
-# the pre-stress of a unit load (`Beam.critical_loads`, SLEPc shift-and-invert).
+# $(K + \lambda K_G)\varphi = 0$ around the straight state: $K$ is the tangent of Hooke's law
+# (the small-strain limit of the energy: the residual's tangent at $u = 0$), $K_G$ the
+# geometric stiffness $\int \sigma_0 : (\nabla\delta u^T \nabla v)$ of the stress $\sigma_0$
+# of a unit compression, one linear solve. SLEPc's shift-and-invert gives the $\lambda$
+# nearest 0 (`solvers.buckling.critical_loads`; with `--mixed`, $K$ is the mixed tangent and
+# $K_G$ acts on the displacement).
 
 # +
-loads, _ = beam.critical_loads(3)
+hooke = LinearElastic(args.E, args.nu)
+linear = (mixed.internal_work(hooke, u, p, v, q, model) if args.mixed
+          else hooke.internal_work(u, v, model))
+K = ufl.derivative(linear * dx, w)  # Hooke's: the same at any state
+w0 = fem.Function(W)  # the pre-stress state of a unit compression
+unit = fem.Constant(msh, np.array([-1.0 / h, 0.0]))
+direct = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+with solver_options("beam_prestress_", direct) as passed:
+    LinearProblem(K, ufl.dot(unit, v) * ds(END), u=w0, bcs=bcs,
+                  petsc_options_prefix="beam_prestress_", petsc_options=passed).solve()
+u0, p0 = ufl.split(w0) if args.mixed else (w0, None)
+sigma0 = (mixed.cauchy_stress(hooke, u0, p0, model) if args.mixed
+          else hooke.stress(kinematics.small_strain(u0, model)))
+K_G = geometric_stiffness(sigma0, du, v,  # embedded 3×3 ∇ matches a 3×3 σ₀
+                          lambda z: kinematics.displacement_gradient(z, model)) * dx
+loads, _ = critical_loads(K, K_G, bcs, W, n=3, prefix="beam_buckling_",
+                          scale_dofs=fields.displacement_dofs)
 P_cr = loads[0]
 say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
-    f"{beam.P_euler:.6g} ({100 * (P_cr / beam.P_euler - 1):+.3f} %)")
+    f"{P_euler:.6g} ({100 * (P_cr / P_euler - 1):+.3f} %)")
+# -
+
+# ### Stability: the tangent's eigenvalue nearest 0, and a push along its mode
+#
+# $K_T \varphi = \lambda M \varphi$ with $M = \int \delta u \cdot v$ (zero on the pressure:
+# with `--mixed` it is the tangent with the pressure condensed out, whose sign is the
+# stability; $K_T$'s own spectrum holds one negative value per pressure unknown, not
+# counted). An unstable state is pushed along its mode, scaled so that the end face moves
+# sideways by a given deflection (the mean over its nodes).
+
+# +
+mass = ufl.inner(du, v) * dx
+
+
+def lowest_mode():
+    """The tangent's eigenvalue nearest 0 (the lowest, if one is negative) and its mode."""
+    return lowest_tangent_mode(tangent, bcs, W, "beam_stability_", mass=mass,
+                               multipliers=fields.pressure_dofs)
+
+
+owned = fields.displacement_space.dofmap.index_map.size_local
+at_tip = np.isclose(fields.displacement_space.tabulate_dof_coordinates()[:owned, 0], L)
+
+
+def push_along(mode, deflection):
+    """w += η φ, η such that φ's mean end-face lateral displacement is `deflection`."""
+    lateral = mode.x.array[fields.displacement_dofs].reshape(-1, 2)[:owned, 1]
+    mean = comm.allreduce(float(lateral[at_tip].sum())) / comm.allreduce(int(at_tip.sum()))
+    w.x.array[:] += deflection / mean * mode.x.array
+    w.x.scatter_forward()
+
+
 # -
 
 # ### The post-buckling path
 #
-# Load steps to $r P_{Euler}$ (never larger than $1/n$ of it, cut on failure), then the
-# stability check of the end state and, if needed, branch switching (`Beam.solve_path`).
+# Each converged state is recorded: its tip, and its centreline for the pictures.
 
 # +
 def progress(message):
@@ -273,55 +329,96 @@ def progress(message):
     say("  " + message)
 
 
-def centreline(beam):
+def centreline():
     """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
-    d = beam.fields.displacement()
+    d = fields.displacement()
     X = d.function_space.tabulate_dof_coordinates()
     on = np.isclose(X[:, 1], 0.0)
-    u = d.x.array.reshape(-1, 2)[on]
-    rows = gather_rows(comm, X[on, 0], X[on, :2] + u)
-    if rows is None:
-        return None
-    x0, pts = rows
-    return pts[np.argsort(x0)]
+    rows = gather_rows(comm, X[on, 0], X[on, :2] + d.x.array.reshape(-1, 2)[on])
+    return None if rows is None else rows[1][np.argsort(rows[0])]
 
 
 history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
 
 
-def record(t, result):
-    r = t * args.load_ratio
+def record(s, result):
+    r = s * args.load_ratio
     # a redone path, or the branch-switched end state, replaces what it passes again
     while len(history) > 1 and history[-1][0] >= r:
         history.pop()
     while shapes and shapes[-1][0] >= r:
         shapes.pop()
-    tip = beam.tip()
-    history.append((r, math.degrees(abs(tip["rotation"])), abs(tip["lateral"]),
-                    tip["axial"]))
-    cli.converged_step({"load_factor": t, "load_ratio": r, "tip_rotation_deg": history[-1][1],
+    end = tip()
+    history.append((r, math.degrees(abs(end["rotation"])), abs(end["lateral"]), end["axial"]))
+    cli.converged_step({"load_factor": s, "load_ratio": r, "tip_rotation_deg": history[-1][1],
                         "tip_deflection": history[-1][2], "tip_axial": history[-1][3],
                         "newton_iterations": result.iterations},
-                       fields=lambda: [beam.fields.displacement(),
-                                       *([beam.fields.pressure()] if args.mixed else [])])
+                       fields=lambda: [fields.displacement(),
+                                       *([fields.pressure()] if args.mixed else [])])
     if args.png:
-        shapes.append((r, centreline(beam)))
+        shapes.append((r, centreline()))
 
 
-redone, critical = [], []
+# -
+
+# Load control (`solvers.loading.solve_incrementally`: steps of at most 1/`--steps` of the
+# load, cut on failure), then the end state's stability and, if it is unstable, the push
+# along its mode to the elastica's deflection (branch switching), or the path again with 4
+# times the steps. With `--path arc-length`, `solvers.arclength.ArcLength` with branch
+# switching at the bifurcation its inertia count finds.
+
+# +
+redone, critical, switched = [], [], False
+max_it = 30 if args.newton == "full" else 500
 if args.path == "load":
+    P = args.load_ratio * P_euler
+    # rtol 1e-8: near P_cr the tangent is nearly singular and modified Newton's linear
+    # rate is close to 1; tighter tolerances stall there on round-off
+    solver = NewtonSolver(residual, w, bcs, method=args.newton, rtol=1e-8, atol=1e-9,
+                          force_scale=P, max_it=max_it, prefix=f"beam_{args.newton}_")
     say(f"load path to P/P_cr = {args.load_ratio:g} in steps of at most 1/{args.steps}")
-    path, switched = beam.solve_path(args.load_ratio, args.steps, args.newton,
-                                     on_step=record, progress=progress,
-                                     progress_every=max(1, args.steps // 10))
-    if beam.path_steps != args.steps:
+    steps = args.steps
+    while True:
+        w.x.array[:] = 0.0
+        path = solve_incrementally(solver, lambda s: set_load(s * P), steps=steps,
+                                   max_step=1.0 / steps, on_step=record, progress=progress,
+                                   progress_every=max(1, args.steps // 10))
+        lam, mode = lowest_mode()
+        if lam >= 0:
+            break
+        progress(f"end state unstable (tangent eigenvalue {lam:.3g}): switching branch")
+        push_along(mode, elastica.tip_position(args.load_ratio)[0] * L)
+        try:
+            result = solver.solve()
+            if lowest_mode()[0] >= 0:
+                path.results.append(result)
+                path.work.add(result.work)
+                record(1.0, result)
+                switched = True
+                break
+        except ConvergenceError:
+            pass
+        if steps >= 256:
+            raise SolveError(f"no stable end state at P/P_cr = {args.load_ratio:g} with up "
+                             f"to {steps} steps")
+        steps = min(4 * steps, 256)
+        progress(f"branch switching failed: load path again with {steps} steps")
+    if steps != args.steps:
         redone.append(f"the {args.steps}-step path ended on the straight (unstable) branch; "
-                      f"it was redone with {beam.path_steps} steps")
-else:  # λ = P/P_Euler is an unknown of the arc-length path
+                      f"it was redone with {steps} steps")
+else:
+    # atol 1e-8 of the reference load: bent past 90°, the internal forces' round-off
+    # reaches ~5e-9 of it (membrane forces ≫ the load), where modified Newton stalls
+    solver = NewtonSolver(residual, w, bcs, method=args.newton, rtol=1e-8, atol=1e-8,
+                          max_it=max_it, prefix=f"beam_{args.newton}_")
+    continuation = ArcLength(solver, lambda lam: set_load(lam * P_euler),
+                             arc_length=args.arc_length, switch=True,
+                             prefix="beam_continuation_", mass=mass,
+                             metric_dofs=fields.displacement_dofs if args.mixed else None,
+                             multipliers=fields.pressure_dofs)
     say(f"arc-length path to P/P_Euler = {args.load_ratio:g} (first arc {args.arc_length:g})")
-    path = beam.solve_arc_length(args.load_ratio, args.newton, arc_length=args.arc_length,
-                                 on_step=lambda lam, r: record(lam / args.load_ratio, r),
-                                 progress=progress, progress_every=4)
+    path = continuation.run(args.load_ratio, 1000, progress=progress, progress_every=4,
+                            on_step=lambda lam, r: record(lam / args.load_ratio, r))
     switched = path.switched
     critical = [{"kind": c.kind, "load_ratio": c.factor, "between": list(c.between)}
                 for c in path.critical_points]
@@ -338,25 +435,25 @@ alpha_el = math.degrees(elastica.tip_rotation(args.load_ratio))
 d_el, x_el = elastica.tip_position(args.load_ratio)
 say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
     f"{alpha_el:.3f}), lateral deflection {abs(end['lateral']):.5g} (elastica "
-    f"{d_el * args.length:.5g}), axial displacement {end['axial']:.5g} (elastica "
-    f"{(x_el - 1) * args.length:.5g}); {len(path.factors)} steps, "
+    f"{d_el * L:.5g}), axial displacement {end['axial']:.5g} (elastica "
+    f"{(x_el - 1) * L:.5g}); {len(path.factors)} steps, "
     f"{path.iterations} Newton iterations, {path.failures} step cuts")
+reactions = boundary.reactions(residual, w, {"clamp": clamped}, space=V if args.mixed else None)
 out = {
-    "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": beam.P_euler,
-    "critical_load_rel_error": P_cr / beam.P_euler - 1, "load_ratio": args.load_ratio,
+    "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": P_euler,
+    "critical_load_rel_error": P_cr / P_euler - 1, "load_ratio": args.load_ratio,
     "tip_rotation_deg": alpha, "tip_deflection": abs(end["lateral"]),
     "tip_axial_displacement": end["axial"], "elastica_tip_rotation_deg": alpha_el,
-    "elastica_tip_deflection": d_el * args.length,
-    "elastica_tip_axial_displacement": (x_el - 1) * args.length,
+    "elastica_tip_deflection": d_el * L, "elastica_tip_axial_displacement": (x_el - 1) * L,
     "load_steps": len(path.factors), "step_cuts": path.failures,
     "newton_iterations": sum(r.iterations for r in path.results),
     "factorizations": path.work.factorizations, "branch_switched": switched,
     "path_control": args.path, "critical_points": critical,
     "inertia_factorizations": getattr(path, "inertia_factorizations", 0),
-    "newton": args.newton, "mixed": args.mixed, "reactions": beam.reactions(),
-    "reactions_of": "the beam, per unit width", "dofs": beam.dofs, "ranks": comm.size,
-    "path": [{"load_ratio": h[0], "tip_rotation_deg": h[1], "tip_deflection": h[2]}
-             for h in history],
+    "newton": args.newton, "mixed": args.mixed, "reactions": reactions,
+    "reactions_of": "the beam, per unit width", "dofs": output.dofs(W), "ranks": comm.size,
+    "path": [{"load_ratio": x[0], "tip_rotation_deg": x[1], "tip_deflection": x[2]}
+             for x in history],
     "warnings": ["the elastica is inextensible and shear-free: the FE beam differs from it "
                  "by O((h/L)²)", *redone],
 }
@@ -370,9 +467,9 @@ out = {
 
 writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
-    writers.append(lambda: beam_pictures.path_against_elastica(
-        history, args.length, args.thickness, args.imperfection, args.load_ratio, args.plot))
+    writers.append(lambda: plots.path_against_elastica(
+        history, L, h, args.imperfection, args.load_ratio, args.plot))
 if args.png:
-    writers.append(lambda: beam_pictures.shapes_against_elastica(
-        shapes, args.length, args.imperfection, args.load_ratio, args.png))
+    writers.append(lambda: plots.shapes_against_elastica(
+        shapes, L, args.imperfection, args.load_ratio, args.png))
 cli.results(out, writers)

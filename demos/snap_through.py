@@ -49,7 +49,7 @@ from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import StVenantKirchhoff
 from fenics_nl.parallel import gather_rows
-from fenics_nl.scenes import arch_pictures
+from fenics_nl.plots import continuation as plots
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as theory
@@ -349,11 +349,12 @@ out = {
 # closed form and the deformed shapes.
 
 
-outcome = arch_pictures.ArchRun(history, shapes, limits, first, q_limit, a_limit, args.rise,
-                                args.slenderness, args.span, args.newton)
 writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
-    writers.append(lambda: arch_pictures.path_against_theory(outcome, args.plot))
+    writers.append(lambda: plots.arch_path(history, [c.factor for c in limits], q_limit,
+                                           args.rise, args.slenderness, args.newton,
+                                           args.plot))
 if args.png:
-    writers.append(lambda: arch_pictures.shapes_along_the_path(outcome, args.png))
+    writers.append(lambda: plots.arch_shapes(history, shapes, q_limit, a_limit, args.rise,
+                                             args.slenderness, args.span, args.png))
 cli.results(out, writers)

@@ -2,16 +2,69 @@
 
 import math
 
+import basix.ufl
+import numpy as np
 import pytest
+import ufl
+from continuation_problems import BucklingBeam
+from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from fenics_nl.scenes.beam import build_beam
-from fenics_nl.scenes.truss import VonMisesTruss
+from fenics_nl.domain import boundary
 from fenics_nl.solvers.arclength import ArcLength, ContinuationError
+from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import elastica
 from fenics_nl.theory import truss as exact
 
 A, H, EA = 1.0, 0.1, 1e6  # half-span, rise (a shallow truss: it snaps through), EA
+
+
+class VonMisesTruss:
+    """The von Mises truss: two P1 bars in the plane, pinned, one dead apex load.
+
+    Half-span `a`, rise `h`, axial stiffness `EA`, reference apex load `P` (downwards). Each
+    bar is one interval element of a mesh embedded in 2D; its free energy is EA/2 e² per
+    unit reference length, e = (|t + ∂u/∂S|² − 1)/2 the Green–Lagrange strain along the bar
+    (t its unit tangent, S its arc length). P1 is exact here: the strain of a straight
+    two-node bar is uniform, so `theory.truss`'s curve is the model's. The apex load λ P is
+    a nodal force (`NewtonSolver.nodal`).
+    """
+
+    def __init__(self, a, h, EA, P, comm=MPI.COMM_WORLD):
+        self.a, self.h, self.EA, self.P = a, h, EA, P
+        points = np.array([[-a, 0.0], [0.0, h], [a, 0.0]]) if comm.rank == 0 else np.zeros((0, 2))
+        cells = (np.array([[0, 1], [1, 2]], dtype=np.int64) if comm.rank == 0
+                 else np.zeros((0, 2), dtype=np.int64))
+        line = ufl.Mesh(basix.ufl.element("Lagrange", "interval", 1, shape=(2,)))
+        self.mesh = mesh.create_mesh(comm, cells, line, points)
+        self.V = fem.functionspace(self.mesh, ("Lagrange", 1, (2,)))
+        self.u = fem.Function(self.V, name="displacement")
+        J = ufl.Jacobian(self.mesh)
+        t = ufl.as_vector([J[0, 0], J[1, 0]])
+        t = t / ufl.sqrt(ufl.dot(t, t))
+        stretched = t + ufl.grad(self.u) * t  # ∂x/∂S: the deformed bar's tangent
+        e = (ufl.dot(stretched, stretched) - 1) / 2
+        energy = EA / 2 * e**2 * ufl.dx
+        self.residual = ufl.derivative(energy, self.u, ufl.TestFunction(self.V))
+        supports = mesh.locate_entities_boundary(self.mesh, 0, lambda x: np.isclose(x[1], 0))
+        self.bcs = [boundary.fixed(self.V, supports)]
+        X = self.V.tabulate_dof_coordinates()[: self.V.dofmap.index_map.size_local]
+        apex = np.flatnonzero(np.isclose(X[:, 1], h) & np.isclose(X[:, 0], 0))
+        self._apex_dof = (2 * apex + 1).astype(np.int32)  # its vertical component
+        self.solver = None
+
+    def newton(self, **options):
+        """The Newton solver of the truss (its nodal load is set by `set_load`)."""
+        self.solver = NewtonSolver(self.residual, self.u, self.bcs, **options)
+        return self.solver
+
+    def set_load(self, lam):
+        """The apex load λ P, downwards."""
+        self.solver.nodal.set_load(self._apex_dof, np.full(len(self._apex_dof), -lam * self.P))
+
+    def apex_deflection(self):
+        """w: the apex's downward displacement."""
+        return self.mesh.comm.allreduce(-float(self.u.x.array[self._apex_dof].sum()))
 
 
 def trace(method, scale=1.0, target=1.5, comm=MPI.COMM_WORLD, max_steps=60, **options):
@@ -115,7 +168,7 @@ def test_the_beam_leaves_the_straight_branch_at_its_bifurcation(method):
     # inertia changes there, the path is bracketed and left along the critical mode (for
     # modified Newton and BFGS the constant tangent is taken after the kick, not at the
     # bifurcation, where it is singular along the mode)
-    beam = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
+    beam = BucklingBeam(1.0, 0.02, 1e3, 0.3, imperfection=0.0)
     P_cr = beam.critical_loads(1)[0][0] / beam.P_euler  # SLEPc, not a closed form
     path = beam.solve_arc_length(1.5, method)
     assert path.switched
@@ -135,7 +188,7 @@ def test_the_beam_path_on_two_ranks_is_the_serial_one():
     assert MPI.COMM_WORLD.size > 1
 
     def run(comm):
-        beam = build_beam(1.0, 0.02, 1e3, 0.3, imperfection=0.0, comm=comm)
+        beam = BucklingBeam(1.0, 0.02, 1e3, 0.3, imperfection=0.0, comm=comm)
         path = beam.solve_arc_length(1.2)
         return beam.tip(), path
 

@@ -3,8 +3,8 @@
 A `NewtonSolver` holds one `NodalTerms` (`solver.nodal`), its one hook for them: the
 friction force of a slipping contact node and, in 3D, its spring against slip across the
 force's direction (`contact.friction` sets both before each solve); the apex load of the
-von Mises truss (`scenes.truss`). The solver adds them to every residual and tangent it
-assembles, and rebuilds its tangent when the springs change.
+von Mises truss (tests/test_arclength.py). The solver adds them to every residual and
+tangent it assembles, and rebuilds its tangent when the springs change.
 """
 
 from __future__ import annotations
