@@ -1,6 +1,7 @@
 """Forming at finite strain: the upsetting's Newton variants and size, the necking bar's mesh.
 
-A. The upsetting (`demos/upsetting.py`'s scene, 50 %, 20 steps), frictionless and f = 0.2,
+A. The upsetting (`demos/upsetting.py`'s problem written again from the same pieces, 50 %,
+   20 steps), frictionless and f = 0.2,
    with full Newton, modified Newton (the elastic tangent of the configuration each solve
    starts from: the course's choice at finite strain, refactorized per solve) and BFGS on
    it: Newton iterations, factorizations, active-set iterations, time, the time per step
@@ -8,7 +9,7 @@ A. The upsetting (`demos/upsetting.py`'s scene, 50 %, 20 steps), frictionless an
    tangent), the force and its difference from full Newton's.
 B. The size: the f = 0.2 upsetting on a fine mesh, 1 rank and 2 ranks (mpiexec of the
    demo), its wall time and unknowns.
-C. Simo's necking bar (`scenes.necking_bar`, each end pulled 7 mm in 50 steps, radially
+C. Simo's necking bar (`NeckingBar` below, each end pulled 7 mm in 50 steps, radially
    free as in ANSYS VM318) on meshes of 4, 8, 16 and 32 cells across the radius, and 8
    gripped: the peak force against Considère's for the neck section, the neck radius r/r0
    at 4, 5, 6 and 7 mm a end against the published ones (Simo & Hughes 1998 as digitized in
@@ -32,17 +33,26 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
 from common import machine, options, publish
+from dolfinx import fem
 from mpi4py import MPI
 from scipy.optimize import brentq
 
+from fenics_nl.contact import ActiveSetContact, FrictionalContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.axisymmetric import billet, narrowed_bar
+from fenics_nl.domain.probes import Probes
+from fenics_nl.io import output
+from fenics_nl.materials import kinematics
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
-from fenics_nl.scenes.necking_bar import NARROWING, RADIUS, NeckingBar, simo_material
-from fenics_nl.scenes.upsetting import Billet, Upsetting
+from fenics_nl.materials.mixed import unknowns
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.newton import NewtonSolver
 
 ROOT = Path(__file__).resolve().parents[1]
+MODEL = "axisymmetric"
 VARIANTS = {"full": {"method": "full"},
             "modified": {"method": "modified", "max_it": 300},
             "bfgs": {"method": "bfgs", "max_it": 300}}
@@ -53,19 +63,16 @@ def say(msg):
         print(msg, flush=True)
 
 
-def linear_solve_time(up) -> float:
+def linear_solve_time(residual, u, bcs) -> float:
     """One assembly, factorization and solve of the elastic tangent at rest (MUMPS)."""
-    import ufl
-    from dolfinx import fem
     from petsc4py import PETSc
 
-    b = up.billet
-    K = fem.form(ufl.derivative(up.residual, up.u))
+    K = fem.form(ufl.derivative(residual, u))
     t0 = time.perf_counter()
     matrix = FormMatrix(K)  # the solvers' own assembly
-    matrix.assemble(K, b.supports)
+    matrix.assemble(K, bcs)
     A = matrix.mat
-    ksp = PETSc.KSP().create(b.mesh.comm)
+    ksp = PETSc.KSP().create(u.function_space.mesh.comm)
     ksp.setOperators(A)
     ksp.setType("preonly")
     ksp.getPC().setType("lu")
@@ -77,27 +84,62 @@ def linear_solve_time(up) -> float:
 
 
 def upset(cells, friction, variant):
-    billet = Billet(10.0, 20.0, cells=cells)
+    """The billet R0 = 10, h0 = 20 of demos/upsetting.py (P2, its defaults' material and die)
+    to 50 % in 20 steps, with the Newton `variant` in the active set's solves."""
+    R0, h0 = 10.0, 20.0
+    mesh_data = billet(MPI.COMM_WORLD, R0, h0, cells=cells)
+    msh = mesh_data.mesh
+
+    def tagged(name):
+        return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+    V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    u = fem.Function(V, name="displacement")
+    supports = [boundary.component(V, 0, tagged("axis")),
+                boundary.component(V, 1, tagged("mid"))]
     law = FiniteJ2Plasticity(200e3, 0.3, sigma0=400.0, H=1000.0)
-    law.bind(billet.mesh, billet.quadrature_degree)
-    up = Upsetting(billet, law, friction=friction, newton_options=VARIANTS[variant])
-    one_solve = linear_solve_time(up)
+    law.bind(msh, 4)
+    residual = law.internal_work(u, ufl.TestFunction(V), MODEL) * kinematics.quadrature_measure(
+        "dx", msh, 4)
+
+    def die_gap(reduction):  # the die's height above each node
+        return lambda x: 0.5 * h0 * (1.0 - reduction) - x[1]
+
+    newton = {"method": "full", "rtol": 1e-10, "atol": 1e-10, "force_scale": law.sigma0 * R0**2,
+              "max_it": 30, **VARIANTS[variant]}
+    on_die = {"normal_axis": 1, "initial": "penetrating", "newton_options": newton,
+              "prefix": "upsetting_"}
+    S_C = np.union1d(tagged("top"), tagged("side"))
+    if friction > 0:
+        contact = FrictionalContact(residual, u, supports, S_C, die_gap(0.0), friction=friction,
+                                    **on_die)
+    else:
+        contact = ActiveSetContact(residual, u, supports, S_C, die_gap(0.0), **on_die)
+
+    def commit():
+        law.commit(u, MODEL)
+        if friction > 0:
+            contact.commit()
+
+    one_solve = linear_solve_time(residual, u, supports)
+    dofs = output.dofs(V)
     t0 = time.perf_counter()
     try:
-        path = solve_incrementally(up, lambda t: up.set_reduction(0.5 * t), 20, max_step=0.05,
-                                   easy_iterations=10**9, commit=up.commit, restore=up.restore)
+        path = solve_incrementally(contact, lambda t: contact.set_gap(die_gap(0.5 * t)), 20,
+                                   max_step=0.05, easy_iterations=10**9, commit=commit,
+                                   restore=contact.restore if friction > 0 else None)
     except LoadStepError as err:  # a variant that cannot do it: said in the table
         return {"problem": f"upsetting f = {friction:g}", "variant": variant,
-                "dofs": billet.dofs, "failed": str(err).split(";")[0]}
+                "dofs": dofs, "failed": str(err).split(";")[0]}
     elapsed = time.perf_counter() - t0
     steps = len(path.results)
     return {"problem": f"upsetting f = {friction:g}", "variant": variant,
-            "dofs": billet.dofs, "time_s": elapsed, "steps": steps,
+            "dofs": dofs, "time_s": elapsed, "steps": steps,
             "step_cuts": path.failures, "newton_iterations": path.iterations,
             "factorizations": path.work.factorizations,
             "status_iterations": sum(r.active_set_iterations for r in path.results),
             "linear_solve_s": one_solve,
-            "step_in_linear_solves": elapsed / steps / one_solve, "force": up.force}
+            "step_in_linear_solves": elapsed / steps / one_solve, "force": contact.force}
 
 
 def variants(quick):
@@ -137,6 +179,75 @@ def size_runs(quick):
         say(f"upsetting f = 0.2, {d['dofs']} dofs, {ranks} rank(s): {d['wall_time_s']:.1f} s, "
             f"F = {d['force']:.8g}")
     return rows
+
+
+# Simo's necking bar (1988, 1992): a bar of radius r0 = 6.413 mm and length L0 = 53.334 mm,
+# narrowed linearly to 0.982 r0 at mid-length (the imperfection that fixes where the neck
+# forms), pulled at both ends. Units: N, mm, MPa.
+RADIUS, LENGTH, NARROWING = 6.413, 53.334, 0.982
+
+
+def simo_material(nu: float = 0.29) -> FiniteJ2Plasticity:
+    """Steel-like, Voce hardening with a linear part: E = 206.9 GPa, σ_y = 450 + 129.24 p
+    + (715 − 450)(1 − exp(−16.93 p)) MPa."""
+    return FiniteJ2Plasticity(206.9e3, nu, sigma0=450.0, H=129.24, saturation=715.0,
+                              delta=16.93)
+
+
+class NeckingBar:
+    """The quarter 0 < r < R(z), 0 < z < L0/2 of the (r, z) plane, J2 at finite strain.
+
+    The axis (u_r = 0), the mid-plane (u_z = 0), the end z = L0/2 moved along z by half the
+    elongation, radially free as in ANSYS VM318 (`gripped`: held radially too). `cells`
+    across the radius and about 4.2 times as many along the half length, graded towards
+    the neck (`domain.axisymmetric.narrowed_bar`; `grading` 1: uniform). P2 displacements,
+    or Taylor–Hood with `mixed`; full Newton with a line search.
+    """
+
+    def __init__(self, cells: int = 4, *, grading: float = 3.0, mixed: bool = True,
+                 nu: float = 0.29, gripped: bool = False, comm: MPI.Comm = MPI.COMM_WORLD):
+        mesh_data = narrowed_bar(comm, RADIUS, LENGTH, NARROWING, cells, grading)
+        msh = mesh_data.mesh
+
+        def tagged(name):
+            return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+        self.fields = f = unknowns(msh, 2, mixed)
+        self.unknown, self.u, V = f.w, f.u, f.V
+        self.mid = tagged("mid")
+        self.pull = boundary.component(V, 1, tagged("end"), 0.0)
+        bcs = [boundary.component(V, 0, tagged("axis")), boundary.component(V, 1, self.mid),
+               self.pull]
+        if gripped:  # the end held radially too (else only pulled along z, as VM318)
+            bcs.append(boundary.component(V, 0, tagged("end")))
+        self.material = simo_material(nu)
+        self.material.bind(msh, 4)
+        self.residual = f.internal_work(self.material, MODEL) * kinematics.quadrature_measure(
+            "dx", msh, 4)
+        self._residual_form = fem.form(self.residual)
+        self.V = V
+        self.solver = NewtonSolver(self.residual, self.unknown, bcs, rtol=1e-10, atol=1e-10,
+                                   force_scale=450.0 * RADIUS**2, max_it=25, line_search=True,
+                                   prefix="necking_")
+        self.probes = Probes(msh, [[RADIUS * NARROWING, 0.0]])  # the neck's surface
+        self.dofs = output.dofs(self.unknown.function_space)
+
+    def set_elongation(self, elongation: float) -> None:
+        """Move the end by half the total `elongation` (both ends pulled)."""
+        self.pull.g.x.array[:] = 0.5 * elongation
+
+    def commit(self) -> None:
+        """The material's state after a converged step."""
+        self.material.commit(self.u, MODEL)
+
+    def force(self) -> float:
+        """The bar's tension: the mid-plane's reaction (the whole section)."""
+        return boundary.reactions(self._residual_form, self.unknown, {"mid": self.mid},
+                                  {"mid": [1]}, space=self.V)["mid"][1] * -1.0
+
+    def neck_radius(self) -> float:
+        """The current radius of the mid-plane section."""
+        return RADIUS * NARROWING + self.probes.continuous(self.fields.displacement())[0][0]
 
 
 # r/r0 at 4, 5, 6 mm a end (Simo & Hughes, digitized to 0.1 mm) and 7 mm (ANSYS VM318)

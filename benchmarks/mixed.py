@@ -31,11 +31,11 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 import ufl
 from common import machine, options, publish
 from continuation_problems import BucklingBeam
+from plasticity_problems import thick_vessel
+from punch_problem import build_punch
 
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean
-from punch_problem import build_punch
-from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import hertz
 
@@ -92,7 +92,7 @@ def incompressible_cylinder_pressure(a: float, A: float, B: float, mu: float) ->
 def cylinder(nu: float, use_mixed: bool, h: float) -> dict:
     A, B, E, delta = 1.0, 2.0, 3.0, 0.5
     law = NeoHookean(E, nu)
-    body = VesselBody("cylinder", A, B, size=h, mixed=use_mixed)
+    body = thick_vessel("cylinder", A, B, size=h, mixed=use_mixed)
     dx = kinematics.quadrature_measure("dx", body.mesh, 4)
     if use_mixed:
         m = body.mixed
@@ -118,7 +118,7 @@ def linear_solvers(nu: float, linear: str, h: float) -> dict:
     """The incompressible Lamé cylinder (linear, mixed): MUMPS LU or MINRES + blocks."""
     A, B, E = 1.0, 2.0, 3.0
     law = LinearElastic(E, nu)
-    body = VesselBody("cylinder", A, B, size=h, mixed=True)
+    body = thick_vessel("cylinder", A, B, size=h, mixed=True)
     m = body.mixed
     dx = kinematics.quadrature_measure("dx", body.mesh, 4)
     R = (mixed.internal_work(law, m.u, m.p, m.v, m.q, body.model) * dx

@@ -41,10 +41,10 @@ import bracket as bracket_benchmark
 import ufl
 from common import machine, options, publish
 from petsc4py import PETSc
+from plasticity_problems import ThickVessel, thick_vessel
 
 from fenics_nl.io import cli
 from fenics_nl.materials.laws import LinearElastic
-from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import create_ksp
 
@@ -60,7 +60,7 @@ def say(*a):
     print(*a, flush=True)
 
 
-def linear_solve_time(body: VesselBody, E: float, nu: float, pressure: float, dx=None,
+def linear_solve_time(body: ThickVessel, E: float, nu: float, pressure: float, dx=None,
                       prefix: str = "linear_") -> float:
     """One elastic solve of the vessel's mesh: assemble K and the load, factorize (MUMPS LU),
     solve; the second of two runs (the first compiles). `dx`: the non-linear forms' rule
@@ -135,7 +135,7 @@ def vessel(size: float, newton: str, ranks: int = 1, ratio: float = 0.9,
 def sphere(sizes) -> list[dict]:
     rows = []
     for size in sizes:
-        body = VesselBody("sphere", 100.0, 200.0, size=size)
+        body = thick_vessel("sphere", 100.0, 200.0, size=size)
         linear = linear_solve_time(body, 210e3, 0.3, 100.0)
         for newton in SPHERE_VARIANTS:
             r = vessel(size, newton)

@@ -63,10 +63,10 @@ import plasticity
 import ufl
 from common import elapsed, machine, update_docs
 from mpi4py import MPI
+from plasticity_problems import ThickVessel, thick_vessel
 
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import EventCounter, all_event_names, petsc_work, solver_options
 
@@ -86,17 +86,17 @@ def lame_inner_displacement(p: float) -> float:
     return p * A * (1 + NU) / E * ((1 - 2 * NU) * A**2 + B**2) / (B**2 - A**2)
 
 
-def body(h: float) -> VesselBody:
-    return VesselBody("cylinder", A, B, size=h)
+def body(h: float) -> ThickVessel:
+    return thick_vessel("cylinder", A, B, size=h)
 
 
-def linear_solve_time(vb: VesselBody) -> float:
+def linear_solve_time(vb: ThickVessel) -> float:
     """One elastic solve of the mesh (assemble, factorize, solve) on the forms' rule."""
     dx = kinematics.quadrature_measure("dx", vb.mesh, QUADRATURE)
     return plasticity.linear_solve_time(vb, E, NU, LOADS[0], dx=dx, prefix="peer_linear_")
 
 
-def ours(vb: VesselBody, linear_solver: str = "lu") -> dict:
+def ours(vb: ThickVessel, linear_solver: str = "lu") -> dict:
     """fenics_nl: the condensed energy in UFL, its UFL tangent, full Newton."""
     material = J2Plasticity(E, NU, sigma0=SIGMA0, H=H)
     material.bind(vb.mesh, QUADRATURE)
@@ -158,7 +158,7 @@ def radial_return(deps, sigma_n, p_n, lmbda, mu, sigma0, hardening):
     return sigma, tangent, dp
 
 
-def peer(vb: VesselBody, snes_type: str = "vinewtonrsls", factorization: str = "lu") -> dict:
+def peer(vb: ThickVessel, snes_type: str = "vinewtonrsls", factorization: str = "lu") -> dict:
     """dolfinx-external-operator: the return map in Numba behind a FEMExternalOperator."""
     import basix.ufl
     from dolfinx import fem

@@ -46,14 +46,14 @@ def factorize(case: str, size: float, repeat: int) -> dict:
     from dolfinx import fem
     from mpi4py import MPI
     from petsc4py import PETSc
+    from plasticity_problems import thick_vessel
 
     from fenics_nl.materials.laws import LinearElastic
-    from fenics_nl.scenes.vessel import VesselBody
     from fenics_nl.solvers.form_matrix import FormMatrix
     from fenics_nl.solvers.linear_solver import create_ksp
 
     comm = MPI.COMM_WORLD
-    body = VesselBody("sphere", 100.0, 200.0, size=size)
+    body = thick_vessel("sphere", 100.0, 200.0, size=size)
     du, v = ufl.TrialFunction(body.V), ufl.TestFunction(body.V)
     K = fem.form(ufl.derivative(LinearElastic(210e3, 0.3).internal_work(
         body.u, v, body.model) * body.dx, body.u, du))

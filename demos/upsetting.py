@@ -31,6 +31,7 @@
 # ## Implementation
 
 # +
+import math
 import time
 from dataclasses import dataclass
 from typing import ClassVar
@@ -39,14 +40,21 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 # isort: split
 
+import numpy as np
+import ufl
+from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.io import cli
+from fenics_nl.contact import ActiveSetContact, FrictionalContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.axisymmetric import billet
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, number, switch
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
-from fenics_nl.scenes import upsetting_pictures
-from fenics_nl.scenes.upsetting import Billet, Upsetting
+from fenics_nl.parallel import global_max
+from fenics_nl.plots import plasticity
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import forming
 
@@ -74,7 +82,7 @@ class UpsettingParameters(Parameters):
                          "plot": "the force against the reduction, with the frictionless "
                                  "closed form and the slab estimate",
                          "output": "the displacement, the cumulated plastic strain, the "
-                                   "contact pressure and active set at every converged step"}
+                                   "contact pressure and active set"}
     CHECKPOINTS = True
 
     friction: float = number(0.2, "Coulomb friction coefficient f on the die faces (0: "
@@ -104,67 +112,176 @@ args = cli.arguments(UpsettingParameters, prefixes={"upsetting_elim_": "Newton's
 R0, h0 = args.radius, 2 * args.radius * args.aspect
 # -
 
-# ### The billet and its material
+# ### The mesh and its tags
 #
-# P2 triangles on the half section (`Billet`), the axis and the mid-plane held. The
-# material's state (the plastic metric $C_p^{-1}$ and $p$) lives at the quadrature points
-# and is committed when a step converges. Its stress and consistent tangent are UFL's
-# derivatives of the step's condensed energy, as at small strain.
+# The half section $0 < r < R_0$, $0 < z < h_0/2$ (`domain.axisymmetric.billet`): squares
+# cut into four triangles by their diagonals, its edges tagged `axis` ($r = 0$), `mid`
+# (the mid-plane $z = 0$), `top` and `side` ($r = R_0$ above the first row of cells: its
+# foot on the mid-plane is held by the symmetry).
 
 # +
-billet = Billet(R0, h0, cells=args.cells, mixed=args.mixed)
-material = FiniteJ2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
-material.bind(billet.mesh, billet.quadrature_degree)
+model = "axisymmetric"
+mesh_data = billet(comm, R0, h0, cells=args.cells)
+msh = mesh_data.mesh
+
+
+def tagged(name):
+    """The facets of the group `name`."""
+    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+
 # -
 
-# ### The die
+# ### The function space and the supports
 #
-# The active set on the top face and the side (`Upsetting`): frictionless, or Coulomb's
-# statuses with the slip history committed at each converged step. Each active-set
-# iteration is a full Newton solve; the die moves in `--steps` equal steps, each cut in
-# half if it fails (the active set cycles, Newton diverges, or the step is too large for
-# the material's logarithmic strain).
+# P2 displacements (with `--mixed`, Taylor–Hood: a P1 pressure as a second unknown; no
+# triangle has all its vertices on the boundary, so the pair is stable). The axis holds
+# $u_r = 0$, the mid-plane $u_z = 0$.
 
 # +
-up = Upsetting(billet, material, friction=args.friction)
-say(f"billet R0 = {R0:g}, h0 = {h0:g}, f = {args.friction:g}: {billet.dofs} unknowns, "
-    f"h = {billet.h:.3g}")
-cli.known(dofs=billet.dofs, ranks=comm.size, initial_radius=R0, initial_height=h0)
+if args.mixed:
+    W = mixed.taylor_hood(msh, 2)
+    w = fem.Function(W, name="displacement_pressure")
+    (u, p), (v, q) = ufl.split(w), ufl.TestFunctions(W)
+    V = W.sub(0)  # the displacement part: its dofs are numbered in w
+else:
+    V = fem.functionspace(msh, ("Lagrange", 2, (2,)))
+    w = u = fem.Function(V, name="displacement")
+    v = ufl.TestFunction(V)
+parts = mixed.unknown_of(w)  # u (and p) as Functions of their own, to write out
+supports = [boundary.component(V, 0, tagged("axis")), boundary.component(V, 1, tagged("mid"))]
+# -
 
+# ### The material and the residual
+#
+# The material's state (the plastic metric $C_p^{-1}$ and $p$) lives at the quadrature
+# points of the residual's rule and is committed when a step converges. Its stress and
+# consistent tangent are UFL's derivatives of the step's condensed energy, as at small
+# strain. The residual is the virtual work of the first Piola stress on the reference
+# section, $R(u; v) = \int P(F) : \nabla v \; 2\pi r\,dr\,dz$ (with `--mixed`, the
+# variation of $\Pi(u, p)$, `fenics_nl.materials.mixed`).
+
+# +
+material = FiniteJ2Plasticity(args.E, args.nu, sigma0=args.sigma0, H=args.hardening)
+material.bind(msh, 4)  # its state at the quadrature points of dx (degree 4: P2's 2 × 2)
+dx = kinematics.quadrature_measure("dx", msh, 4)
+weight = kinematics.measure_weight(msh, model)  # 2πr: totals per turn
+if args.mixed:
+    residual = mixed.internal_work(material, u, p, v, q, model) * dx
+else:
+    residual = ufl.inner(material.first_piola(u, model),
+                         kinematics.displacement_gradient(v, model)) * weight * dx
+# -
+
+# ### The die and the active set
+#
+# The die is the plane $z = h_0/2 - d$, $d = $ reduction $\cdot h_0/2$. Its candidate
+# surface $S_C$ is the top face and the side, whose nodes fold onto the die as the billet
+# barrels. A node's condition $u_z \le \gamma = h_0/2 - d - Z$ is exact at any
+# deformation for a flat die (its current height $Z + u_z$ stays below the die), and so is
+# its slip: the die does not move along $r$, and a node's slip on it is its increment of
+# $u_r$. The active set on $S_C$: frictionless (`ActiveSetContact`), or Coulomb's statuses
+# (`FrictionalContact`) with the slip history committed at each converged step. Each
+# active-set iteration is a full Newton solve, its absolute tolerance scaled by the force of
+# a yielded die face.
+
+# +
+def die_gap(reduction):
+    """γ(x) = h0/2 (1 − reduction) − z: the die's height above each node."""
+    return lambda x: 0.5 * h0 * (1.0 - reduction) - x[1]
+
+
+newton = {"method": "full", "rtol": 1e-10, "atol": 1e-10,
+          "force_scale": args.sigma0 * R0**2, "max_it": 30}
+on_die = {"normal_axis": 1, "initial": "penetrating", "newton_options": newton,
+          "prefix": "upsetting_", "displacement_space": V if args.mixed else None}
+S_C = np.union1d(tagged("top"), tagged("side"))
+if args.friction > 0:
+    contact = FrictionalContact(residual, w, supports, S_C, die_gap(0.0),
+                                friction=args.friction, **on_die)
+else:
+    contact = ActiveSetContact(residual, w, supports, S_C, die_gap(0.0), **on_die)
+dofs = output.dofs(w.function_space)
+say(f"billet R0 = {R0:g}, h0 = {h0:g}, f = {args.friction:g}: {dofs} unknowns, "
+    f"h = {R0 / args.cells:.3g}")
+# -
+
+# ### What is measured
+#
+# The die's force (the contact forces' total over the turn), and on $S_C$ the current
+# radius $r + u_r$ of its nodes: the outermost one on the die (the contact radius), the
+# outermost sticking one, and how many nodes of the side have folded onto the die.
+
+# +
+r_dofs, _ = contact.surface.tangential(0)  # u_r at the nodes of S_C, in w's numbering
+on_top = np.isclose(contact.x[:, 1], 0.5 * h0, atol=1e-9 * 0.5 * h0)
+
+
+def current_radius():
+    """r + u_r at the nodes of S_C."""
+    return contact.x[:, 0] + w.x.array[r_dofs]
+
+
+def outermost(nodes):
+    """The largest current radius of the nodes of S_C in the mask `nodes` (0: none)."""
+    return global_max(comm, current_radius()[nodes & contact.owned])
+
+
+# -
+
+# ### Load steps
+#
+# The die moves in `--steps` equal steps; each step's solver is the active-set loop
+# (`contact.solve()`), from the last step's set and the die's new gap. A step that fails
+# (the active set cycles, Newton diverges, or the step is too large for the material's
+# logarithmic strain) is cut in half. A converged step commits the plastic state and, with
+# friction, the slip history; a cut one restores the statuses of the last converged step.
+
+# +
+cli.known(dofs=dofs, ranks=comm.size, initial_radius=R0, initial_height=h0)
 history = []
 
 
 def record(t, result):
     """One converged step: the force, the closed forms, the contact zone."""
     r = t * args.reduction
-    step = {"load_factor": t, "reduction": r, "force": up.force,
+    step = {"load_factor": t, "reduction": r, "force": contact.force,
             "force_frictionless_exact": forming.frictionless_force(
                 r, R0, material.yield_stress, args.E),
             "force_slab_estimate": forming.slab_force(r, R0, h0, args.friction,
                                                       material.yield_stress, args.E),
-            "contact_radius": up.contact_radius(), "stick_radius": up.stick_radius(),
-            "folded_nodes": up.folded_nodes(), "newton_iterations": result.iterations,
+            "contact_radius": outermost(contact.active),
+            "stick_radius": outermost(contact.stick) if args.friction > 0 else 0.0,
+            "folded_nodes": contact.surface.count(contact.active & ~on_top),
+            "newton_iterations": result.iterations,
             "status_iterations": result.active_set_iterations}
     history.append(step)
-    cli.converged_step(step, lambda: [billet.displacement(), *material.output_fields(),
-                                      *up.contact.fields(billet.weight)])
-    say(f"  reduction {r:.3f}: F = {up.force:.6g} (frictionless "
+    cli.converged_step(step, lambda: [parts.displacement(), *material.output_fields(),
+                                      *contact.fields(weight)])
+    say(f"  reduction {r:.3f}: F = {contact.force:.6g} (frictionless "
         f"{step['force_frictionless_exact']:.6g}), contact radius "
         f"{step['contact_radius']:.4g}, stick {step['stick_radius']:.4g}; "
         f"{result.iterations} Newton / {result.active_set_iterations} status iterations")
 
 
+def commit():
+    """A converged step: the material's state and (friction) the slip history."""
+    material.commit(u, model)
+    if args.friction > 0:
+        contact.commit()
+
+
 # --checkpoint saves, after each converged step, the displacement, the plastic state, the
 # contact's statuses and slip history and the steps so far; --restart puts them back
-checkpoints = cli.checkpointing({"unknown": billet.unknown, **material.state_functions()},
-                                newton=up.contact.newton, contact=up.contact)
+checkpoints = cli.checkpointing({"unknown": w, **material.state_functions()},
+                                newton=contact.newton, contact=contact)
 history += checkpoints.steps
 t0 = time.perf_counter()
-run = solve_incrementally(up, lambda t: up.set_reduction(t * args.reduction), args.steps,
-                          adaptive=True, max_step=1.0 / args.steps,
+run = solve_incrementally(contact, lambda t: contact.set_gap(die_gap(t * args.reduction)),
+                          args.steps, adaptive=True, max_step=1.0 / args.steps,
                           easy_iterations=10**9, progress=say, progress_every=10**9,
-                          commit=up.commit, restore=up.restore, on_step=record,
-                          **checkpoints.options)
+                          commit=commit, restore=contact.restore if args.friction > 0 else None,
+                          on_step=record, **checkpoints.options)
 solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 # -
 
@@ -172,10 +289,17 @@ solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 #
 # Frictionless: the force at every step against $\sigma_y(p)\pi R_0^2 h_0/h$ (the mesh
 # represents the homogeneous state exactly: the error is the solver's). With friction: the
-# force above it, and its ratio to the slab estimate.
+# force above it, and its ratio to the slab estimate. And the volume of the whole billet,
+# $2 \cdot 2\pi \int J\, r\,dr\,dz$: the plastic flow keeps it, the elastic strain
+# changes it a little.
 
 # +
 last = history[-1]
+p_cum = material.cumulated_plastic_strain
+owned = p_cum.function_space.dofmap.index_map.size_local
+max_plastic_strain = global_max(comm, p_cum.x.array[:owned])
+J = ufl.det(kinematics.deformation_gradient(u, model))
+volume = 2 * comm.allreduce(fem.assemble_scalar(fem.form(J * weight * dx)))
 frictionless_error = max(abs(h["force"] / h["force_frictionless_exact"] - 1) for h in history)
 slab_ratio = last["force"] / last["force_slab_estimate"]
 if args.friction == 0:
@@ -199,12 +323,12 @@ out = {"force": last["force"], "reduction": last["reduction"], "friction": args.
        "force_frictionless_error": frictionless_error if args.friction == 0 else None,
        "force_slab_estimate": last["force_slab_estimate"], "force_over_slab": slab_ratio,
        "stick_radius": last["stick_radius"], "contact_radius": last["contact_radius"],
-       "folded_nodes": last["folded_nodes"], "max_plastic_strain": up.max_plastic_strain(),
-       "volume_change": up.volume() / up.initial_volume(R0, h0) - 1,
+       "folded_nodes": last["folded_nodes"], "max_plastic_strain": max_plastic_strain,
+       "volume_change": volume / (math.pi * R0**2 * h0) - 1,
        "newton_iterations": run.iterations,
        "status_iterations": sum(h["status_iterations"] for h in history),
        "step_cuts": run.failures, "factorizations": run.work.factorizations,
-       "dofs": billet.dofs, "ranks": comm.size, "solve_time_s": solve_time,
+       "dofs": dofs, "ranks": comm.size, "solve_time_s": solve_time,
        "warnings": [] if args.friction == 0 else [
            "the slab estimate assumes sliding on the whole face and small f R/h: an "
            "estimate, not a closed form"]}
@@ -214,15 +338,21 @@ title = (f"upsetting to {100 * last['reduction']:.0f} %, f = {args.friction:g}: 
 
 
 def picture():
-    """The billet at the last state, coloured by its plastic strain."""
-    upsetting_pictures.billet_picture(up, args.png, title)
+    """The billet at the last state, coloured by its plastic strain; the nodes on the die."""
+    x = np.column_stack([current_radius(), contact.x[:, 1] + w.x.array[contact.surface.dofs_V]])
+    on = contact.owned & contact.active  # u_z above: S_C's normal component
+    marked = ({"sticking nodes": x[on & contact.stick], "slipping nodes": x[on & contact.slip]}
+              if args.friction > 0 else {"nodes on the die": x[on]})
+    plasticity.billet_picture(parts.displacement(), material.cumulated_plastic_strain_per_cell(),
+                              args.png, title, die_height=0.5 * h0 * (1 - last["reduction"]),
+                              marked=marked)
     say(f"wrote {args.png}")
 
 
 def curve():
     """The force against the reduction, every converged step."""
-    if billet.mesh.comm.rank == 0:
-        upsetting_pictures.force_curve(history, args.friction, args.plot, title)
+    if comm.rank == 0:
+        plasticity.upsetting_force_curve(history, args.friction, args.plot, title)
 
 
 cli.results(out, [*([picture] if args.png else []), *([curve] if args.plot else [])])

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 import ufl
 from mpi4py import MPI
+from plasticity_problems import thick_vessel  # benchmarks/, on the tests' path
 
 from fenics_nl.domain.probes import Probes
 from fenics_nl.materials import mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean, PowerLaw, StVenantKirchhoff
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.scenes.vessel import VesselBody
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import vessels
@@ -41,7 +41,7 @@ def test_incompressible_law_without_the_mixed_formulation_is_one_clear_error():
 def cylinder(material, h, *, pressure=None, inner=None, steps=1):
     """The plane-strain thick cylinder, mixed, under a pressure or an inner displacement
     (in `steps` load steps); returns the body, the residual and the last step's result."""
-    body = VesselBody("cylinder", A, B, size=h, mixed=True)
+    body = thick_vessel("cylinder", A, B, size=h, mixed=True)
     m = body.mixed
     R = mixed.internal_work(material, m.u, m.p, m.v, m.q, body.model) * ufl.dx(
         metadata={"quadrature_degree": 4})
@@ -134,7 +134,7 @@ def test_j2_in_the_mixed_formulation_reaches_the_cylinder_limit_load():
     # (2/√3) σ0 ln(b/a) where the displacement form on coarse P2 overestimates it
     law = J2Plasticity(210e3, 0.3, sigma0=250.0)
     a, b, h = 100.0, 200.0, 12.5
-    body = VesselBody("cylinder", a, b, size=h, mixed=True)
+    body = thick_vessel("cylinder", a, b, size=h, mixed=True)
     m = body.mixed
     law.bind(body.mesh, 4)
     from fenics_nl.materials import kinematics
@@ -225,7 +225,7 @@ def test_mixed_bracket_bad_combinations_are_one_line(demo):
 def minres_iterations(nu, h=0.05):
     """Krylov iterations of the block-preconditioned MINRES on the Lamé cylinder, u(a) error."""
     law, p_in = LinearElastic(E, nu), 1e-3
-    body = VesselBody("cylinder", A, B, size=h, mixed=True)
+    body = thick_vessel("cylinder", A, B, size=h, mixed=True)
     m = body.mixed
     dx = ufl.dx(metadata={"quadrature_degree": 4})
     R = (mixed.internal_work(law, m.u, m.p, m.v, m.q, body.model) * dx

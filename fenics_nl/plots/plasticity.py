@@ -1,0 +1,200 @@
+"""Pictures of plastic bodies against their closed forms: the thick vessel and the upsetting.
+
+The deformed body coloured by the cumulated plastic strain (each cell's largest), with
+what it is compared with drawn on it: the closed form's plastic radius in the vessel's
+quarter (`vessel_plastic_zone`), the die and the contact statuses on the billet
+(`billet_picture`). And the load against the motion: the vessel's pressure against its
+inner displacement with Lamé and the perfectly plastic sphere (`vessel_pressure_curve`),
+the die's force against the height reduction with the homogeneous compression and the slab
+method (`upsetting_force_curve`). `demos/pressure_vessel.py` and `demos/upsetting.py` draw
+them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.io import pictures
+from fenics_nl.theory import vessels
+
+__all__ = ["VesselRun", "billet_picture", "upsetting_force_curve", "vessel_plastic_zone",
+           "vessel_pressure_curve"]
+
+
+@dataclass
+class VesselRun:
+    """What the pictures read of a vessel run (pressures and lengths in the run's units).
+
+    Args:
+        shape: ``sphere`` or ``cylinder``.
+        a: the inner radius.
+        b: the outer radius.
+        E: Young's modulus.
+        nu: Poisson's ratio.
+        sigma0: the yield stress.
+        path: (pressure, u(a)) after each converged step, from (0, 0).
+        loaded: the peak pressure (also after unloading).
+        unload: whether the run unloaded from it.
+        p_lim: the closed form's limit pressure.
+        p_e: the closed form's yield-onset pressure.
+        c_fe: the plastic radius computed.
+        c_exact: the plastic radius of the closed form.
+        compliance: Lamé's elastic u(a)/p.
+        exact_curve: the closed form holds along the whole loading (sphere, perfect
+            plasticity, below the limit).
+        inner: u(a) at the peak, computed.
+        inner_exact: u(a) at the peak, of the closed form (None if not `exact_curve`).
+    """
+
+    shape: str
+    a: float
+    b: float
+    E: float
+    nu: float
+    sigma0: float
+    path: list
+    loaded: float
+    unload: bool
+    p_lim: float
+    p_e: float
+    c_fe: float
+    c_exact: float
+    compliance: float
+    exact_curve: bool
+    inner: float
+    inner_exact: float | None
+
+    def title(self, sep: str = ", ") -> str:
+        """What the run ends in, loaded or unloaded from its peak.
+
+        Args:
+            sep: what goes before the plastic radius (a new line in the curve's title).
+
+        Returns:
+            The title of both pictures.
+        """
+        # plain "nu": pyvista's font has no Greek letters (the picture shares this title)
+        closed = "closed form" + (" for nu = 1/2" if self.shape == "cylinder" else "")
+        radius = f"plastic radius {self.c_fe:.4g} ({closed} {self.c_exact:.4g})"
+        if self.unload:
+            return (f"{self.shape}: unloaded from {self.loaded / self.p_lim:.3f} p_lim, "
+                    f"permanent u(a) = {self.path[-1][1]:.4g}{sep}{radius}")
+        return f"{self.shape}: p = {self.loaded / self.p_lim:.3f} p_lim{sep}{radius}"
+
+
+def vessel_pressure_curve(run: VesselRun, path: str, comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """p(u(a)) of the run against the closed forms (loading and elastic unloading).
+
+    Args:
+        run: the run's values.
+        path: the PNG, written by rank 0 of `comm`.
+        comm: the run's communicator.
+    """
+    if comm.rank != 0:
+        return
+    plt = pictures.pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    q, d = np.array(run.path).T
+    p_lim, loaded = run.p_lim, run.loaded
+    if run.exact_curve:  # the monotonic loading, exact up to the limit
+        ps = np.linspace(0.0, loaded, 200)
+        us = [vessels.sphere_inner_displacement(run.a, run.b, run.E, run.nu, run.sigma0, x)
+              for x in ps]
+        ax.plot(us, ps / p_lim, "k-", lw=1, label="closed form (loading)")
+    else:  # Lamé up to the yield onset
+        ps = np.array([0.0, min(run.p_e, loaded)])
+        ax.plot(ps * run.compliance, ps / p_lim, "k-", lw=1, label="Lamé (elastic)")
+    if run.unload:  # from the closed-form peak (else the computed one), Lamé's compliance
+        peak = run.inner_exact if run.inner_exact is not None else run.inner
+        # the sphere unloads elastically up to 2 p_e (σ_eq(a) goes from σ0 to −σ0); the
+        # cylinder's bound is close to it (exact for ν = 1/2)
+        reverse = loaded > 2 * run.p_e
+        ax.plot([peak, peak - loaded * run.compliance], [loaded / p_lim, 0.0], "k--", lw=1,
+                label="elastic unloading (Lamé" + (", reverse yield ignored)" if reverse
+                                                   else ")"))
+    ax.plot(d, q / p_lim, "o", ms=4, mfc="none", color="C0", label="FE, J2 (each step)")
+    ax.axhline(1.0, color="C3", ls="--", lw=1, label=f"limit pressure {p_lim:.4g}")
+    ax.axhline(run.p_e / p_lim, color="gray", ls=":", lw=1, label="yield onset")
+    ax.set_xlabel("inner radial displacement u(a) [length]")
+    ax.set_ylabel("p / p_lim")
+    ax.set_ylim(0, 1.08)
+    ax.set_xlim(left=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.set_title(f"b/a = {run.b / run.a:g}, " + run.title("\n"), fontsize=9)
+    pictures.save_figure(fig, path)
+
+
+def vessel_plastic_zone(run: VesselRun, displacement: fem.Function,
+                        plastic_strain_per_cell: fem.Function, path: str) -> None:
+    """The deformed quarter coloured by each cell's largest cumulated plastic strain.
+
+    The closed form's plastic radius drawn over it. Collective; rank 0 writes `path`.
+
+    Args:
+        run: the run's values.
+        displacement: u (a Function of its own space).
+        plastic_strain_per_cell: p, each cell's largest (DG0).
+        path: the PNG.
+    """
+    theta = np.linspace(0.0, 0.5 * np.pi, 91)
+    c = run.c_exact
+    arc = {f"closed-form plastic radius {c:.4g}"
+           + (" (for nu = 1/2)" if run.shape == "cylinder" else ""):
+           np.column_stack([c * np.cos(theta), c * np.sin(theta)])}
+    pictures.deformed_picture(displacement, plastic_strain_per_cell, path, run.title(),
+                              label="cumulated plastic strain", curves=arc)
+
+
+def billet_picture(displacement: fem.Function, plastic_strain_per_cell: fem.Function,
+                   path: str, title: str, *, die_height: float,
+                   marked: dict[str, np.ndarray]) -> None:
+    """The deformed half billet coloured by p, the die and the nodes on it.
+
+    True scale (the die is drawn where it is). Collective; rank 0 writes `path`.
+
+    Args:
+        displacement: u (a Function of its own space), the (r, z) half section's.
+        plastic_strain_per_cell: p, each cell's largest (DG0).
+        path: the PNG.
+        title: the picture's title.
+        die_height: the die's current height: the plane z = `die_height`.
+        marked: a name → this rank's nodes to draw at their current (r, z) (the sticking
+            and the slipping ones, or those on the die).
+    """
+    pictures.deformed_picture(
+        displacement, plastic_strain_per_cell, path, title, marked=marked,
+        label="cumulated plastic strain p", axes=("r (length)", "z (length)"),
+        obstacle={"obstacle": "plane", "point": [0.0, die_height], "normal": [0.0, 1.0]})
+
+
+def upsetting_force_curve(history: list[dict], friction: float, path: str, title: str) -> None:
+    """F against the reduction, with the frictionless closed form and the slab estimate.
+
+    Args:
+        history: each converged step's ``reduction``, ``force``,
+            ``force_frictionless_exact`` and (with friction) ``force_slab_estimate``.
+        friction: Coulomb's coefficient f (0: no slab estimate drawn).
+        path: the PNG (call on one rank).
+        title: the figure's title.
+    """
+    plt = pictures.pyplot()
+    r = np.array([0.0] + [h["reduction"] for h in history])
+    fig, ax = plt.subplots(figsize=(7, 4.8))
+    ax.plot(100 * r, [0.0] + [h["force"] for h in history], "o-", ms=3,
+            label=f"computed, f = {friction:g}")
+    ax.plot(100 * r, [0.0] + [h["force_frictionless_exact"] for h in history], "k--",
+            label="frictionless, homogeneous: σ_y(p) π R0² h0/h")
+    if friction > 0:
+        ax.plot(100 * r, [0.0] + [h["force_slab_estimate"] for h in history], "g:",
+                label="slab method: (1 + 2fR/3h) × frictionless")
+    ax.set_xlabel("height reduction 1 − h/h0 (%)")
+    ax.set_ylabel("die force F (force units)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    pictures.save_figure(fig, path)
