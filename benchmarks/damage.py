@@ -4,8 +4,10 @@ A. The AT1 bar of L = 2 ell (free damage ends): through its loss of stability (d
    second variation, left along its mode) and its crack, 20 displacement steps to twice ε_c.
 B. A crack in a held bar (AT1, ell = L/10) on three meshes, h = ell/5, ell/10, ell/20: the
    dissipated energy's error against Gc (1 + h/(c_w ell)).
-C. The surfing test (`scenes.surfing`): a crack dragged by a moving K-field, 15 steps; 2 dD/da
-   against the mesh's toughness (the 1D half bar cracked at its free end).
+C. The surfing test (`demos/crack.py --test surfing`): a crack dragged by a moving K-field, 15
+   steps; 2 dD/da against the mesh's toughness (the 1D half bar cracked at its free end).
+
+The problems are `damage_problems`' (built as the demos build theirs), which the tests share.
 
 Each with the plain alternate iteration, over-relaxed (ω = 1.5) and Anderson-accelerated
 (depth 5), both guarded by the energy: alternate iterations, the Newton iterations in u and
@@ -23,11 +25,10 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 
 import numpy as np
 from common import machine, options, publish
+from damage_problems import GradientBar, crack, end_crack, pull, release_rate, surfing
 from mpi4py import MPI
 
 from fenics_nl.materials.gradient_damage import GradientDamage
-from fenics_nl.scenes.gradient_damage_bar import GradientDamageBar, crack, end_crack, pull
-from fenics_nl.scenes.surfing import Surfing, release_rate
 
 SCHEMES = ("none", "overrelaxed", "anderson")
 
@@ -61,7 +62,7 @@ def bar_runs(quick):
     rows = []
     for scheme in SCHEMES:
         t0 = time.perf_counter()
-        bar = GradientDamageBar(law(0.5), 1.0, 20 if quick else 40, acceleration=scheme)
+        bar = GradientBar(law(0.5), 1.0, 20 if quick else 40, acceleration=scheme)
         strains = bar.law.critical_strain * np.linspace(0, 2, 21)[1:]
         record = pull(bar, strains)
         rows.append(row("bar, unstable", scheme, t0, work(record), bar.dissipated_energy(),
@@ -94,11 +95,11 @@ def surfing_runs(quick):
     steps = 8 if quick else 15
     for scheme in SCHEMES:
         t0 = time.perf_counter()
-        surf = Surfing(law(0.04, 0.3), resolution=4, acceleration=scheme, toughness=2 * half)
-        record = surf.advance(surf.notch + 2 * surf.h * np.arange(steps + 1))
+        record = surfing(law(0.04, 0.3), steps, resolution=4, acceleration=scheme,
+                         toughness=2 * half)
         G, lag = release_rate(record, skip=steps // 3)
         rows.append(row("surfing", scheme, t0, work(record), G, error=G / (2 * half) - 1,
-                        lag=lag, dofs=surf.dofs))
+                        lag=lag, dofs=record.dofs))
     return rows
 
 

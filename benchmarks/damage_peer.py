@@ -1,12 +1,13 @@
 """Gradient damage against a peer: phasefieldx 0.4.1 on Miehe's notched square in tension.
 
-The same specimen, mesh, pre-crack and load steps (`scenes.notched_specimen`: the square
+The same specimen, mesh, pre-crack and load steps (`demos/crack.py`'s tension test: the square
 [0, 1]² mm, E = 210 kN/mm², ν = 0.3, Gc = 2.7e-3 kN/mm, plane strain, the notch a band of one
 cell at α = 1, h = ell/2 where the crack goes, the top moved up in equal steps), AT2 with no
 split (the one model both have: phasefieldx's history solver is AT2 only), residual
 stiffness 1e-6:
 
-* **ours**: `AlternateMinimization`, irreversibility as a bound αⁿ ≤ α ≤ 1 (SNES
+* **ours**: `AlternateMinimization` (as the demo builds it: `Specimen` below),
+  irreversibility as a bound αⁿ ≤ α ≤ 1 (SNES
   `vinewtonrsls`), plain and Anderson-accelerated, stopped at max |Δα| < 1e-6;
 * **peer**: phasefieldx's staggered solver with Miehe's history field
   (`Element.Phase_Field_Fracture.solver.solver_history.solve`, `irreversibility="miehe"`):
@@ -44,11 +45,15 @@ import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfi
 # isort: split
 
 import numpy as np
+import ufl
 from common import machine, options, publish
+from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.materials.gradient_damage import GradientDamage
-from fenics_nl.scenes.notched_specimen import NotchedSpecimen
+from fenics_nl.domain import boundary
+from fenics_nl.domain.damage_specimens import BOTTOM, NOTCH, TOP, notched_square
+from fenics_nl.materials.gradient_damage import GradientDamage, crack_tip
+from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
 
 sys.modules.setdefault("scifem", types.ModuleType("scifem"))  # see the docstring
 try:
@@ -72,7 +77,59 @@ def say(msg):
         print(msg, flush=True)
 
 
-def crack_line(specimen: NotchedSpecimen) -> np.ndarray:
+class Specimen:
+    """Miehe's notched square in tension, as `demos/crack.py` builds it (h = ell/2)."""
+
+    def __init__(self, ell: float, acceleration: str = "anderson"):
+        self.law = a = law(ell)
+        h = ell / 2
+        msh, cells, facets = notched_square(MPI.COMM_WORLD, h, "tension", width=3 * ell)
+        self.mesh, self.notch_tip = msh, np.array([0.5, 0.5])
+        self.V = V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+        self.A = A = fem.functionspace(msh, ("Lagrange", 1))
+        self.u, self.alpha = fem.Function(V), fem.Function(A)
+        self.top = facets.find(TOP)
+        self.top_bc = boundary.component(V, 1, self.top)  # the top moved up
+        self.bcs = [boundary.fixed(V, facets.find(BOTTOM)), self.top_bc,
+                    boundary.component(V, 0, self.top)]
+        cracked = fem.locate_dofs_topological(A, 2, cells.find(NOTCH))
+        self.alpha.x.array[cracked] = 1.0
+        self.precrack = fem.dirichletbc(1.0, cracked, A)
+        self.solver = AlternateMinimization(
+            a.energy(self.u, self.alpha, "plane_strain") * ufl.dx, self.u, self.alpha,
+            self.bcs, damage_bcs=[self.precrack], force_scale=a.critical_stress * h,
+            damage_scale=a.Gc / a.ell * h**2, tol=TOL, max_it=2000, acceleration=acceleration)
+        self._fracture = fem.form(a.fracture_energy(self.alpha) * ufl.dx)
+        self._residual = fem.form(self.solver.residual_u)
+        self.dofs = V.dofmap.index_map.size_global * 2 + A.dofmap.index_map.size_global
+
+    def load(self, loads) -> tuple[AlternateWork, list, list, list]:
+        """The demo's steps: (the work, the top's force, the tip, D at each step)."""
+        work, force, tips, dissipated = AlternateWork(), [], [], []
+        for U in loads:
+            self.top_bc.g.x.array[:] = U
+            work.count(self.solver.solve())
+            self.solver.commit()
+            force.append(self.force())
+            tips.append(self.tip())
+            dissipated.append(self.dissipated_energy())
+        return work, force, tips, dissipated
+
+    def force(self) -> float:
+        """The top's reaction along its motion, per unit thickness."""
+        return boundary.reactions(self._residual, self.u, {"top": self.top})["top"][1]
+
+    def tip(self) -> list[float]:
+        """The broken node (α >= 0.9) ahead of the notch farthest from its tip."""
+        return crack_tip(self.alpha, self.notch_tip, level=0.9,
+                         where=lambda x: x[0] > 0.5 + 1e-9)
+
+    def dissipated_energy(self) -> float:
+        """∫ (Gc/c_w)(w(α)/ell + ell |∇α|²), per unit thickness."""
+        return self.mesh.comm.allreduce(fem.assemble_scalar(self._fracture), op=MPI.SUM)
+
+
+def crack_line(specimen: Specimen) -> np.ndarray:
     """(x, y) of the crack ahead of the notch: on each column of nodes, the most damaged."""
     n = specimen.A.dofmap.index_map.size_local
     x = specimen.A.tabulate_dof_coordinates()[:n, :2]
@@ -84,7 +141,7 @@ def crack_line(specimen: NotchedSpecimen) -> np.ndarray:
     return np.column_stack([columns, ahead[order[first], 1]])
 
 
-def summary(specimen: NotchedSpecimen, loads, force, tips, dissipated, seconds, **extra):
+def summary(specimen: Specimen, loads, force, tips, dissipated, seconds, **extra):
     k = int(np.argmax(force))
     line = crack_line(specimen)
     return {"time_s": seconds, "peak_force": force[k], "peak_displacement": float(loads[k]),
@@ -96,25 +153,25 @@ def summary(specimen: NotchedSpecimen, loads, force, tips, dissipated, seconds, 
 
 
 def ours(ell, loads, acceleration) -> dict:
-    """`NotchedSpecimen.load`: alternate minimization, the damage bounded."""
-    NotchedSpecimen(law(ell), resolution=2, acceleration=acceleration).load(loads[:1])
-    specimen = NotchedSpecimen(law(ell), resolution=2, acceleration=acceleration)
+    """`Specimen.load`: alternate minimization, the damage bounded."""
+    Specimen(ell, acceleration).load(loads[:1])
+    specimen = Specimen(ell, acceleration)
     t0 = time.perf_counter()
-    record = specimen.load(loads)
+    work, force, tips, dissipated = specimen.load(loads)
     seconds = time.perf_counter() - t0
-    return summary(specimen, loads, record.force, record.tip, record.dissipated_energy,
-                   seconds, scheme=acceleration, alternate_iterations=record.iterations,
-                   newton_iterations=record.newton_iterations,
-                   damage_iterations=record.damage_iterations)
+    return summary(specimen, loads, force, tips, dissipated, seconds, scheme=acceleration,
+                   alternate_iterations=work.iterations,
+                   newton_iterations=work.newton_iterations,
+                   damage_iterations=work.damage_iterations)
 
 
 def phasefieldx(ell, loads, folder: Path) -> dict:
     """phasefieldx's history solver on a fresh specimen's mesh, spaces, supports, pre-crack."""
-    specimen = NotchedSpecimen(law(ell), resolution=2)
+    specimen = Specimen(ell)
     states = []  # (u, damage, the time it converged) of each step
 
     def move_top(bcs, t):
-        specimen._top_bc.g.x.array[:] = loads[round(t)]
+        specimen.top_bc.g.x.array[:] = loads[round(t)]
         return 0.0, float(loads[round(t)]), 0.0
 
     energies = peer.compute_total_energies

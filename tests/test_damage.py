@@ -132,37 +132,37 @@ def homogeneous_gradient_damage_bar(model, split="none", sign=1, steps=10):
     import numpy as np
     import ufl
     from dolfinx import fem
+    from mpi4py import MPI
 
     from fenics_nl.domain import boundary
-    from fenics_nl.materials.damage import CourseDamage
+    from fenics_nl.domain.damage_specimens import BOTTOM, LEFT, RIGHT, TOP, bar_strip
     from fenics_nl.materials.gradient_damage import GradientDamage
-    from fenics_nl.scenes.damage_bar import DamageBar
     from fenics_nl.solvers.alternate import AlternateMinimization
 
     law = GradientDamage(1.0, 0.0, Gc=1.0, ell=0.1, model=model, residual_stiffness=1e-6,
                          split=split)
-    bar = DamageBar(CourseDamage(1.0, 0.0, w_c=1.0), 1.0, 10)  # its mesh and supports
-    alpha = fem.Function(fem.functionspace(bar.mesh, ("Lagrange", 1)))
-    energy = law.energy(bar.u, alpha, bar.MODEL) * ufl.dx
-    solver = AlternateMinimization(energy, bar.u, alpha, force_scale=law.critical_stress * 0.1)
+    msh, tags = bar_strip(MPI.COMM_WORLD, 1.0, 10)  # 0.1 high
+    V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+    u = fem.Function(V)
+    alpha = fem.Function(fem.functionspace(msh, ("Lagrange", 1)))
+    energy = law.energy(u, alpha, "plane_strain") * ufl.dx
+    solver = AlternateMinimization(energy, u, alpha, force_scale=law.critical_stress * 0.1)
     peak = law.critical_strain if model == "at1" else math.sqrt(law.Gc / law.ell / 3)
     assert law.critical_stress == pytest.approx(
         law.homogeneous_stress(peak), rel=1e-14)
     if model == "at1":
         assert law.critical_stress == pytest.approx(
             (1 + 1e-6) * math.sqrt(3 * 1.0 * 1.0 / (8 * 0.1)), rel=1e-14)
-    lateral = []
-    if split != "none":
-        from dolfinx import mesh
-
-        top = mesh.locate_entities_boundary(bar.mesh, 1, lambda x: np.isclose(x[1], bar.height))
-        lateral = [boundary.component(bar.V, 1, top)]
+    supports = [boundary.component(V, 0, tags.find(LEFT)),
+                boundary.component(V, 1, tags.find(BOTTOM))]
+    lateral = [boundary.component(V, 1, tags.find(TOP))] if split != "none" else []
     for strain in sign * np.linspace(0, 2 * peak, steps + 1)[1:]:
-        solver.solve([*bar.stretch_supports(strain), *lateral])
+        end = boundary.component(V, 0, tags.find(RIGHT), strain)  # L = 1
+        solver.solve([*supports, end, *lateral])
         solver.commit()
-        held = boundary.reactions(solver.residual_u, bar.u, {"right": bar.right},
-                                  {"right": [0]}, space=bar.V)["right"][0]
-        sigma = held / bar.cross_section
+        held = boundary.reactions(solver.residual_u, u, {"right": tags.find(RIGHT)},
+                                  {"right": [0]}, space=V)["right"][0]
+        sigma = held / 0.1
         assert sigma == pytest.approx(law.homogeneous_stress(strain), rel=1e-9)
         assert alpha.x.array == pytest.approx(law.homogeneous_damage(strain), abs=1e-9)
 
@@ -181,8 +181,7 @@ def crack_in_a_held_bar(comm):
     # AT1, ell = L/10, h = ell/5 and ell/10 (odd cells: a band of one cell at α = 1 in the
     # middle), pulled to twice the peak's strain
     import numpy as np
-
-    from fenics_nl.scenes.gradient_damage_bar import crack
+    from damage_problems import crack
 
     law = _gradient_law("at1", 0.1)
     strains = _peak_strain(law) * np.array([0.99, 1.1, 1.25, 1.5, 2.0])
@@ -222,13 +221,11 @@ def test_the_homogeneous_bar_bifurcates_where_its_second_variation_says(model):
 
 def _pulled_short_bar(model, acceleration, comm=None):
     import numpy as np
+    from damage_problems import GradientBar, pull
     from mpi4py import MPI
 
-    from fenics_nl.scenes.gradient_damage_bar import GradientDamageBar, pull
-
     law = _gradient_law(model, 0.5)
-    bar = GradientDamageBar(law, 1.0, 40, acceleration=acceleration,
-                            comm=comm or MPI.COMM_WORLD)
+    bar = GradientBar(law, 1.0, 40, acceleration=acceleration, comm=comm or MPI.COMM_WORLD)
     record = pull(bar, _peak_strain(law) * np.linspace(0, 2, 21)[1:])
     return bar, record
 
@@ -267,14 +264,12 @@ def surfing_run(comm, steps):
     # AT1, ell = 0.04, h = ell/4 along the path, a K-field moved by 2h per step
     # (Anderson-accelerated alternate minimization: 15 iterations a step, the plain one 136,
     # the same crack to 1e-8 in G)
-    import numpy as np
+    from damage_problems import surfing
 
     from fenics_nl.materials.gradient_damage import GradientDamage
-    from fenics_nl.scenes.surfing import Surfing
 
     law = GradientDamage(1.0, 0.3, Gc=1.0, ell=0.04, model="at1", residual_stiffness=1e-6)
-    surf = Surfing(law, resolution=4, acceleration="anderson", comm=comm)
-    return surf, surf.advance(surf.notch + 2 * surf.h * np.arange(steps + 1))
+    return surfing(law, steps, resolution=4, acceleration="anderson", comm=comm)
 
 
 def test_a_surfing_crack_follows_its_k_field_and_dissipates_the_mesh_toughness():
@@ -283,28 +278,26 @@ def test_a_surfing_crack_follows_its_k_field_and_dissipates_the_mesh_toughness()
     # = 1.1875, measured 1.1867); the surfing crack's 2 dD/da over its steady steps: -1.4 %
     # (the issue asks 2 %). The tip trails the field's centre by a constant h
     import numpy as np
+    from damage_problems import end_crack, release_rate
     from mpi4py import MPI
-
-    from fenics_nl.scenes.gradient_damage_bar import end_crack
-    from fenics_nl.scenes.surfing import release_rate
 
     bar_law = _gradient_law("at1", 0.04)
     strains = bar_law.critical_strain * np.array([0.99, 1.1, 1.5, 2, 3])
     half = end_crack(bar_law, 0.4, 40, strains)
     assert 2 * half == pytest.approx(1 + 2 * 0.01 / (8 / 3 * 0.04), rel=2e-3)
-    surf, record = surfing_run(MPI.COMM_WORLD, 10)
+    record = surfing_run(MPI.COMM_WORLD, 10)
     G, lag = release_rate(record, skip=4)
     assert G == pytest.approx(2 * half, rel=0.02)
     lags = np.array(record.centre[4:]) - np.array(record.tip[4:])
-    assert np.ptp(lags) < 1e-9 and 0 <= lag <= 2 * surf.h
+    assert np.ptp(lags) < 1e-9 and 0 <= lag <= 2 * record.h
 
 
 @pytest.mark.mpi
 def test_a_surfing_crack_on_two_ranks_is_the_serial_one():
     from mpi4py import MPI
 
-    _, cut = surfing_run(MPI.COMM_WORLD, 4)
-    _, whole = surfing_run(MPI.COMM_SELF, 4)
+    cut = surfing_run(MPI.COMM_WORLD, 4)
+    whole = surfing_run(MPI.COMM_SELF, 4)
     assert cut.tip == whole.tip
     assert cut.dissipated_energy == pytest.approx(whole.dissipated_energy, rel=1e-7)
 

@@ -30,7 +30,7 @@ import ufl
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["AT1", "AT2", "DamagedElastic", "GradientDamage"]
+__all__ = ["AT1", "AT2", "DamagedElastic", "GradientDamage", "crack_tip"]
 
 MODELS = {"at1": 8.0 / 3.0, "at2": 2.0}  # c_w
 SPLITS = ("none", "volumetric")
@@ -289,3 +289,35 @@ class DamagedElastic(SmallStrain):
             model: the kinematic model (unused).
         """
         self.lower.x.array[:] = self.alpha.x.array
+
+
+def crack_tip(alpha, origin, *, level: float, where=None) -> list[float]:
+    """A crack's tip: the broken node (α ≥ `level`) farthest from `origin` (collective).
+
+    A crack of the mesh is a band of cells at α = 1, whose neighbours' nodes are at most
+    (1 − h/(2 ell))² (AT1): a level above that (0.9 at ell/h = 2) finds the band's nodes only.
+
+    Args:
+        alpha: the damage (a P1 Function).
+        origin: where the crack starts (a notch's tip), its coordinates.
+        level: the damage of a broken node.
+        where: the nodes looked at, a marker of their coordinates as DOLFINx's (x of shape
+            (3, n) to a boolean array); None: all.
+
+    Returns:
+        The tip's coordinates (`origin` if no node is broken).
+    """
+    import numpy as np
+
+    A = alpha.function_space
+    n = A.dofmap.index_map.size_local
+    x = A.tabulate_dof_coordinates()[:n]
+    broken = alpha.x.array[:n] >= level
+    if where is not None:
+        broken &= where(x.T)
+    gdim = A.mesh.geometry.dim
+    cracked, origin = x[broken, :gdim], np.asarray(origin, dtype=float)
+    d = np.linalg.norm(cracked - origin, axis=1)
+    local = (float(d.max()), *cracked[d.argmax()]) if len(d) else (0.0, *origin)
+    best = max(A.mesh.comm.allgather(local))
+    return [float(v) for v in best[1:]]

@@ -15,11 +15,16 @@ only condenses v out (its eigenvalues are infinite): λ is that of the Schur com
 E''_αα − E''_αu (E''_uu)⁻¹ E''_uα, per unit volume, whatever the mesh. Its eigenvector's β is
 the critical mode. Both come from `buckling.lowest_tangent_mode` (the tangent's inertia,
 then shift-and-invert) on the mixed space of (u, α), the second derivative by UFL.
+
+Along a load path, `BranchStability` keeps λ step by step and tells where it crossed 0;
+`DamageStability.perturb` moves α along the critical mode, where the path leaves its branch.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import basix.ufl
 import numpy as np
@@ -29,7 +34,7 @@ from mpi4py import MPI
 
 from fenics_nl.solvers import buckling
 
-__all__ = ["DamageStability"]
+__all__ = ["BranchStability", "DamageStability"]
 
 # α is at its bound if within this of it and E pushes against it by more than DRIVING times
 # the node's share of the damage's energy scale (∫ density · β): the damage criterion is met
@@ -136,3 +141,72 @@ class DamageStability:
         beta.x.array[:] /= top if top >= -bottom else bottom
         return float(lam), beta
 
+    def perturb(self, mode: fem.Function, amplitude: float) -> None:
+        """α + amplitude · mode, kept within αⁿ ≤ α ≤ 1: where a step leaves its branch.
+
+        Args:
+            mode: the critical mode (`lowest_mode`'s β, max |β| = 1).
+            amplitude: its factor.
+        """
+        a = self.alpha.x.array
+        a[:] = np.clip(a + amplitude * mode.x.array, self.lower.x.array, 1.0)
+
+
+@dataclass
+class BranchStability:
+    """The lowest eigenvalue of each step of a load path, until it turns negative.
+
+    A load path of alternate minimization leaves its branch where the second variation's
+    lowest eigenvalue λ on the inactive set (`DamageStability.lowest_mode`) turns negative.
+    Where it does, `observe` says so, and the bifurcation load is where λ crossed 0 between
+    the last step and this one, interpolated linearly in the load's square (exact for the
+    homogeneous bar, whose λ is affine in ε²). If no damage could grow at the step before (λ
+    infinite: AT1 unstable as soon as it damages), it is the damage's onset: where the
+    driving margin of the elastic steps (`DamageStability.driving_margin`), affine in the
+    load's square too, reaches 0, extrapolated from the last two (None with fewer).
+    """
+
+    loads: list[float] = field(default_factory=list)  # the steps observed
+    lowest_eigenvalue: list[float] = field(default_factory=list)  # inf: no damage can grow
+    # (load, driving margin) of the steps where no damage could grow (elastic)
+    elastic_margins: list[tuple[float, float]] = field(default_factory=list)
+    damage_onset: float | None = None  # the load where the margin reaches 0, extrapolated
+    bifurcation_load: float | None = None
+    bifurcation_step: int | None = None  # the index of the step where λ turned negative
+
+    def observe(self, load: float, lam: float, margin: float) -> bool:
+        """One converged step's λ: whether the path bifurcates at it (λ < 0, the first time).
+
+        Args:
+            load: the step's load (e.g. the bar's mean strain).
+            lam: the lowest eigenvalue there (inf where no damage can grow).
+            margin: the driving margin there (read where λ is infinite).
+
+        Returns:
+            True at the step where λ is negative, the first time.
+        """
+        self.loads.append(float(load))
+        self.lowest_eigenvalue.append(lam)
+        if not math.isfinite(lam):
+            self.elastic_margins.append((float(load), margin))
+        elif self.damage_onset is None:
+            self.damage_onset = self._onset()
+        if lam >= 0:
+            return False
+        self.bifurcation_step = len(self.loads) - 1
+        self.bifurcation_load = self._crossing(load, lam)
+        return True
+
+    def _crossing(self, load: float, lam: float) -> float | None:
+        """Where λ crossed 0 since the last step (affine in the load's square), or the onset."""
+        if len(self.loads) < 2 or not math.isfinite(self.lowest_eigenvalue[-2]):
+            return self.damage_onset
+        e0, l0 = self.loads[-2], self.lowest_eigenvalue[-2]
+        return math.sqrt(e0**2 + (load**2 - e0**2) * l0 / (l0 - lam))
+
+    def _onset(self) -> float | None:
+        """The load where the elastic steps' margin, affine in its square, reaches 0."""
+        if len(self.elastic_margins) < 2:
+            return None
+        (e1, m1), (e2, m2) = self.elastic_margins[-2:]
+        return math.sqrt(e2**2 + (e2**2 - e1**2) * m2 / (m1 - m2))
