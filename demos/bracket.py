@@ -44,13 +44,14 @@ from mpi4py import MPI
 from fenics_nl.contact import ActiveSetContact, FrictionalContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.bracket import THICK, bracket_mesh
-from fenics_nl.io import cli, output, pictures
+from fenics_nl.io import cli, output
 from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch, text
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, PowerLaw
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.parallel import global_max
+from fenics_nl.plots import deformed, figures
 from fenics_nl.solvers import LoadStepError, NewtonSolver, SnesSolver, solve_incrementally
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
@@ -512,7 +513,7 @@ else:
     def curve():
         """The load against the load-point displacement, every converged step."""
         if comm.rank == 0:
-            plt = pictures.pyplot()
+            plt = figures.pyplot()
             fig, ax = plt.subplots(figsize=(5, 4))
             ax.plot([0] + [s["load_point_displacement"] for s in steps],
                     [0] + [s["force"] / 1e3 for s in steps], "o-")
@@ -520,12 +521,12 @@ else:
                    title=f"bracket, {args.support} support, {args.material}"
                    + (f" n = {args.n}" if args.material == "power-law" else ""))
             ax.grid(alpha=0.3)
-            pictures.save_figure(fig, args.plot)
+            figures.save_figure(fig, args.plot)
 
     def picture():
         """The deformed part, coloured by σ_eq (J2: by the cumulated plastic strain)."""
         field = material.cumulated_plastic_strain_per_cell() if plastic else von_mises()
-        pictures.bracket_picture(
+        deformed.bracket_picture(
             parts.displacement(), field, args.png,
             clamped=tagged("bolts"), loaded=tagged("load"), load_motion=load_point_motion(),
             units=args.units, force=args.force, support=args.support, unloaded=args.unload,

@@ -59,7 +59,7 @@ from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.laws import LinearElastic, NeoHookean, StVenantKirchhoff
 from fenics_nl.parallel import gather_rows
-from fenics_nl.plots import continuation as plots
+from fenics_nl.plots import continuation as continuation_pictures
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.buckling import critical_loads, geometric_stiffness, lowest_tangent_mode
 from fenics_nl.solvers.loading import solve_incrementally
@@ -467,9 +467,9 @@ out = {
 
 writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
-    writers.append(lambda: plots.path_against_elastica(
+    writers.append(lambda: continuation_pictures.path_against_elastica(
         history, L, h, args.imperfection, args.load_ratio, args.plot))
 if args.png:
-    writers.append(lambda: plots.shapes_against_elastica(
+    writers.append(lambda: continuation_pictures.shapes_against_elastica(
         shapes, L, args.imperfection, args.load_ratio, args.png))
 cli.results(out, writers)

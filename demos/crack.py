@@ -67,7 +67,7 @@ from fenics_nl.domain.damage_specimens import (
 from fenics_nl.io import cli
 from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.materials.gradient_damage import GradientDamage, crack_tip
-from fenics_nl.plots import damage as pictures
+from fenics_nl.plots import damage as damage_pictures
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
 
 cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
@@ -382,12 +382,12 @@ first = int(moved[0]) if len(moved) and not surfing else len(tips) // 2
 shown = sorted({0 if surfing else max(first - 1, 0), first, len(tips) - 1})
 if surfing:
     title = (f"surfing: 2 dD/da = {G:.4g} kN/mm (mesh toughness {mesh_toughness:.4g})")
-    writers = [lambda: pictures.surfing_figure(args.plot, A, damage, shown, loads,
+    writers = [lambda: damage_pictures.surfing_figure(args.plot, A, damage, shown, loads,
                                                [x for x, _ in tips], title=title)]
 else:
     title = (f"{args.test}: {args.model.upper()}, ℓ = {args.ell:g} mm, "
              f"h = ℓ/{args.ell / h:.3g}")
-    writers = [lambda: pictures.notched_figure(args.plot, A, damage, shown, loads, force,
+    writers = [lambda: damage_pictures.notched_figure(args.plot, A, damage, shown, loads, force,
                                                peak_force=out["peak_force"], title=title)]
 # -
 

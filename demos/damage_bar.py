@@ -87,7 +87,7 @@ from fenics_nl.materials import kinematics
 from fenics_nl.materials.damage import CourseDamage
 from fenics_nl.materials.gradient_damage import GradientDamage
 from fenics_nl.parallel import global_max
-from fenics_nl.plots import damage as pictures
+from fenics_nl.plots import damage as damage_pictures
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.damage_stability import BranchStability, DamageStability
@@ -493,7 +493,7 @@ else:
             "alternate_iterations": work.iterations, "acceleration": args.acceleration}
 # -
 
-writers = ([lambda: pictures.stress_strain(
+writers = ([lambda: damage_pictures.stress_strain(
     args.plot, law, args.model, strain_history, stress_history, peak_strain=peak_strain,
     peak_stress=sigma_c, table=table, bifurcation=out["bifurcation_strain"],
     bifurcation_exact=out.get("bifurcation_strain_exact"))] if args.plot else [])

@@ -164,9 +164,9 @@ summary["function"] = args.function
 
 def plot(results, path, title):
     """e_{k+1} against e_k, log-log: near the root the points lie on lines of slope q."""
-    from fenics_nl.io import pictures  # imports dolfinx: only when a plot is asked for
+    from fenics_nl.plots import figures  # imports dolfinx: only when a plot is asked for
 
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
 
     fig, ax = plt.subplots(figsize=(6, 5))
     lo, hi = math.inf, 0.0
@@ -193,7 +193,7 @@ def plot(results, path, title):
     ax.set_title(f"e_k+1 against e_k (grey: slopes 1, 1.62, 2)\n{title}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 cli.results(summary, [lambda: plot(results, args.plot, what)] if args.plot else [])

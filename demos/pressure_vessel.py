@@ -46,7 +46,7 @@ from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, choice, number, switch
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.plasticity import J2Plasticity
-from fenics_nl.plots import plasticity
+from fenics_nl.plots import plasticity as plasticity_pictures
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.snes import SnesSolver
@@ -483,7 +483,7 @@ def summary():
     return out
 
 
-outcome = plasticity.VesselRun(
+outcome = plasticity_pictures.VesselRun(
     shape, a, b, args.E, args.nu, s0, path, loaded, args.unload, p_lim, p_e_exact, c_fe,
     c_exact, compliance, exact_curve, inner, inner_exact)
 
@@ -491,10 +491,10 @@ outcome = plasticity.VesselRun(
 
 def picture():
     """The plastic zone on the deformed quarter, and the path."""
-    plasticity.vessel_plastic_zone(outcome, displacement_now(),
+    plasticity_pictures.vessel_plastic_zone(outcome, displacement_now(),
                                    material.cumulated_plastic_strain_per_cell(), args.png)
     say(f"wrote {args.png}")
 
 
-cli.results(summary(), [*([lambda: plasticity.vessel_pressure_curve(outcome, args.plot)]
+cli.results(summary(), [*([lambda: plasticity_pictures.vessel_pressure_curve(outcome, args.plot)]
                           if args.plot else []), *([picture] if args.png else [])])

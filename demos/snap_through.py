@@ -49,7 +49,7 @@ from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import StVenantKirchhoff
 from fenics_nl.parallel import gather_rows
-from fenics_nl.plots import continuation as plots
+from fenics_nl.plots import continuation as continuation_pictures
 from fenics_nl.solvers.arclength import ArcLength
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.theory import arch as theory
@@ -351,10 +351,10 @@ out = {
 
 writers = []  # (--output: the fields of every converged step were written as they came)
 if args.plot:
-    writers.append(lambda: plots.arch_path(history, [c.factor for c in limits], q_limit,
-                                           args.rise, args.slenderness, args.newton,
-                                           args.plot))
+    writers.append(lambda: continuation_pictures.arch_path(
+        history, [c.factor for c in limits], q_limit, args.rise, args.slenderness,
+        args.newton, args.plot))
 if args.png:
-    writers.append(lambda: plots.arch_shapes(history, shapes, q_limit, a_limit, args.rise,
-                                             args.slenderness, args.span, args.png))
+    writers.append(lambda: continuation_pictures.arch_shapes(
+        history, shapes, q_limit, a_limit, args.rise, args.slenderness, args.span, args.png))
 cli.results(out, writers)

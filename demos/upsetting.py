@@ -54,7 +54,7 @@ from fenics_nl.io.parameters import Parameters, number, switch
 from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.parallel import global_max
-from fenics_nl.plots import plasticity
+from fenics_nl.plots import plasticity as plasticity_pictures
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.theory import forming
 
@@ -343,16 +343,16 @@ def picture():
     on = contact.owned & contact.active  # u_z above: S_C's normal component
     marked = ({"sticking nodes": x[on & contact.stick], "slipping nodes": x[on & contact.slip]}
               if args.friction > 0 else {"nodes on the die": x[on]})
-    plasticity.billet_picture(parts.displacement(), material.cumulated_plastic_strain_per_cell(),
-                              args.png, title, die_height=0.5 * h0 * (1 - last["reduction"]),
-                              marked=marked)
+    plasticity_pictures.billet_picture(
+        parts.displacement(), material.cumulated_plastic_strain_per_cell(), args.png, title,
+        die_height=0.5 * h0 * (1 - last["reduction"]), marked=marked)
     say(f"wrote {args.png}")
 
 
 def curve():
     """The force against the reduction, every converged step."""
     if comm.rank == 0:
-        plasticity.upsetting_force_curve(history, args.friction, args.plot, title)
+        plasticity_pictures.upsetting_force_curve(history, args.friction, args.plot, title)
 
 
 cli.results(out, [*([picture] if args.png else []), *([curve] if args.plot else [])])

@@ -142,12 +142,12 @@ def test_output_is_a_time_series_of_every_converged_step(tmp_path, demo):
 
 
 def test_a_failing_picture_keeps_the_json(tmp_path, demo, monkeypatch):
-    from fenics_nl.io import pictures
+    from fenics_nl.plots import figures
 
     def broken(*args, **kwargs):
         raise RuntimeError("the renderer crashed")
 
-    monkeypatch.setattr(pictures, "save_figure", broken)
+    monkeypatch.setattr(figures, "save_figure", broken)
     proc = demo.run(["punch.py", "--refine", "0", "--json", "o.json", "--png", "p.png"],
                     check=False)
     assert proc.returncode == 1 and "writing an output failed" in proc.stderr

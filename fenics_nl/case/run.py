@@ -298,11 +298,11 @@ def load_path_plot(out: dict, path: str) -> None:
     """
     if MPI.COMM_WORLD.rank != 0:
         return
-    from fenics_nl.io import pictures
+    from fenics_nl.plots import figures
 
     steps = out["steps"]
     t = [0.0] + [s["load_factor"] for s in steps]
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     names = COMPONENTS[out["model"]]
     curves = [{}, {}, {}]
@@ -330,7 +330,7 @@ def load_path_plot(out: dict, path: str) -> None:
             ax.text(0.5, 0.5, "none in this case", ha="center", transform=ax.transAxes)
     fig.suptitle(f"{Path(out['case']).name}: {out['law']}, {out['model']}, {len(steps)} "
                  f"converged steps, load factor {out['load_factor']:.4g}", fontsize=11)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | None = None):
@@ -342,7 +342,7 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
     writers = [lambda: load_path_plot(out, plot)] if plot else []
     if png:
         def picture():
-            from fenics_nl.io.pictures import deformed_picture, facet_points
+            from fenics_nl.plots.deformed import deformed_picture, facet_points
 
             marked = {}
             for c in problem.case.conditions:

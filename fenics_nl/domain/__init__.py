@@ -1,5 +1,6 @@
 """Meshes and what is written on them.
 
-Meshes (`meshes`, gmsh), their checks (`mesh_check`), boundary conditions and reactions
-(`boundary`), and point values of fields (`probes`).
+Meshes with their tags (`meshes` by gmsh; `bracket`, `strips`, `axisymmetric`,
+`damage_specimens`, `graded_grid`), their checks (`mesh_check`), boundary conditions and
+reactions (`boundary`), and point values of fields (`probes`).
 """

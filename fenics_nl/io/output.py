@@ -1,4 +1,4 @@
-"""What a scene hands to its user: VTX fields for ParaView, whole meshes for pictures.
+"""What a run hands to its user: VTX fields for ParaView, whole meshes for pictures.
 
 * `write_fields`: one ADIOS2 VTX file per function (any Lagrange degree, on any mesh
   degree: P2 on quadrilaterals included), which ParaView opens directly.

@@ -15,7 +15,7 @@ import math
 import numpy as np
 from mpi4py import MPI
 
-from fenics_nl.io import pictures
+from fenics_nl.plots import figures
 from fenics_nl.theory import arch, elastica
 
 __all__ = ["arch_path", "arch_shapes", "path_against_elastica", "shapes_against_elastica"]
@@ -38,7 +38,7 @@ def arch_path(history, limits, q_limit: float, rise: float, slenderness: float, 
     if comm.rank != 0:
         return
     h = np.array(history)
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, ax = plt.subplots(figsize=(7, 5))
     a = np.linspace(min(h[:, 1].min(), -rise) * 1.05, rise * 1.02, 400)
     ax.plot(a, [arch.load(x, rise) / q_limit for x in a], "-", color="k", lw=1,
@@ -60,7 +60,7 @@ def arch_path(history, limits, q_limit: float, rise: float, slenderness: float, 
                  f"{err} from the closed form", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def arch_shapes(history, shapes, q_limit: float, a_limit: float, rise: float,
@@ -81,7 +81,7 @@ def arch_shapes(history, shapes, q_limit: float, a_limit: float, rise: float,
     """
     if comm.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, ax = plt.subplots(figsize=(9.5, 3.5))
     picks = shapes[:: max(1, len(shapes) // 8)] + shapes[-1:]
     cmap = plt.get_cmap("viridis")
@@ -99,7 +99,7 @@ def arch_shapes(history, shapes, q_limit: float, a_limit: float, rise: float,
                  f"(e/r = {rise:g}, L/h = {slenderness:g})", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def path_against_elastica(history, length: float, thickness: float, imperfection: float,
@@ -117,7 +117,7 @@ def path_against_elastica(history, length: float, thickness: float, imperfection
     """
     if comm.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
 
     h = np.array(history)
     top = max(h[:, 0].max(), 1.1) * 1.05
@@ -145,7 +145,7 @@ def path_against_elastica(history, length: float, thickness: float, imperfection
     fig.suptitle(f"cantilever, L/h = {length / thickness:g}, imperfection "
                  f"{imperfection:g} P: P/P_cr = {load_ratio:g}, α = {h[-1, 1]:.2f}° "
                  f"(elastica {math.degrees(elastica.tip_rotation(load_ratio)):.2f}°)")
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def shapes_against_elastica(shapes, length: float, imperfection: float, load_ratio: float,
@@ -162,7 +162,7 @@ def shapes_against_elastica(shapes, length: float, imperfection: float, load_rat
     """
     if comm.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
 
     fig, ax = plt.subplots(figsize=(7, 6))
     L = length
@@ -206,4 +206,4 @@ def shapes_against_elastica(shapes, length: float, imperfection: float, load_rat
                  f"{math.degrees(elastica.tip_rotation(load_ratio)):.1f}°", fontsize=10)
     ax.legend(fontsize=8, loc="best")
     ax.grid(alpha=0.3)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)

@@ -14,7 +14,8 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.io import output, pictures
+from fenics_nl.io import output
+from fenics_nl.plots import figures
 
 __all__ = ["notched_figure", "stress_strain", "surfing_figure"]
 
@@ -49,7 +50,7 @@ def stress_strain(path: str, law, model: str, strains, stresses, *, peak_strain:
     """
     if MPI.COMM_WORLD.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     local = model == "local"
     fig, axes = plt.subplots(1, 1 if local else 2, figsize=(6.5 if local else 11, 4.5),
                              squeeze=False)
@@ -80,7 +81,7 @@ def stress_strain(path: str, law, model: str, strains, stresses, *, peak_strain:
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def _profile(ax, t: dict) -> None:
@@ -168,7 +169,7 @@ def _crack_figure(path, space, damage, shown, x, y, curve, label) -> None:
     grids = _snapshots(space, [damage[k] for k in shown])
     if MPI.COMM_WORLD.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     from matplotlib.ticker import MaxNLocator
 
     fig, axes = plt.subplots(1, 1 + len(shown), figsize=(4.2 + 3.1 * len(shown), 3.9),
@@ -187,7 +188,7 @@ def _crack_figure(path, space, damage, shown, x, y, curve, label) -> None:
     # beside the last panel, not taken from it: the panels keep one size
     bar = axes[-1].inset_axes([1.06, 0.0, 0.06, 1.0])
     fig.colorbar(image, cax=bar, label="damage α", ticks=np.linspace(0, 1, 5))
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def _snapshots(space: fem.FunctionSpace, damage: list[np.ndarray]) -> list:

@@ -22,7 +22,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.errors import SolveError
-from fenics_nl.io import pictures
+from fenics_nl.plots import figures
 from fenics_nl.theory import hertz, mindlin
 
 __all__ = ["PunchRun", "curves", "identification_figure", "misfit_grid", "section_picture"]
@@ -85,7 +85,7 @@ def curves(run: PunchRun, path: str) -> None:
     """P(δ) of every step against Hertz, beside the pressure (or traction) panel."""
     if not run.rank0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     n = len(run.states) if run.loading_steps is None else run.loading_steps
     d = np.array([0.0] + [s.indentation for s in run.states])
@@ -105,7 +105,7 @@ def curves(run: PunchRun, path: str) -> None:
     ax1.grid(alpha=0.3)
     _right_panel(ax2, run, run.profile, run.state)
     fig.suptitle(title(run, run.state))
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def title(run: PunchRun, state) -> str:
@@ -228,7 +228,7 @@ def section_picture(run: PunchRun, path: str) -> None:
     state, ref = run.state, run.ref
     if not run.rank0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     x, z, u_x, u_z, triangles, vm = run.section
     a = max(state.contact_radius, ref["contact_radius"] if ref else 0.0, 4 * run.h)
     window = 2.5 * a
@@ -267,7 +267,7 @@ def section_picture(run: PunchRun, path: str) -> None:
     ax.legend(loc="lower right", fontsize=8)
     _right_panel(ax2, run, run.profile, state)
     fig.suptitle(title(run, state), fontsize=10)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 def misfit_grid(model, measured, iterates: np.ndarray, spread: np.ndarray, points: int):
     """(σ0 values, H values, ½‖r‖² on their grid): points × points model runs (collective).
@@ -307,7 +307,7 @@ def identification_figure(out: dict, path: str, grid=None, *, labels: tuple[str,
     """
     if MPI.COMM_WORLD.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, axes = plt.subplots(1, 2 if grid is not None else 1,
                              figsize=(11.5 if grid is not None else 6, 4.6), squeeze=False)
     ax = axes[0, 0]
@@ -356,7 +356,7 @@ def identification_figure(out: dict, path: str, grid=None, *, labels: tuple[str,
         ax.legend(loc="upper right", fontsize=8)
         ax.set_title(f"misfit: {len(s)}×{len(h)} runs (dots) and the iterates', linear "
                      "between them", fontsize=9)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def _title(out: dict) -> str:

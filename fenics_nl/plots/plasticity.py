@@ -18,7 +18,7 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.io import pictures
+from fenics_nl.plots import deformed, figures
 from fenics_nl.theory import vessels
 
 __all__ = ["VesselRun", "billet_picture", "upsetting_force_curve", "vessel_plastic_zone",
@@ -96,7 +96,7 @@ def vessel_pressure_curve(run: VesselRun, path: str, comm: MPI.Comm = MPI.COMM_W
     """
     if comm.rank != 0:
         return
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.8))
     q, d = np.array(run.path).T
     p_lim, loaded = run.p_lim, run.loaded
@@ -126,7 +126,7 @@ def vessel_pressure_curve(run: VesselRun, path: str, comm: MPI.Comm = MPI.COMM_W
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"b/a = {run.b / run.a:g}, " + run.title("\n"), fontsize=9)
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)
 
 
 def vessel_plastic_zone(run: VesselRun, displacement: fem.Function,
@@ -146,7 +146,7 @@ def vessel_plastic_zone(run: VesselRun, displacement: fem.Function,
     arc = {f"closed-form plastic radius {c:.4g}"
            + (" (for nu = 1/2)" if run.shape == "cylinder" else ""):
            np.column_stack([c * np.cos(theta), c * np.sin(theta)])}
-    pictures.deformed_picture(displacement, plastic_strain_per_cell, path, run.title(),
+    deformed.deformed_picture(displacement, plastic_strain_per_cell, path, run.title(),
                               label="cumulated plastic strain", curves=arc)
 
 
@@ -166,7 +166,7 @@ def billet_picture(displacement: fem.Function, plastic_strain_per_cell: fem.Func
         marked: a name → this rank's nodes to draw at their current (r, z) (the sticking
             and the slipping ones, or those on the die).
     """
-    pictures.deformed_picture(
+    deformed.deformed_picture(
         displacement, plastic_strain_per_cell, path, title, marked=marked,
         label="cumulated plastic strain p", axes=("r (length)", "z (length)"),
         obstacle={"obstacle": "plane", "point": [0.0, die_height], "normal": [0.0, 1.0]})
@@ -182,7 +182,7 @@ def upsetting_force_curve(history: list[dict], friction: float, path: str, title
         path: the PNG (call on one rank).
         title: the figure's title.
     """
-    plt = pictures.pyplot()
+    plt = figures.pyplot()
     r = np.array([0.0] + [h["reduction"] for h in history])
     fig, ax = plt.subplots(figsize=(7, 4.8))
     ax.plot(100 * r, [0.0] + [h["force"] for h in history], "o-", ms=3,
@@ -197,4 +197,4 @@ def upsetting_force_curve(history: list[dict], friction: float, path: str, title
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend()
-    pictures.save_figure(fig, path)
+    figures.save_figure(fig, path)

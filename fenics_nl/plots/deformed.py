@@ -1,52 +1,19 @@
-"""Scene pictures drawn with pyvista off-screen, from meshes gathered on rank 0."""
+"""A body drawn deformed and coloured by a field, with pyvista, from meshes gathered on rank 0.
+
+`bracket_picture` (the 3D part, its supports and load) and `deformed_picture` (any 2D or 3D
+body, a contact status and an obstacle if given) take DOLFINx Functions and plain values.
+"""
 
 from __future__ import annotations
-
-import os
 
 import numpy as np
 from dolfinx import fem
 
 from fenics_nl.io.output import gather_grid, owned_cell_values, vertex_interpolant
 from fenics_nl.parallel import gather_rows
+from fenics_nl.plots.figures import off_screen
 
-__all__ = [
-    "bracket_picture",
-    "deformed_picture",
-    "facet_points",
-    "off_screen",
-    "pyplot",
-    "save_figure",
-]
-
-
-def pyplot():
-    """matplotlib.pyplot on the Agg backend: figures are files, no display is needed."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def save_figure(fig, path) -> None:
-    """Lay out, write and close a matplotlib figure (closed: runs in one process add up)."""
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    pyplot().close(fig)
-    print(f"wrote {path}")
-
-
-def off_screen():
-    """pyvista, set for off-screen rendering without the VTK X-server noise."""
-    os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")
-    import pyvista
-    import vtk
-
-    vtk.vtkObject.GlobalWarningDisplayOff()  # "bad X server connection" is not an error
-    pyvista.OFF_SCREEN = True
-    return pyvista
+__all__ = ["bracket_picture", "deformed_picture", "facet_points"]
 
 
 def facet_points(msh, facets: np.ndarray) -> np.ndarray:
