@@ -121,6 +121,10 @@ class AlternateMinimization:
         self.lower = lower
         self._upper = self.damage_problem.x.duplicate()
         self._upper.set(1.0)
+        # u at fixed α: one Newton solver for every step (its forms compiled once), the
+        # step's conditions set by `solve`
+        self._displacement = NewtonSolver(self.residual_u, u, self.bcs, rtol=1e-12,
+                                          atol=1e-10, force_scale=force_scale)
 
     def _damage_atol(self) -> float:
         """The damage problem's absolute tolerance.
@@ -161,8 +165,9 @@ class AlternateMinimization:
         """
         bcs = self.bcs if bcs is None else list(bcs)
         snes = self.damage_problem.solver
-        displacement = NewtonSolver(self.residual_u, self.u, bcs, rtol=1e-12, atol=1e-10,
-                                    force_scale=self.force_scale)
+        displacement = self._displacement
+        displacement.set_bcs(bcs)
+        displacement.force_reference = 0.0  # without a force scale: this step's own
         counts = AlternateResult(0, 0, 0, math.inf)
         if self.accelerate is not None:
             self.accelerate.reset()
