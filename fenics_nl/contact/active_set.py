@@ -116,6 +116,10 @@ class EliminationSystem:
 
         The residual without the constrained rows: at a constrained dof, the force the
         constraint puts on the body.
+
+        Returns:
+            The reactions, a new array (the last solve's residual if still at this u, else
+            assembled afresh).
         """
         b = self._reaction
         if self.newton.copy_kept_residual(b):  # the last solve's, at this u
@@ -221,6 +225,9 @@ class ActiveSetContact:
         For the contact forces and the next solve's start: between inner solves only the
         conditions change (Dirichlet rows, nodal terms). `NewtonSolver`'s
         `reuse_residual_at_same_u`; nothing for the multiplier form (SNES).
+
+        Returns:
+            The context manager of that block (a null context for the multiplier form).
         """
         newton = self.newton
         return newton.reuse_residual_at_same_u() if newton else contextlib.nullcontext()
@@ -233,7 +240,12 @@ class ActiveSetContact:
     # -- a checkpoint ------------------------------------------------------------------
 
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
-        """What a restart needs of the contact after a converged step: the active nodes."""
+        """What a restart needs of the contact after a converged step: the active nodes.
+
+        Returns:
+            This rank's flags of the S_C nodes (1 where active) under "active", for
+            `restore_arrays`.
+        """
         return {"active": self.active.astype(np.uint8)}
 
     def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
@@ -257,11 +269,19 @@ class ActiveSetContact:
         return self.surface.owned
 
     def normal_forces(self) -> np.ndarray:
-        """Nodal normal contact forces T_n at the S_C nodes (negative in compression)."""
+        """Nodal normal contact forces T_n at the S_C nodes (negative in compression).
+
+        Returns:
+            T_n at each node of S_C, from the formulation's last solve.
+        """
         return self.system.normal_forces()
 
     def normal_gap(self) -> np.ndarray:
-        """u_n − γ at the S_C nodes (positive = penetration)."""
+        """u_n − γ at the S_C nodes (positive = penetration).
+
+        Returns:
+            u_n − γ at each node of S_C, for the current u and gap.
+        """
         return self.surface.normal_gap(self.u)
 
     def pressure(self, weight=1.0) -> np.ndarray:
@@ -331,11 +351,20 @@ class ActiveSetContact:
                      for tag in (0, 1))
 
     def active_vertices(self) -> mesh.MeshTags:
-        """Vertex meshtags of the active nodes (value 1)."""
+        """Vertex meshtags of the active nodes (value 1).
+
+        Returns:
+            Vertex meshtags, value 1 on the active S_C nodes that are mesh vertices.
+        """
         return self.surface.vertex_tags(self.active)
 
     def active_facets(self) -> mesh.MeshTags:
-        """Facet meshtags of S_C: 1 where all the facet's vertices are active, else 0."""
+        """Facet meshtags of S_C: 1 where all the facet's vertices are active, else 0.
+
+        Returns:
+            Facet meshtags of every facet of S_C, valued 1 or 0 (what `contact_areas`
+            integrates over).
+        """
         return self.surface.facet_tags(self.active)
 
     def nodal_field(self, values: np.ndarray, name: str) -> fem.Function:
@@ -394,6 +423,11 @@ class ActiveSetContact:
         every rule (frictionless here, Coulomb in `friction`). The result counts the Newton
         iterations and the work of every inner solve, the loop's iterations, and keeps the
         last inner solve's residual history; the total contact force is left in `force`.
+
+        Returns:
+            The converged result, with the inner solves' iterations and work summed, the
+            loop's iterations (`active_set_iterations`), the active set's size after each,
+            and its `history`; on a failure, the ContactError's `result` instead.
         """
         t0 = time.perf_counter()
         seen = collections.Counter()

@@ -117,6 +117,10 @@ class FrictionalContact(ActiveSetContact):
 
         The statuses, slip directions and forces, the obstacle's position and the
         tangential force.
+
+        Returns:
+            The committed arrays by name (this rank's nodes of S_C; the statuses as 1/0),
+            for `restore_arrays`.
         """
         active, slip, direction, slip_force, spring = self._committed
         return {"active": active.astype(np.uint8), "slip": slip.astype(np.uint8),
@@ -151,7 +155,11 @@ class FrictionalContact(ActiveSetContact):
     # -- the surface's tangential quantities ------------------------------------------
 
     def tangential_displacement(self) -> np.ndarray:
-        """u_t at the nodes, one column per tangential axis."""
+        """u_t at the nodes, one column per tangential axis.
+
+        Returns:
+            u_t at each node of S_C, read off the current u.
+        """
         x = self.u.x.array
         return np.column_stack([x[self.surface.tangential(i)[0]] for i in self.axes])
 
@@ -172,12 +180,20 @@ class FrictionalContact(ActiveSetContact):
                                             for i in self.axes])
 
     def slip_increment(self) -> np.ndarray:
-        """Δg = Δu_t − Δd since the last committed state, at the nodes (0 where held)."""
+        """Δg = Δu_t − Δd since the last committed state, at the nodes (0 where held).
+
+        Returns:
+            Δg at each node of S_C, one column per tangential axis.
+        """
         return self.free * (self.tangential_displacement() - self._u_t_committed
                             - (self.motion - self.committed_motion))
 
     def tangential_force(self) -> np.ndarray:
-        """Σ T_t over S_C (every rank's owned nodes), one value per axis."""
+        """Σ T_t over S_C (every rank's owned nodes), one value per axis.
+
+        Returns:
+            The tangential force of the modelled part, the same on every rank (collective).
+        """
         T_t = self.tangential_forces()
         return np.array([self.surface.total(T_t[:, k]) for k in range(len(self.axes))])
 

@@ -101,8 +101,8 @@ class RigidPunch:
             symmetry: the whole body's force over the modelled part's.
 
         Returns:
-            The state: its force, the outermost active node's distance from the axis, the
-            largest nodal pressure and the work (collective).
+            The state, with its force, the outermost active node's distance from the axis,
+            the largest nodal pressure and the work (collective).
         """
         contact.set_gap(self.gap(delta))
         contact.add_penetrating()

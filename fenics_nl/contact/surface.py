@@ -134,7 +134,7 @@ class ContactSurface:
             mask: one flag per node of S_C.
 
         Returns:
-            (size, sum of global indices), the same on every rank: equal for equal sets (and,
+            (size, sum of global indices), the same on every rank; equal for equal sets (and,
             rarely, for two different ones).
         """
         im = self.Vn.dofmap.index_map
@@ -358,7 +358,7 @@ def check_contact_resolution(nodes: int, h: float, state) -> list[str]:
         state: a converged state with its total `force` and `contact_radius`.
 
     Returns:
-        The warnings: one below FEW_NODES, none when the zone is resolved or there is no
+        The warnings, one below FEW_NODES, none when the zone is resolved or there is no
         contact.
 
     Raises:

@@ -198,17 +198,29 @@ class CourseDamage(Isotropic, SmallStrain):
         return self._bound().alpha
 
     def damage_per_cell(self):
-        """The largest committed α of each cell's quadrature points (DG0 Function)."""
+        """The largest committed α of each cell's quadrature points (DG0 Function).
+
+        Returns:
+            The maxima, a new DG0 Function named "damage".
+        """
         from fenics_nl.materials.plasticity import cell_max
 
         return cell_max(self.alpha, "damage")
 
     def state_functions(self) -> dict:
-        """The committed state's quadrature Functions by name (to checkpoint and restore)."""
+        """The committed state's quadrature Functions by name (to checkpoint and restore).
+
+        Returns:
+            The committed damage αⁿ under the name "damage" (the Function itself, not a copy).
+        """
         return {"damage": self.alpha}
 
     def output_fields(self) -> list:
-        """What --output writes of the state: the damage per cell."""
+        """What --output writes of the state: the damage per cell.
+
+        Returns:
+            The one DG0 Function of `damage_per_cell`.
+        """
         return [self.damage_per_cell()]
 
     def commit(self, u, model: str = "3d") -> None:

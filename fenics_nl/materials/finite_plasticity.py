@@ -320,12 +320,21 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
         return self._bound().metric
 
     def state_functions(self) -> dict:
-        """The committed state's quadrature Functions by name (to checkpoint and restore)."""
+        """The committed state's quadrature Functions by name (to checkpoint and restore).
+
+        Returns:
+            The committed Cp⁻¹ ("plastic_metric") and p ("cumulated_plastic_strain"), the
+            Functions themselves, not copies.
+        """
         st = self._bound()
         return {"plastic_metric": st.metric, "cumulated_plastic_strain": st.p}
 
     def output_fields(self) -> list:
-        """What a time series writes of the state: p (cell max), DG0."""
+        """What a time series writes of the state: p (cell max), DG0.
+
+        Returns:
+            The one new DG0 Function of `cumulated_plastic_strain_per_cell`.
+        """
         return [self.cumulated_plastic_strain_per_cell()]
 
     def commit(self, u, model: str = "3d") -> None:

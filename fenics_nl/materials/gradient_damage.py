@@ -274,11 +274,20 @@ class DamagedElastic(SmallStrain):
         return self.law.elastic_energy(eps, self.alpha)
 
     def state_functions(self) -> dict:
-        """The damage and its bound (to checkpoint and restore)."""
+        """The damage and its bound (to checkpoint and restore).
+
+        Returns:
+            The damage α ("damage") and its committed lower bound ("committed_damage"), the
+            P1 Functions themselves, not copies.
+        """
         return {"damage": self.alpha, "committed_damage": self.lower}
 
     def output_fields(self) -> list:
-        """What --output writes of the state: the damage."""
+        """What --output writes of the state: the damage.
+
+        Returns:
+            The damage α itself, the one P1 Function of the list.
+        """
         return [self.alpha]
 
     def commit(self, u=None, model: str = "3d") -> None:

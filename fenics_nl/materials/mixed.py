@@ -257,7 +257,11 @@ class DisplacementUnknown:
         self.displacement_dofs = np.arange(self.w.x.array.size, dtype=np.int32)
 
     def displacement(self) -> fem.Function:
-        """The displacement Function itself."""
+        """The displacement Function itself.
+
+        Returns:
+            `w` (= `u`) itself, the Function the solver updates, not a copy.
+        """
         return self.w
 
     def von_mises(self, material, model: str) -> fem.Function:
@@ -299,7 +303,7 @@ class DisplacementUnknown:
 
 
 class MixedUnknown:
-    """w = (u, p) in Taylor–Hood, and what scenes read of it.
+    """w = (u, p) in Taylor–Hood, and what demos and drivers read of it.
 
     `w` is the Function a solver updates; `u`, `p` its parts for forms; `V` the displacement
     sub-space (Dirichlet conditions, contact nodes: dofs in `w`'s numbering); and
@@ -322,12 +326,22 @@ class MixedUnknown:
         self._p = fem.Function(Qc, name="pressure")
 
     def displacement(self) -> fem.Function:
-        """The current displacement (a copy in the collapsed P2 space)."""
+        """The current displacement (a copy in the collapsed P2 space).
+
+        Returns:
+            The displacement part of `w`, a Function named "displacement" on
+            `displacement_space`; the same Function at every call, overwritten.
+        """
         self._u.x.array[:] = self.w.x.array[self.displacement_dofs]
         return self._u
 
     def pressure(self) -> fem.Function:
-        """The current pressure field p (a copy in the collapsed P1 space)."""
+        """The current pressure field p (a copy in the collapsed P1 space).
+
+        Returns:
+            The pressure part of `w`, a Function named "pressure"; the same Function at every
+            call, overwritten.
+        """
         self._p.x.array[:] = self.w.x.array[self._p_dofs]
         return self._p
 

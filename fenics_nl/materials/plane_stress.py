@@ -80,16 +80,30 @@ class PlaneStressUnknown:
         self._ez = fem.Function(Qc, name="out_of_plane_strain")
 
     def strain(self):
-        """ε₃ of the current unknown."""
+        """ε₃ of the current unknown.
+
+        Returns:
+            ε₃ of (`u`, `ez`), UFL 3x3 (`whole_strain`).
+        """
         return whole_strain(self.u, self.ez)
 
     def displacement(self) -> fem.Function:
-        """The current displacement (a copy in the collapsed Lagrange space)."""
+        """The current displacement (a copy in the collapsed Lagrange space).
+
+        Returns:
+            The displacement part of `w`, a Function named "displacement" on
+            `displacement_space`; the same Function at every call, overwritten.
+        """
         self._u.x.array[:] = self.w.x.array[self.displacement_dofs]
         return self._u
 
     def out_of_plane_strain(self) -> fem.Function:
-        """ε_zz (a copy in the collapsed discontinuous space)."""
+        """ε_zz (a copy in the collapsed discontinuous space).
+
+        Returns:
+            The ε_zz part of `w`, a Function named "out_of_plane_strain"; the same Function
+            at every call, overwritten.
+        """
         self._ez.x.array[:] = self.w.x.array[self._ez_dofs]
         return self._ez
 

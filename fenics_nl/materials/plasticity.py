@@ -92,7 +92,11 @@ class QuadratureStateOutputs:
     """
 
     def cumulated_plastic_strain_per_cell(self):
-        """The largest committed p of each cell's quadrature points (DG0 Function)."""
+        """The largest committed p of each cell's quadrature points (DG0 Function).
+
+        Returns:
+            The maxima, a new DG0 Function named "cumulated_plastic_strain".
+        """
         return cell_max(self.cumulated_plastic_strain, "cumulated_plastic_strain")
 
     def plastic_radius(self, least: float = 0.0) -> float:
@@ -224,7 +228,12 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         return self._bound().p
 
     def state_functions(self) -> dict:
-        """The committed state's quadrature Functions by name (to checkpoint and restore)."""
+        """The committed state's quadrature Functions by name (to checkpoint and restore).
+
+        Returns:
+            The committed ε_p ("plastic_strain") and p ("cumulated_plastic_strain"), the
+            Functions themselves, not copies.
+        """
         st = self._bound()
         return {"plastic_strain": st.eps_p, "cumulated_plastic_strain": st.p}
 
@@ -267,11 +276,20 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
                 "plastic_volume_fraction": plastic / volume}
 
     def output_fields(self) -> list:
-        """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0."""
+        """What a time series writes of the state: p (cell max) and ε_p (cell mean), DG0.
+
+        Returns:
+            The new DG0 Functions of `cumulated_plastic_strain_per_cell` and
+            `plastic_strain_per_cell`, in that order.
+        """
         return [self.cumulated_plastic_strain_per_cell(), self.plastic_strain_per_cell()]
 
     def plastic_strain_per_cell(self):
-        """The mean committed plastic strain ε_p of each cell's quadrature points (DG0, 3x3)."""
+        """The mean committed plastic strain ε_p of each cell's quadrature points (DG0, 3x3).
+
+        Returns:
+            The means, a new DG0 tensor Function named "plastic_strain".
+        """
         from dolfinx import fem
 
         eps_p = self.plastic_strain

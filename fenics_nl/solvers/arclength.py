@@ -227,12 +227,20 @@ class ArcState:
     VECTORS = ("previous_du", "tangent", "kick")
 
     def scalars(self) -> dict:
-        """Everything but the vectors, JSON-able."""
+        """Everything but the vectors, JSON-able.
+
+        Returns:
+            Every field but those of `VECTORS`, by name.
+        """
         return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
                 if f.name not in self.VECTORS}
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """This rank's vectors (those the walk has)."""
+        """This rank's vectors (those the walk has).
+
+        Returns:
+            The arrays of `VECTORS` that are not None, by name (the fields themselves).
+        """
         return {k: getattr(self, k) for k in self.VECTORS if getattr(self, k) is not None}
 
     @classmethod

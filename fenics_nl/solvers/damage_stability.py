@@ -191,7 +191,7 @@ class BranchStability:
             self.elastic_margins.append((float(load), margin))
         elif self.damage_onset is None:
             self.damage_onset = self._onset()
-        if lam >= 0:
+        if lam >= 0 or self.bifurcation_step is not None:
             return False
         self.bifurcation_step = len(self.loads) - 1
         self.bifurcation_load = self._crossing(load, lam)
@@ -205,8 +205,13 @@ class BranchStability:
         return math.sqrt(e0**2 + (load**2 - e0**2) * l0 / (l0 - lam))
 
     def _onset(self) -> float | None:
-        """The load where the elastic steps' margin, affine in its square, reaches 0."""
+        """The load where the elastic steps' margin, affine in its square, reaches 0.
+
+        None with fewer than two elastic steps, or if their margin does not fall as the
+        load grows (nothing to extrapolate to).
+        """
         if len(self.elastic_margins) < 2:
             return None
         (e1, m1), (e2, m2) = self.elastic_margins[-2:]
-        return math.sqrt(e2**2 + (e2**2 - e1**2) * m2 / (m1 - m2))
+        square = e2**2 + (e2**2 - e1**2) * m2 / (m1 - m2) if m1 > m2 else -1.0
+        return math.sqrt(square) if square >= 0 else None

@@ -34,7 +34,7 @@ def reach_force(state_at: Callable[[float], object], force: float, guess: float,
         max_it: the states tried at most.
 
     Returns:
-        (the state at P = force within rtol, every (d, state) tried, in order: the work
+        (the state at P = force within rtol, every (d, state) tried, in order; the work
         spent is theirs all).
 
     Raises:

@@ -372,7 +372,12 @@ class NewtonSolver:
     # -- the loop --------------------------------------------------------------------
 
     def solve(self) -> SolveResult:
-        """Run the loop from the current `u`; raise ConvergenceError on failure."""
+        """Run the loop from the current `u`; raise ConvergenceError on failure.
+
+        Returns:
+            The converged result, with its iterations, residual norms and work (also added
+            to `total`); on a failure, the ConvergenceError's `result` instead.
+        """
         t_start = time.perf_counter()
         work = WorkCounts()
         self.start_solve()

@@ -121,6 +121,10 @@ class PathSensitivity:
 
         Also carries dα/dθ_i to this step. The tangent is assembled once at the converged u;
         each parameter costs one solve with it.
+
+        Returns:
+            One array per parameter, in the order of `names`, of dR/dθ_i at this rank's
+            dofs, ghosts included (a copy of the local form).
         """
         self.newton.assemble_exact_tangent(self.work)
         bcs = self.newton.bcs

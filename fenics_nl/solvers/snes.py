@@ -1,6 +1,6 @@
 """The same problems through PETSc SNES (`dolfinx.fem.petsc.NonlinearProblem`), for cross-checks.
 
-`SnesSolver` has the surface of `NewtonSolver` (`solve()` → `SolveResult`), so scenes and
+`SnesSolver` has the surface of `NewtonSolver` (`solve()` → `SolveResult`), so demos and
 benchmarks swap one for the other. Work is counted with PETSc's own logging events, so the
 counts do not depend on our code being right. Modified and periodic Newton are SNES's
 Jacobian lagging (`-snes_lag_jacobian`).
@@ -61,7 +61,11 @@ class EventCounter:
         self._t0 = self._snapshot()
 
     def stop(self) -> dict[str, tuple[int, float]]:
-        """(count, time) of each event since `start()`."""
+        """(count, time) of each event since `start()`.
+
+        Returns:
+            By event name, the number of its calls and the seconds spent in them.
+        """
         now = self._snapshot()
         return {n: (now[n]["count"] - self._t0[n]["count"], now[n]["time"] - self._t0[n]["time"])
                 for n in self.events}
@@ -89,7 +93,11 @@ def petsc_work(counter: EventCounter) -> WorkCounts:
 
 
 def all_event_names() -> list[str]:
-    """Every PETSc event name that `petsc_work` reads."""
+    """Every PETSc event name that `petsc_work` reads.
+
+    Returns:
+        The names, to build the `EventCounter` of a solver.
+    """
     out = list(SYMBOLIC)
     for names in EVENTS.values():
         out += [names] if isinstance(names, str) else list(names)
@@ -215,6 +223,10 @@ class SnesSolver:
         """Solve from the current `u`, the boundary values imposed first.
 
         That is SNES's own way; NewtonSolver lifts them into its first correction instead.
+
+        Returns:
+            The converged result, with its iterations, residual norms and the work read off
+            PETSc's event log; on a failure, the ConvergenceError's `result` instead.
         """
         t0 = time.perf_counter()
         x = self.u.x.petsc_vec

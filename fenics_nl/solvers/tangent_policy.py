@@ -82,7 +82,12 @@ class TangentPolicy:
         return not self.ready
 
     def needs_factorization(self) -> bool:
-        """After a tangent assembly."""
+        """After a tangent assembly.
+
+        Returns:
+            Whether the new tangent is to be factorized; False while `reuse` or `lag` keeps
+            the last factorization.
+        """
         return not ((self.reuse or self.lag) and self.factorization_current)
 
     def factorized(self) -> None:
