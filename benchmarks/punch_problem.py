@@ -38,7 +38,6 @@ from mpi4py import MPI
 from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.friction import FrictionalContact
 from fenics_nl.contact.obstacles import BERKOVICH, Indentation, RigidPunch, Traction
-from fenics_nl.contact.surface import check_contact_resolution
 from fenics_nl.domain import boundary
 from fenics_nl.domain.meshes import PUNCH_GROWTH, punch_block
 from fenics_nl.io import output
@@ -48,14 +47,7 @@ from fenics_nl.parallel import global_max
 from fenics_nl.solvers.force_control import reach_load
 from fenics_nl.theory import hertz
 
-__all__ = [
-    "Indentation",
-    "Punch",
-    "PunchBlock",
-    "Traction",
-    "build_punch",
-    "check_contact_resolution",
-]
+__all__ = ["BERKOVICH", "Punch", "PunchBlock", "build_punch"]
 
 MODELS = ("axisymmetric", "3d", "plane_strain")
 

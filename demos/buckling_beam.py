@@ -332,9 +332,10 @@ def progress(message):
 def centreline():
     """Deformed centreline points (x + u) of the dofs on y = 0, gathered, sorted by x."""
     d = fields.displacement()
-    X = d.function_space.tabulate_dof_coordinates()
+    n = d.function_space.dofmap.index_map.size_local  # owned: each point once
+    X = d.function_space.tabulate_dof_coordinates()[:n]
     on = np.isclose(X[:, 1], 0.0)
-    rows = gather_rows(comm, X[on, 0], X[on, :2] + d.x.array.reshape(-1, 2)[on])
+    rows = gather_rows(comm, X[on, 0], X[on, :2] + d.x.array.reshape(-1, 2)[:n][on])
     return None if rows is None else rows[1][np.argsort(rows[0])]
 
 

@@ -66,6 +66,7 @@ from fenics_nl.domain.damage_specimens import (
 )
 from fenics_nl.io import cli
 from fenics_nl.io.parameters import Parameters, choice, number
+from fenics_nl.materials import kinematics
 from fenics_nl.materials.gradient_damage import GradientDamage, crack_tip
 from fenics_nl.plots import damage as damage_pictures
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
@@ -131,10 +132,11 @@ warnings = []
 # `BOTTOM`, `TOP`, and the pre-crack:
 #
 # * `notched_square`: the square $[0, 1]^2$ mm, fine within $3\ell$ of the notch's line
-#   ahead of the notch (and in shear the lower right quarter, where the crack turns). Its
-#   rows of nodes are at $0.5 \pm h/2$: the notch is the cell tag `NOTCH`, the band of one
-#   cell between them up to the centre, which is what a crack of the mesh is (a line of
-#   nodes at $\alpha = 1$ alone would still carry stress through its neighbouring cells).
+#   from $3\ell$ behind the notch's tip to the right side (and in shear the lower right
+#   quarter, where the crack turns). Its rows of nodes are at $0.5 \pm h/2$: the notch is
+#   the cell tag `NOTCH`, the band of one cell between them up to the centre, which is
+#   what a crack of the mesh is (a line of nodes at $\alpha = 1$ alone would still carry
+#   stress through its neighbouring cells).
 # * `surfing_strip`: the half strip $[0, 1] \times [0, 0.3]$ mm (its length a whole number
 #   of cells: the field moves by whole cells), fine up to $3\ell$ above the crack's line
 #   $y = 0$, whose first 0.3 mm are the facet tag `PRECRACK` (the rest is `BOTTOM`).
@@ -187,6 +189,7 @@ if surfing:
            fem.dirichletbc(g, np.setdiff1d(outer, fem.locate_dofs_topological(V, 1,
                                                                               crack_line)))]
 else:
+    msh.topology.create_connectivity(2, 2)  # the cells' own entities, to locate their dofs
     cracked = fem.locate_dofs_topological(A, 2, cell_tags.find(NOTCH))
     moving = 0 if args.test == "shear" else 1  # the top's moving component
     top_motion = boundary.component(V, moving, facets["top"])
@@ -201,7 +204,8 @@ precrack = fem.dirichletbc(1.0, cracked, A)
 
 # ### The law, its energy and the solver
 #
-# `GradientDamage` (its split), the energy $\mathcal E(u, \alpha)$ above in UFL, and an
+# `GradientDamage`, the energy $\mathcal E(u, \alpha)$ above written in UFL (with the split,
+# `elastic_energy` degrades $\psi_0^+$ only and keeps $\psi_0^-$ whole), and an
 # `AlternateMinimization` of it: at each step, $u$ at fixed $\alpha$ by Newton, $\alpha$ at
 # fixed $u$ within $\alpha_{n-1} \le \alpha \le 1$ by PETSc's SNES `vinewtonrsls`, until
 # $\alpha$ changes by less than $10^{-6}$ (surfing $10^{-8}$), Anderson-accelerated by
@@ -211,7 +215,10 @@ precrack = fem.dirichletbc(1.0, cracked, A)
 # +
 law = GradientDamage(args.E, args.nu, Gc=args.Gc, ell=args.ell, model=args.model,
                      residual_stiffness=1e-6, split=args.split)
-energy = law.energy(u, alpha, "plane_strain") * ufl.dx
+eps = kinematics.small_strain(u, "plane_strain")  # 3x3, ε_zz = 0
+dissipation = law.Gc / law.c_w * (law.w(alpha) / law.ell
+                                  + law.ell * ufl.inner(ufl.grad(alpha), ufl.grad(alpha)))
+energy = (law.elastic_energy(eps, alpha) + dissipation) * ufl.dx  # a(α) ψ0 (+ the split)
 if surfing:  # a crack on the strip's symmetry line: two half bands
     mesh_toughness = args.Gc * (1 + 2 * h / (law.c_w * args.ell))
     K = math.sqrt(mesh_toughness * args.E / (1 - args.nu**2))
@@ -362,9 +369,9 @@ if args.model == "at2":
 
 # ## Outputs
 #
-# The JSON (its keys `peak_force`, `crack_tip_history`, `energy_release_rate`,
-# `dissipated_energy` and the solver counts), and when asked the picture: the curve, and the
-# damage at three steps (the last before the crack moves, the first after, the last;
+# The JSON (its keys `crack_tip_history`, `energy_release_rate`, `dissipated_energy`, the
+# solver counts, and for the notched square `peak_force`), and when asked the picture: the
+# curve, and the damage at three steps (the last before the crack moves, the first after, the last;
 # surfing: the first, the middle, the last).
 
 # +

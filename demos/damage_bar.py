@@ -86,6 +86,7 @@ from fenics_nl.io.parameters import Parameters, choice, number
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.damage import CourseDamage
 from fenics_nl.materials.gradient_damage import GradientDamage
+from fenics_nl.materials.laws import LinearElastic
 from fenics_nl.parallel import global_max
 from fenics_nl.plots import damage as damage_pictures
 from fenics_nl.solvers.alternate import AlternateMinimization, AlternateWork
@@ -158,8 +159,8 @@ warnings = []
 # right end's $u_x$ is prescribed on `RIGHT` (its value set at each step), or left free and
 # pulled by a traction. The demo builds several bars (the mesh table below): `strip` makes
 # one of `cells` cells. The local law's bars are $H = L/$`cells` high on every mesh, so
-# that their cross-section $A = H$ (per unit thickness) stays; the gradient laws' are one
-# cell of their coarsest mesh high.
+# that their cross-section $A = H$ (per unit thickness) stays; the gradient laws' are
+# $L/\lceil L\,$`resolution`$/\ell\rceil$ high, one cell of the uniform bar's mesh.
 
 # +
 MODEL = "plane_strain"  # at ν = 0: uniaxial stress
@@ -177,7 +178,7 @@ def strip(cells, height):
 
 
 def stress_at_end(internal, u, tags):
-    """σ = the right end's reaction over A, from the internal work (a form in u)."""
+    """σ = the right end's reaction over A, from the internal work (a compiled form in u)."""
     held = boundary.reactions(internal, u, {"right": tags.find(RIGHT)}, {"right": [0]},
                               space=u.function_space)["right"][0]
     return held / height
@@ -208,7 +209,7 @@ sigma_c = law.critical_stress
 #   consistent tangent from UFL. Each step is a Newton solve, and the damage is committed
 #   once it has converged.
 # * The gradient laws add the damage field α, P1, and their energy
-#   $\mathcal E(u, \alpha)$ above in UFL (`law.energy(u, alpha, MODEL) * dx`), minimized at
+#   $\mathcal E(u, \alpha)$ above, written in UFL below (`gradient_energy`), minimized at
 #   each step by alternate minimization (`AlternateMinimization`): u at fixed α by Newton,
 #   α at fixed u by PETSc's bound-constrained SNES (`vinewtonrsls`) within
 #   $\alpha_n \le \alpha \le 1$, until α changes by less than $10^{-8}$. The bar's ends are
@@ -216,20 +217,34 @@ sigma_c = law.critical_stress
 #   homogeneous solution.
 
 # +
+def eps(z):
+    """The small strain of the plane-strain bar."""
+    return kinematics.small_strain(z, MODEL)
+
+
+def gradient_energy(u, alpha):
+    """E(u, α) = ∫ a(α) ψ0(ε(u)) + (Gc/c_w)(w(α)/ℓ + ℓ |∇α|²): the gradient laws' energy."""
+    psi0 = LinearElastic(args.E, 0.0).energy(eps(u))  # Hooke's, at ν = 0
+    dissipation = law.Gc / law.c_w * (law.w(alpha) / law.ell
+                                      + law.ell * ufl.inner(ufl.grad(alpha), ufl.grad(alpha)))
+    return (law.stiffness(alpha) * psi0 + dissipation) * ufl.dx
+
+
 if local:
     law.bind(msh, 2)  # α_n at the quadrature points of degree 2
     dx = kinematics.quadrature_measure("dx", msh, 2)
-    internal = law.internal_work(u, ufl.TestFunction(V), MODEL) * dx
+    internal = ufl.inner(law.stress(eps(u)), eps(ufl.TestFunction(V))) * dx  # σ = ∂ψ/∂ε
     newton = NewtonSolver(internal, u, bcs, rtol=1e-12, atol=1e-12,
                           force_scale=law.critical_stress * height, prefix="bar_")
 else:
     A = fem.functionspace(msh, ("Lagrange", 1))
     alpha = fem.Function(A, name="damage")
-    energy = law.energy(u, alpha, MODEL) * ufl.dx
+    energy = gradient_energy(u, alpha)
     solver = AlternateMinimization(energy, u, alpha, force_scale=law.critical_stress * height,
                                    damage_scale=law.Gc / law.ell * height * height,
                                    acceleration=args.acceleration)
     internal = solver.residual_u  # ∂E/∂u
+internal = fem.form(internal)  # compiled once: the reaction is read at every step
 # -
 
 # ### The uniform bar against the closed form
@@ -307,7 +322,7 @@ def localize(cells):
     ds = ufl.Measure("ds", msh, subdomain_data=tags)
     load_factor = fem.Constant(msh, 0.0)
     v = ufl.TestFunction(V)
-    residual = (law.internal_work(u, v, MODEL) * dx
+    residual = (ufl.inner(law.stress(eps(u)), eps(v)) * dx
                 - load_factor * sigma_ref * v[0] * ds(RIGHT))
     newton = NewtonSolver(residual, u, supports, rtol=1e-10, atol=1e-12, max_it=30,
                           force_scale=sigma_ref * height, prefix="bar_")
@@ -327,7 +342,7 @@ def localize(cells):
         (global_max(comm, u.x.array[ends]), lam * sigma_ref)))
     U, s = np.array(path).T
     external = float(np.sum(0.5 * (s[1:] + s[:-1]) * np.diff(U)) * height)  # its work
-    stored = fem.form(law.energy(kinematics.small_strain(u, MODEL)) * dx)
+    stored = fem.form(law.energy(eps(u)) * dx)
     dissipated = external - comm.allreduce(fem.assemble_scalar(stored), op=MPI.SUM)
     expected = height * h * args.wc * args.weak * math.log(1 / args.stress_ratio)
     damage = law.damage_per_cell().x.array[:msh.topology.index_map(2).size_local]
@@ -360,8 +375,7 @@ def crack(cells):
     alpha = fem.Function(A, name="damage")
     gripped = fem.locate_dofs_topological(A, 1, np.concatenate([tags.find(LEFT),
                                                                 tags.find(RIGHT)]))
-    energy = law.energy(u, alpha, MODEL) * ufl.dx
-    solver = AlternateMinimization(energy, u, alpha,
+    solver = AlternateMinimization(gradient_energy(u, alpha), u, alpha,
                                    damage_bcs=[fem.dirichletbc(0.0, gripped, A)],
                                    force_scale=law.critical_stress * height,
                                    damage_scale=law.Gc / law.ell * h * height,

@@ -339,8 +339,9 @@ title = (f"upsetting to {100 * last['reduction']:.0f} %, f = {args.friction:g}: 
 
 def picture():
     """The billet at the last state, coloured by its plastic strain; the nodes on the die."""
+    # S_C's nodes where they are now: r + u_r, and z + u_z (S_C's normal component)
     x = np.column_stack([current_radius(), contact.x[:, 1] + w.x.array[contact.surface.dofs_V]])
-    on = contact.owned & contact.active  # u_z above: S_C's normal component
+    on = contact.owned & contact.active
     marked = ({"sticking nodes": x[on & contact.stick], "slipping nodes": x[on & contact.slip]}
               if args.friction > 0 else {"nodes on the die": x[on]})
     plasticity_pictures.billet_picture(

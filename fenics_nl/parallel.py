@@ -1,4 +1,4 @@
-"""The two reductions the scenes and pictures need, so that no rank decides alone."""
+"""The two reductions the demos, drivers and pictures need, so that no rank decides alone."""
 
 from __future__ import annotations
 

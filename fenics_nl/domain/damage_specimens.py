@@ -103,7 +103,6 @@ def notched_square(comm: MPI.Comm, h: float, test: str = "tension", *, width: fl
     low = a - width if test == "tension" else 0.0
     ys = graded_axis(side, h, (low, a + width), through=a - h / 2)  # rows at a ± h/2
     msh = graded_rectangle(comm, xs, ys)
-    msh.topology.create_connectivity(2, 2)  # for fem.locate_dofs_topological on the cells
     notch = {NOTCH: lambda x: (np.abs(x[1] - a) <= 0.5001 * h) & (x[0] <= a + 1e-9 * side)}
     return msh, _tags(msh, 2, notch, boundary=False), _tags(msh, 1, _sides(side, side))
 

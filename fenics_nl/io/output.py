@@ -31,7 +31,7 @@ __all__ = [
 
 
 def dofs(V: fem.FunctionSpace) -> int:
-    """Global number of scalar unknowns of V (what the scenes report as `dofs`)."""
+    """Global number of scalar unknowns of V (what a run reports as `dofs`)."""
     return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
 
 

@@ -167,7 +167,7 @@ def surfing_figure(path: str, space: fem.FunctionSpace, damage: list[np.ndarray]
 def _crack_figure(path, space, damage, shown, x, y, curve, label) -> None:
     """The curve (x, y) with the steps `shown` lettered, then their damage (collective)."""
     grids = _snapshots(space, [damage[k] for k in shown])
-    if MPI.COMM_WORLD.rank != 0:
+    if space.mesh.comm.rank != 0:  # gathered there
         return
     plt = figures.pyplot()
     from matplotlib.ticker import MaxNLocator

@@ -64,8 +64,6 @@ def cone_from_indentation(E: float, nu: float, cot: float, delta: float) -> dict
 
 def pressure_profile(p0: float, a: float, r):
     """p(r) = p0 √(1 − r²/a²) inside the contact, 0 outside."""
-    import numpy as np
-
     r = np.asarray(r, dtype=float)
     return p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0.0, None))
 
