@@ -42,13 +42,18 @@ def geometric_stiffness(stress, du, v, gradient=ufl.grad):
     return ufl.inner(stress, gradient(du).T * gradient(v))
 
 
+def _compiled(a: ufl.Form | fem.Form) -> fem.Form:
+    """`a` compiled (a caller that asks at every step compiles it once and passes it)."""
+    return a if isinstance(a, fem.Form) else fem.form(a)
+
+
 def _stiffness(a: ufl.Form, bcs) -> PETSc.Mat:
     """K with its Dirichlet rows scaled to its largest diagonal entry.
 
     A diagonal of 1 would put their (spurious) eigenvalues anywhere, depending on the units;
     at the stiffness's own scale they stay away from the target, in any unit system.
     """
-    form = fem.form(a)
+    form = _compiled(a)
     K = petsc.assemble_matrix(form, bcs=bcs, diag=1.0)
     K.assemble()
     diagonal = K.getDiagonal()
@@ -230,12 +235,13 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     Dirichlet rows are identity rows scaled to the largest diagonal entry (and zero in M).
 
     Args:
-        a_T: the bilinear form of the tangent K_T.
+        a_T: the bilinear form of the tangent K_T (UFL, or compiled by a caller that asks
+            at every step).
         bcs: the Dirichlet conditions.
         V: the function space of the unknown (the mode's).
         prefix: PETSc options prefix of the eigensolver (``-{prefix}eps_...``); the inertia
             factorizations' is ``{prefix}inertia_``.
-        mass: the bilinear form of M (None: the identity).
+        mass: the bilinear form of M (None: the identity; UFL or compiled).
         multipliers: m, the negative eigenvalues of the constraint, not counted.
 
     Returns:
@@ -246,7 +252,7 @@ def lowest_tangent_mode(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = 
     K = _stiffness(a_T, bcs)
     M = None
     if mass is not None:
-        M = petsc.assemble_matrix(fem.form(mass), bcs=bcs, diag=0.0)
+        M = petsc.assemble_matrix(_compiled(mass), bcs=bcs, diag=0.0)
         M.assemble()
     unstable = negative_eigenvalues(K, f"{prefix}inertia_") > multipliers
     lam, mode = _eigenpair_nearest(comm, prefix, K, M, 0.0, V)
@@ -289,7 +295,7 @@ def mode_nearest_zero(a_T: ufl.Form, bcs, V: fem.FunctionSpace, prefix: str = "s
     K = _stiffness(a_T, bcs)
     M = None
     if mass is not None:
-        M = petsc.assemble_matrix(fem.form(mass), bcs=bcs, diag=0.0)
+        M = petsc.assemble_matrix(_compiled(mass), bcs=bcs, diag=0.0)
         M.assemble()
     _, mode = _eigenpair_nearest(V.mesh.comm, prefix, K, M, 0.0, V)
     vector = mode.x.petsc_vec.copy()

@@ -67,10 +67,11 @@ class DamageStability:
         self.w = fem.Function(W)
         u_w, alpha_w = ufl.split(self.w)
         energy_w = ufl.replace(energy, {u: u_w, alpha: alpha_w})
-        self.hessian = ufl.derivative(ufl.derivative(energy_w, self.w), self.w)
+        # compiled once: the check runs at every load step
+        self.hessian = fem.form(ufl.derivative(ufl.derivative(energy_w, self.w), self.w))
         _, beta = ufl.split(ufl.TrialFunction(W))
         _, beta_ = ufl.split(ufl.TestFunction(W))
-        self.mass = beta * beta_ * ufl.dx
+        self.mass = fem.form(beta * beta_ * ufl.dx)
         self.driving = fem.form(ufl.derivative(energy, alpha, ufl.TestFunction(A)))
         share = fem.assemble_vector(fem.form(density * ufl.TestFunction(A) * ufl.dx))
         share.scatter_reverse(la.InsertMode.add)
