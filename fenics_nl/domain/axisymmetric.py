@@ -16,6 +16,8 @@ from dolfinx import mesh
 from dolfinx.io.gmsh import MeshData, PhysicalGroup
 from mpi4py import MPI
 
+from fenics_nl.domain.boundary import tags_where
+
 __all__ = ["BAR_GROUPS", "BILLET_GROUPS", "billet", "narrowed_bar"]
 
 # facet tags: the axis r = 0 and the mid-plane z = 0 (both symmetry lines), the die's faces
@@ -27,15 +29,10 @@ BAR_GROUPS = {"axis": 1, "mid": 2, "end": 3}
 def _tagged(msh: mesh.Mesh, groups: dict[str, int], where: dict) -> MeshData:
     """The mesh with the boundary facets where `where[name](x)` holds tagged `groups[name]`."""
     fdim = msh.topology.dim - 1
-    found = {name: mesh.locate_entities_boundary(msh, fdim, test)
-             for name, test in where.items()}
-    indices = np.concatenate(list(found.values())).astype(np.int32)
-    values = np.concatenate([np.full(len(f), groups[name], dtype=np.int32)
-                             for name, f in found.items()])
-    order = np.argsort(indices)
-    tags = mesh.meshtags(msh, fdim, indices[order], values[order])
-    return MeshData(msh, None, tags, None, None,
-                    {name: PhysicalGroup(fdim, tag) for name, tag in groups.items()})
+    tags = tags_where(msh, fdim, {groups[name]: test for name, test in where.items()})
+    return MeshData(mesh=msh, cell_tags=None, facet_tags=tags, ridge_tags=None,
+                    peak_tags=None, physical_groups={name: PhysicalGroup(fdim, tag)
+                                                     for name, tag in groups.items()})
 
 
 def billet(comm: MPI.Comm, radius: float, height: float, cells: int = 8) -> MeshData:

@@ -1,11 +1,45 @@
-"""Dirichlet conditions on facets: whole vector or one component."""
+"""Tags on a mesh, and on tagged facets Dirichlet conditions and reactions.
+
+`tags_where` tags entities by predicates; `fixed` and `component` hold the whole vector or
+one component; `reactions` reads the supports' forces.
+"""
 
 from __future__ import annotations
 
-import numpy as np
-from dolfinx import fem
+from collections.abc import Callable
 
-__all__ = ["component", "fixed", "reactions"]
+import numpy as np
+from dolfinx import fem, mesh
+
+__all__ = ["component", "fixed", "reactions", "tags_where"]
+
+
+def tags_where(msh: mesh.Mesh, dim: int, marked: dict[int, Callable], *,
+               boundary: bool = True) -> mesh.MeshTags:
+    """The entities of dimension `dim` where each marker holds, tagged with its key.
+
+    Sorted and each entity once, as `dolfinx.mesh.meshtags` needs (an entity two markers
+    hold keeps the first one's tag).
+
+    Args:
+        msh: the mesh.
+        dim: the entities' dimension (the facets': msh.topology.dim − 1).
+        marked: {tag value: a predicate of the coordinates x (3, n), as
+            `dolfinx.mesh.locate_entities` takes}.
+        boundary: look on the boundary only (`locate_entities_boundary`).
+
+    Returns:
+        The meshtags.
+    """
+    entities, values = np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32)
+    for tag, where in marked.items():
+        found = (mesh.locate_entities_boundary(msh, dim, where) if boundary
+                 else mesh.locate_entities(msh, dim, where))
+        found = np.setdiff1d(found, entities).astype(np.int32)
+        entities = np.concatenate([entities, found])
+        values = np.concatenate([values, np.full(len(found), tag, dtype=np.int32)])
+    order = np.argsort(entities)
+    return mesh.meshtags(msh, dim, entities[order], values[order])
 
 
 def fixed(V: fem.FunctionSpace, facets: np.ndarray) -> fem.DirichletBC:

@@ -19,6 +19,7 @@ import numpy as np
 from dolfinx import mesh
 from mpi4py import MPI
 
+from fenics_nl.domain.boundary import tags_where
 from fenics_nl.domain.graded_grid import graded_axis, graded_rectangle
 
 __all__ = ["BOTTOM", "LEFT", "NOTCH", "PRECRACK", "RIGHT", "TESTS", "TOP", "bar_strip",
@@ -27,20 +28,6 @@ __all__ = ["BOTTOM", "LEFT", "NOTCH", "PRECRACK", "RIGHT", "TESTS", "TOP", "bar_
 LEFT, RIGHT, BOTTOM, TOP, PRECRACK = 1, 2, 3, 4, 5  # facet tags
 NOTCH = 1  # cell tag
 TESTS = ("tension", "shear")  # the notched square's
-
-
-def _tags(msh: mesh.Mesh, dim: int, marked: dict[int, Callable], boundary: bool = True
-          ) -> mesh.MeshTags:
-    """The entities of `dim` where each marker holds, tagged with its key (the first wins)."""
-    entities, values = np.empty(0, dtype=np.int32), np.empty(0, dtype=np.int32)
-    for tag, where in marked.items():
-        found = (mesh.locate_entities_boundary(msh, dim, where) if boundary
-                 else mesh.locate_entities(msh, dim, where))
-        found = np.setdiff1d(found, entities).astype(np.int32)
-        entities = np.concatenate([entities, found])
-        values = np.concatenate([values, np.full(len(found), tag, dtype=np.int32)])
-    order = np.argsort(entities)
-    return mesh.meshtags(msh, dim, entities[order], values[order])
 
 
 def _sides(length: float, height: float, extra: dict[int, Callable] | None = None
@@ -72,7 +59,7 @@ def bar_strip(comm: MPI.Comm, length: float, cells: int, *, height: float | None
     H = height or length / cells
     msh = mesh.create_rectangle(comm, [[0.0, 0.0], [length, H]], [cells, 1],
                                 mesh.CellType.quadrilateral)
-    return msh, _tags(msh, 1, _sides(length, H))
+    return msh, tags_where(msh, 1, _sides(length, H))
 
 
 def notched_square(comm: MPI.Comm, h: float, test: str = "tension", *, width: float,
@@ -104,7 +91,7 @@ def notched_square(comm: MPI.Comm, h: float, test: str = "tension", *, width: fl
     ys = graded_axis(side, h, (low, a + width), through=a - h / 2)  # rows at a ± h/2
     msh = graded_rectangle(comm, xs, ys)
     notch = {NOTCH: lambda x: (np.abs(x[1] - a) <= 0.5001 * h) & (x[0] <= a + 1e-9 * side)}
-    return msh, _tags(msh, 2, notch, boundary=False), _tags(msh, 1, _sides(side, side))
+    return msh, tags_where(msh, 2, notch, boundary=False), tags_where(msh, 1, _sides(side, side))
 
 
 def surfing_strip(comm: MPI.Comm, h: float, cells: int, *, height: float, notch: float,
@@ -133,4 +120,4 @@ def surfing_strip(comm: MPI.Comm, h: float, cells: int, *, height: float, notch:
     def precrack(x):
         return np.isclose(x[1], 0.0) & (x[0] <= notch + 1e-9 * xs[-1])
 
-    return msh, _tags(msh, 1, _sides(xs[-1], height, {PRECRACK: precrack}))
+    return msh, tags_where(msh, 1, _sides(xs[-1], height, {PRECRACK: precrack}))

@@ -12,6 +12,8 @@ import numpy as np
 from dolfinx import mesh
 from mpi4py import MPI
 
+from fenics_nl.domain.boundary import tags_where
+
 __all__ = ["CLAMPED", "END", "cantilever_strip"]
 
 CLAMPED, END = 1, 2  # the facet tags of the end x = 0 and of the end x = L
@@ -39,9 +41,5 @@ def cantilever_strip(comm: MPI.Comm, length: float, thickness: float, refine: in
     nx = max(4, round(length / thickness * ny / 2))
     msh = mesh.create_rectangle(comm, [[0, -thickness / 2], [length, thickness / 2]],
                                 [nx, ny], mesh.CellType.quadrilateral)
-    clamped = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], 0.0))
-    end = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[0], length))
-    facets = np.concatenate([clamped, end])
-    values = np.hstack([np.full_like(clamped, CLAMPED), np.full_like(end, END)])
-    order = np.argsort(facets)  # meshtags takes sorted entities
-    return msh, mesh.meshtags(msh, 1, facets[order], values[order].astype(np.int32))
+    return msh, tags_where(msh, 1, {CLAMPED: lambda x: np.isclose(x[0], 0.0),
+                                    END: lambda x: np.isclose(x[0], length)})
