@@ -92,6 +92,7 @@ class Specimen:
         self.top_bc = boundary.component(V, 1, self.top)  # the top moved up
         self.bcs = [boundary.fixed(V, facets.find(BOTTOM)), self.top_bc,
                     boundary.component(V, 0, self.top)]
+        msh.topology.create_connectivity(2, 2)  # the cells' own entities, to locate dofs
         cracked = fem.locate_dofs_topological(A, 2, cells.find(NOTCH))
         self.alpha.x.array[cracked] = 1.0
         self.precrack = fem.dirichletbc(1.0, cracked, A)

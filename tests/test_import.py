@@ -105,3 +105,27 @@ def test_the_solvers_import_nothing_of_io_and_the_parameters_not_the_run():
     assert not {m for m in imports(root / "io" / "parameters.py") if ".cli" in m}
     assert imports(root / "io" / "flags.py") <= {"fenics_nl.vocabulary",
                                                  "fenics_nl.vocabulary.canonical"}
+
+
+def test_no_two_subpackages_import_each_other():
+    # the layout's directions (docs/architecture.md): a subpackage that imports another is
+    # never imported back by it, function-level imports included
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "fenics_nl"
+    packages = {p.name for p in root.iterdir() if (p / "__init__.py").exists()}
+    uses = {name: set() for name in packages}
+    for name in packages:
+        for path in (root / name).rglob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text())):
+                module = (node.module if isinstance(node, ast.ImportFrom) else None) or ""
+                names = [module] if module else (
+                    [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+                for m in names:
+                    parts = m.split(".")
+                    if parts[0] == "fenics_nl" and len(parts) > 1 and parts[1] in packages:
+                        uses[name].add(parts[1])
+    assert "scenes" not in packages
+    both = {tuple(sorted((a, b))) for a in uses for b in uses[a] if b != a and a in uses[b]}
+    assert not both, both
