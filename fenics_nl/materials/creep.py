@@ -182,6 +182,20 @@ class NortonCreep(Isotropic, SmallStrain):
         eps_v, _, _, _ = self.return_map(eps)
         return LinearElastic(self.E, self.nu).stress(eps - eps_v)
 
+    def deviatoric_stress(self, eps):
+        """dev σ = 2μ dev(ε − εᵛ): what the mixed form takes instead of φ̃'s derivative.
+
+        (The flow is isochoric, so the volumetric part is κ tr ε, the mixed form's p.)
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            dev σ (UFL, 3x3).
+        """
+        eps_v, _, _, _ = self.return_map(eps)
+        return 2 * self.mu * ufl.dev(eps - eps_v)
+
     def energy(self, eps):
         """ψ(ε) = W(ε − εᵛ) + n/(n + 1) q Δp: the step's condensed energy.
 
@@ -194,6 +208,25 @@ class NortonCreep(Isotropic, SmallStrain):
         eps_v, _, dp, q = self.return_map(eps)
         n = float(self.n)
         return LinearElastic(self.E, self.nu).energy(eps - eps_v) + n / (n + 1) * q * dp
+
+    def volumetric_split(self, eps):
+        """ψ = [μ |dev(ε − εᵛ)|² + n/(n + 1) q Δp] + κ/2 (tr ε)²: the flow is isochoric.
+
+        The mixed displacement–pressure form (`materials.mixed`) needs it here more than
+        for any rate-independent law: stationary creep is an incompressible flow whose
+        strain grows without bound, and P2 displacements alone cannot follow it (their
+        divergence error grows with it, and with it a spurious pressure).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (μ |dev(ε − εᵛ)|² + n/(n + 1) q Δp, tr ε, κ).
+        """
+        eps_v, _, dp, q = self.return_map(eps)
+        d = ufl.dev(eps - eps_v)
+        n = float(self.n)
+        return self.mu * ufl.inner(d, d) + n / (n + 1) * q * dp, ufl.tr(eps), self.kappa
 
     def modified_newton_tangent(self, u, model: str, dx):
         """Hooke's tangent (E, ν), factorized once: the law's instantaneous stiffness.

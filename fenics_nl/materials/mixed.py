@@ -110,7 +110,7 @@ def internal_work(material, u, p, v, q, model: str = "3d"):
     else:
         strain = ufl.variable(kinematics.small_strain(u, model))
     rest, g, k = material.volumetric_split(strain)
-    stress = ufl.diff(rest + p * g, strain)  # σ̃ (small strain) or S̃ (finite strain)
+    stress = _split_stress(material, rest, g, p, strain)  # σ̃ (small strain) or S̃ (finite)
     if material.finite_strain:
         F = kinematics.deformation_gradient(u, model)
         work = ufl.inner(F * stress, kinematics.displacement_gradient(v, model))
@@ -139,7 +139,20 @@ def cauchy_stress(material, u, p, model: str = "3d"):
         return F * ufl.diff(rest + p * g, e) * F.T / ufl.det(F)
     eps = ufl.variable(kinematics.small_strain(u, model))
     rest, g, _ = material.volumetric_split(eps)
-    return ufl.diff(rest + p * g, eps)
+    return _split_stress(material, rest, g, p, eps)
+
+
+def _split_stress(material, rest, g, p, strain):
+    """∂(φ̃ + p g)/∂strain; from the law's own deviatoric stress where it gives one.
+
+    A law whose state comes out of a local iteration written in UFL (Norton creep) gives
+    `deviatoric_stress` (its g is tr ε, so ∂(p g)/∂ε = p I): differentiating φ̃ through
+    the iteration and then again for the tangent would multiply the expression (and its
+    compilation) many times over.
+    """
+    if hasattr(material, "deviatoric_stress") and not material.finite_strain:
+        return material.deviatoric_stress(strain) + p * ufl.Identity(3)
+    return ufl.diff(rest + p * g, strain)
 
 
 def von_mises_expression(material, u, p, model: str = "3d"):
