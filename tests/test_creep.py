@@ -238,3 +238,47 @@ def test_a_creeping_vessel_reaches_the_stationary_closed_form(shape, n):
     errors, steps = stationary_vessel(shape, n, 0.1)
     assert max(errors.values()) < 2.5e-3, errors
     assert steps < 40
+
+
+def test_perzyna_tends_to_j2_as_the_step_outgrows_the_relaxation_time():
+    # one step to 3 ε_y: as Δt → ∞ the overstress y ≈ K (f_tr/((3μ + H) Δt))^(1/m)
+    # vanishes and Δp becomes J2's radial return; at m = 2, 1e4 times the step divides
+    # the difference from J2 by 100
+    from fenics_nl.materials import J2Plasticity
+    from fenics_nl.materials.creep import PerzynaViscoplasticity
+
+    def sigma(law, dt=None):
+        solver, read, pull, _ = cube(law)
+        if dt is not None:
+            law.set_time_step(dt)
+        pull(3 * 1.0 / E)
+        solver.solve()
+        return read()[0]
+
+    j2 = sigma(J2Plasticity(E, NU, sigma0=1.0, H=5.0))
+    assert j2 > 1.0  # yielded: σ = σ0 + H p
+    gaps = [sigma(PerzynaViscoplasticity(E, NU, sigma0=1.0, H=5.0, K=0.5, m=2.0), dt) - j2
+            for dt in (1e8, 1e12)]
+    assert gaps[0] > gaps[1] > 0 and gaps[1] < 1e-7 * j2
+    assert gaps[0] / gaps[1] == pytest.approx(100.0, rel=0.01)
+
+
+@pytest.mark.parametrize("m", [1.0, 3.0])
+def test_perzyna_at_a_constant_strain_rate_reaches_its_overstress_plateau(m):
+    # ε = ε̇ t held up (H = 0): once the elastic strain stops changing, ṗ = ε̇ and the stress
+    # is σ0 + K ε̇^(1/m), which backward Euler reproduces exactly there
+    from fenics_nl.materials.creep import PerzynaViscoplasticity
+
+    rate, dt, sigma0, K = 1e-3, 1.0, 1.0, 0.5
+    law = PerzynaViscoplasticity(E, NU, sigma0=sigma0, H=0.0, K=K, m=m)
+    solver, read, pull, u = cube(law)
+    law.set_time_step(dt)
+    history = []
+    for k in range(1, 400):
+        pull(rate * k * dt)
+        solver.solve()
+        history.append(read()[0])
+        law.commit(u)
+        if k > 10 and abs(history[-1] - history[-2]) < 1e-13:
+            break
+    assert history[-1] == pytest.approx(sigma0 + K * rate ** (1 / m), rel=1e-10)

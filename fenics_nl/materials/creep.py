@@ -34,9 +34,34 @@ from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain
 from fenics_nl.materials.plasticity import quadrature_spaces
 
-__all__ = ["NEWTON_STEPS", "NortonCreep", "ViscousState"]
+__all__ = ["NEWTON_STEPS", "NortonCreep", "PerzynaViscoplasticity", "ViscousLaw", "ViscousState",
+           "power_root"]
 
 NEWTON_STEPS = 7  # the local equation's Newton steps: 6 reach round-off (module docstring)
+
+
+def power_root(rhs, c, n: float, flows):
+    """y ≥ 0 with y + c yⁿ = rhs (UFL), by `NEWTON_STEPS` Newton steps from an upper bound.
+
+    From y₀ = min(rhs, (rhs/c)^(1/n)), within a factor 2^(1/n) of the root; the left side
+    is convex and increasing, so the steps fall monotonically onto it.
+
+    Args:
+        rhs: the right side (UFL, > 0 where `flows`).
+        c: the coefficient (UFL, > 0 where `flows`).
+        n: the exponent, >= 1.
+        flows: where the point flows (UFL condition); elsewhere rhs and c are replaced by 1
+            so that nothing without a derivative (a root of 0) is evaluated.
+
+    Returns:
+        y (UFL; meaningless where not `flows`).
+    """
+    rhs = ufl.conditional(flows, rhs, 1.0)
+    c = ufl.conditional(flows, c, 1.0)
+    y = ufl.min_value(rhs, (rhs / c) ** (1 / n))
+    for _ in range(NEWTON_STEPS):
+        y = y - (y + c * y**n - rhs) / (1 + n * c * y ** (n - 1))
+    return y
 
 
 @dataclass(eq=False)
@@ -69,25 +94,17 @@ class ViscousState:
 
 
 @dataclass(frozen=True, eq=False)
-class NortonCreep(Isotropic, SmallStrain):
-    """Norton creep: ε̇ᵛ = A σ_eqⁿ uniaxially, A > 0, n ≥ 1 (n = 1: linear viscosity).
+class ViscousLaw(Isotropic, SmallStrain):
+    """What Norton's and Perzyna's laws share: the state, the time step, σ, the commit.
 
-    Models: 3D, plane strain, axisymmetric (3x3 strains).
+    A law gives `return_map` (its inelastic strain after the step) and `dissipated` (the
+    condensed energy's terms beyond Hooke's). Models: 3D, plane strain, axisymmetric (3x3).
     """
 
-    A: float = 1.0
-    n: float = 1.0
     state: ViscousState = field(default_factory=ViscousState, init=False, repr=False,
                                 compare=False)
 
     path_dependent = True
-
-    def __post_init__(self):
-        super().__post_init__()
-        if not (math.isfinite(self.A) and self.A > 0):
-            raise ValueError(f"A must be > 0 and finite, got {self.A!r}")
-        if not (math.isfinite(self.n) and self.n >= 1):
-            raise ValueError(f"n must be >= 1 and finite, got {self.n!r}")
 
     def bind(self, mesh, degree: int) -> None:
         """Create the state (zero) at the quadrature points of `degree` on `mesh`.
@@ -100,8 +117,8 @@ class NortonCreep(Isotropic, SmallStrain):
 
     def _bound(self) -> ViscousState:
         if self.state.eps_v is None:
-            raise ValueError("NortonCreep has no state: call bind(mesh, quadrature degree) "
-                             "before writing a form with it")
+            raise ValueError(f"{type(self).__name__} has no state: call bind(mesh, "
+                             "quadrature degree) before writing a form with it")
         return self.state
 
     def set_time_step(self, dt: float) -> None:
@@ -141,32 +158,22 @@ class NortonCreep(Isotropic, SmallStrain):
         return {"viscous_strain": st.eps_v, "cumulated_viscous_strain": st.p}
 
     def return_map(self, eps):
-        """(εᵛ, p, Δp, q) at the strain ε after the time step, from the committed state.
+        """(εᵛ, p, Δp, the step's stress measure) after the time step: the law's own.
 
         Args:
             eps: the small strain ε (UFL, 3x3).
-
-        Returns:
-            (viscous strain εᵛ, cumulated viscous strain p, its increment Δp, the step's
-            equivalent stress q), UFL.
         """
-        self.require_3x3(eps)
-        st = self._bound()
-        mu, n = self.mu, float(self.n)
-        s_tr = 2 * mu * ufl.dev(eps - st.eps_v)
-        q_tr2 = 1.5 * ufl.inner(s_tr, s_tr)
-        # an unstressed point (q_tr = 0: no direction) or an instantaneous step (Δt = 0)
-        # does not flow; the other branch is then never evaluated (√ and q^(1/n) at 0
-        # have no derivative)
-        flows = ufl.And(ufl.gt(q_tr2, (1e-14 * self.E) ** 2), ufl.gt(st.dt, 0))
-        q_tr = ufl.sqrt(ufl.conditional(flows, q_tr2, 1.0))
-        c = 3 * mu * self.A * ufl.conditional(flows, st.dt, 1.0)
-        q = ufl.min_value(q_tr, (q_tr / c) ** (1 / n))
-        for _ in range(NEWTON_STEPS):
-            q = q - (q + c * q**n - q_tr) / (1 + n * c * q ** (n - 1))
-        dp = ufl.conditional(flows, (q_tr - q) / (3 * mu), 0)
-        direction = ufl.conditional(flows, 1.5 * s_tr / q_tr, ufl.zero(3, 3))
-        return st.eps_v + dp * direction, st.p + dp, dp, ufl.conditional(flows, q, 0)
+        raise NotImplementedError
+
+    def dissipated(self, p, dp, measure):
+        """The condensed energy's terms beyond Hooke's, at the step's state (UFL).
+
+        Args:
+            p: the cumulated inelastic strain after the step.
+            dp: its increment.
+            measure: the fourth value of `return_map`.
+        """
+        raise NotImplementedError
 
     def stress(self, eps):
         """σ = C : (ε − εᵛ) at the step's viscous strain.
@@ -197,7 +204,7 @@ class NortonCreep(Isotropic, SmallStrain):
         return 2 * self.mu * ufl.dev(eps - eps_v)
 
     def energy(self, eps):
-        """ψ(ε) = W(ε − εᵛ) + n/(n + 1) q Δp: the step's condensed energy.
+        """ψ(ε) = W(ε − εᵛ) + the dissipated terms: the step's condensed energy.
 
         Args:
             eps: the small strain ε (UFL, 3x3).
@@ -205,12 +212,12 @@ class NortonCreep(Isotropic, SmallStrain):
         Returns:
             ψ (UFL scalar).
         """
-        eps_v, _, dp, q = self.return_map(eps)
-        n = float(self.n)
-        return LinearElastic(self.E, self.nu).energy(eps - eps_v) + n / (n + 1) * q * dp
+        eps_v, p, dp, measure = self.return_map(eps)
+        return LinearElastic(self.E, self.nu).energy(eps - eps_v) + self.dissipated(p, dp,
+                                                                                    measure)
 
     def volumetric_split(self, eps):
-        """ψ = [μ |dev(ε − εᵛ)|² + n/(n + 1) q Δp] + κ/2 (tr ε)²: the flow is isochoric.
+        """ψ = [μ |dev(ε − εᵛ)|² + the dissipated terms] + κ/2 (tr ε)²: isochoric flow.
 
         The mixed displacement–pressure form (`materials.mixed`) needs it here more than
         for any rate-independent law: stationary creep is an incompressible flow whose
@@ -221,12 +228,12 @@ class NortonCreep(Isotropic, SmallStrain):
             eps: the small strain ε (UFL, 3x3).
 
         Returns:
-            (μ |dev(ε − εᵛ)|² + n/(n + 1) q Δp, tr ε, κ).
+            (μ |dev(ε − εᵛ)|² + the dissipated terms, tr ε, κ).
         """
-        eps_v, _, dp, q = self.return_map(eps)
+        eps_v, p, dp, measure = self.return_map(eps)
         d = ufl.dev(eps - eps_v)
-        n = float(self.n)
-        return self.mu * ufl.inner(d, d) + n / (n + 1) * q * dp, ufl.tr(eps), self.kappa
+        return self.mu * ufl.inner(d, d) + self.dissipated(p, dp, measure), ufl.tr(eps), \
+            self.kappa
 
     def modified_newton_tangent(self, u, model: str, dx):
         """Hooke's tangent (E, ν), factorized once: the law's instantaneous stiffness.
@@ -266,3 +273,126 @@ class NortonCreep(Isotropic, SmallStrain):
         b.interpolate(new_p)
         st.eps_v.x.array[:] = a.x.array
         st.p.x.array[:] = b.x.array
+
+
+@dataclass(frozen=True, eq=False)
+class NortonCreep(ViscousLaw):
+    """Norton creep: ε̇ᵛ = A σ_eqⁿ uniaxially, A > 0, n ≥ 1 (n = 1: linear viscosity)."""
+
+    A: float = 1.0
+    n: float = 1.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not (math.isfinite(self.A) and self.A > 0):
+            raise ValueError(f"A must be > 0 and finite, got {self.A!r}")
+        if not (math.isfinite(self.n) and self.n >= 1):
+            raise ValueError(f"n must be >= 1 and finite, got {self.n!r}")
+
+    def return_map(self, eps):
+        """(εᵛ, p, Δp, q) at the strain ε after the time step, from the committed state.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (viscous strain εᵛ, cumulated viscous strain p, its increment Δp, the step's
+            equivalent stress q), UFL.
+        """
+        self.require_3x3(eps)
+        st = self._bound()
+        mu = self.mu
+        s_tr = 2 * mu * ufl.dev(eps - st.eps_v)
+        q_tr2 = 1.5 * ufl.inner(s_tr, s_tr)
+        # an unstressed point (q_tr = 0: no direction) or an instantaneous step (Δt = 0)
+        # does not flow; the other branch is then never evaluated (√ and q^(1/n) at 0
+        # have no derivative)
+        flows = ufl.And(ufl.gt(q_tr2, (1e-14 * self.E) ** 2), ufl.gt(st.dt, 0))
+        q_tr = ufl.sqrt(ufl.conditional(flows, q_tr2, 1.0))
+        q = power_root(q_tr, 3 * mu * self.A * st.dt, float(self.n), flows)
+        dp = ufl.conditional(flows, (q_tr - q) / (3 * mu), 0)
+        direction = ufl.conditional(flows, 1.5 * s_tr / q_tr, ufl.zero(3, 3))
+        return st.eps_v + dp * direction, st.p + dp, dp, ufl.conditional(flows, q, 0)
+
+    def dissipated(self, p, dp, measure):
+        """Δt φ*(Δp/Δt) = n/(n + 1) q Δp (q: the step's equivalent stress).
+
+        Args:
+            p: the cumulated viscous strain after the step (unused).
+            dp: its increment.
+            measure: q.
+
+        Returns:
+            The term (UFL scalar).
+        """
+        n = float(self.n)
+        return n / (n + 1) * measure * dp
+
+
+@dataclass(frozen=True, eq=False)
+class PerzynaViscoplasticity(ViscousLaw):
+    """Perzyna (Norton–Hoff) viscoplasticity on J2: ṗ = ⟨(σ_eq − σ0 − H p)/K⟩^m.
+
+    The plastic strain flows only above the yield stress σ0 + H p, at a rate set by the
+    overstress y = σ_eq − σ0 − H p: ε̇ᵖ = (3/2) ṗ s/σ_eq. Backward Euler over Δt: with the
+    trial f_tr = q_tr − σ0 − H pₙ > 0, the overstress solves y + (3μ + H) Δt (y/K)^m = f_tr
+    (`power_root`, as Norton's), Δp = (f_tr − y)/(3μ + H). As Δt grows against the
+    relaxation time, y → 0 and Δp → f_tr/(3μ + H): J2's radial return (tested). At a
+    constant plastic strain rate the stress tends to σ0 + H p + K ṗ^(1/m).
+    """
+
+    sigma0: float = 1.0
+    H: float = 0.0
+    K: float = 1.0
+    m: float = 1.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name, least in (("sigma0", 0.0), ("K", 0.0)):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > least):
+                raise ValueError(f"{name} must be > 0 and finite, got {value!r}")
+        if not (math.isfinite(self.H) and self.H >= 0):
+            raise ValueError(f"H must be >= 0 and finite, got {self.H!r}")
+        if not (math.isfinite(self.m) and self.m >= 1):
+            raise ValueError(f"m must be >= 1 and finite, got {self.m!r}")
+
+    def return_map(self, eps):
+        """(εᵖ, p, Δp, y) at the strain ε after the time step, from the committed state.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            (plastic strain εᵖ, cumulated plastic strain p, its increment Δp, the step's
+            overstress y), UFL.
+        """
+        self.require_3x3(eps)
+        st = self._bound()
+        mu, H = self.mu, self.H
+        s_tr = 2 * mu * ufl.dev(eps - st.eps_v)
+        q_tr = ufl.sqrt(1.5 * ufl.inner(s_tr, s_tr))
+        f_tr = q_tr - (self.sigma0 + H * st.p)
+        # above yield, and a step that takes time (Δt = 0: the instantaneous, elastic
+        # response); the other branch is then never evaluated
+        flows = ufl.And(ufl.gt(f_tr, 1e-10 * self.sigma0), ufl.gt(st.dt, 0))
+        m = float(self.m)
+        y = power_root(f_tr, (3 * mu + H) * st.dt / self.K**m, m, flows)
+        dp = ufl.conditional(flows, (f_tr - y) / (3 * mu + H), 0)
+        q = ufl.conditional(flows, q_tr, 1.0)
+        direction = ufl.conditional(flows, 1.5 * s_tr / q, ufl.zero(3, 3))
+        return st.eps_v + dp * direction, st.p + dp, dp, ufl.conditional(flows, y, 0)
+
+    def dissipated(self, p, dp, measure):
+        """H/2 p² + σ0 Δp + m/(m + 1) y Δp (y: the step's overstress).
+
+        Args:
+            p: the cumulated plastic strain after the step.
+            dp: its increment.
+            measure: y.
+
+        Returns:
+            The terms (UFL scalar).
+        """
+        m = float(self.m)
+        return 0.5 * self.H * p**2 + self.sigma0 * dp + m / (m + 1) * measure * dp
