@@ -344,10 +344,13 @@ history, shapes = [(0.0, 0.0, 0.0, 0.0)], []
 
 def record(s, result):
     r = s * args.load_ratio
-    # a redone path, or the branch-switched end state, replaces what it passes again
-    while len(history) > 1 and history[-1][0] >= r:
+    # a redone path, or the branch-switched end state, replaces what it passes again (at
+    # the same load up to the round-off of the summed steps: ten steps of 0.1 sum to
+    # 0.9999999999999999)
+    again = r - 1e-9 * args.load_ratio
+    while len(history) > 1 and history[-1][0] >= again:
         history.pop()
-    while shapes and shapes[-1][0] >= r:
+    while shapes and shapes[-1][0] >= again:
         shapes.pop()
     end = tip()
     history.append((r, math.degrees(abs(end["rotation"])), abs(end["lateral"]), end["axial"]))

@@ -303,13 +303,15 @@ for k, load in enumerate(loads):
 # ## What the steps say
 #
 # * Tension: the force grows almost linearly, the damage at the notch's tip stays small, and
-#   at the peak the crack runs through the ligament in one or two steps (brutally: the
-#   alternate minimization then takes a hundred iterations or more). It is straight: its tip
-#   stays on $y = 0.5$ within a cell.
+#   at the peak the crack runs through the ligament in one or two steps (brutally: the plain
+#   alternate minimization then takes a hundred iterations or more, Anderson's a few tens).
+#   It is straight: its tip stays on $y = 0.5$ within a cell (the JSON's
+#   `crack_straightness`).
 #   Once broken, the square has dissipated $G_h$ per unit width. The energy release rate
 #   measured between the first step and the last, $(D_{end} - D_1)/\Delta a$ ($\Delta a$ the
-#   tip's path), reads a little low: $D_1$ includes the damage around the notch's tip (about
-#   $G_c\ell$), which the crack that leaves the square no longer has.
+#   tip's path, the JSON's `energy_release_rate`), reads a little low: $D_1$ includes the
+#   damage around the notch's tip (about $G_c\ell$), which the crack that leaves the square
+#   no longer has.
 # * Shear: the crack leaves the notch downwards and reaches the right side or the bottom.
 #   Its length is not measured (its tip jumps in one step along a path that turns), so
 #   neither is its energy release rate.
@@ -345,7 +347,7 @@ else:
     peaked = k_peak < len(loads) - 1  # else the force was still rising: no peak
     cli.say((f"peak force {force[k_peak]:.4g} kN at U = {loads[k_peak]:.4g} mm; "
              if peaked else "no peak: the force still rises at the last step; ")
-            + (f"broken: D/L = {per_width:.5g} against the mesh toughness "
+            + (f"broken: D per unit width {per_width:.5g} against the mesh toughness "
                f"{mesh_toughness:.5g} ({100 * width_error:+.2f} %)"
                if width_error is not None
                else "broken" if broken else "not broken by the last step"))

@@ -180,15 +180,17 @@ def shapes_against_elastica(shapes, length: float, imperfection: float, load_rat
     straight = [r for r, pts in picks[:-1]
                 if abs(pts[-1, 1]) < 0.01 * elastica.tip_position(r)[0] * L]
     for r, pts in picks:
-        if r not in straight:
-            colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
-            ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
+        if r in straight:  # no buckled FE shape to set the elastica against
+            continue
+        colour = cmap(0.1 + 0.8 * (r - 1) / max(top - 1, 1e-9))
+        ax.plot(pts[:, 0], pts[:, 1], color=colour, lw=2, label=f"FE, P/P_cr = {r:.3g}")
         xe, ye = elastica.shape(r)
         ax.plot(xe * L, sign * ye * L, "--", color="k", lw=0.8)
     if straight:
         ax.plot([0, L], [0, 0], color="tab:red", lw=2,
-                label=f"FE, still straight (unstable) at P/P_cr = {straight[0]:.3g}"
-                      f"–{straight[-1]:.3g}")
+                label="FE, still straight (unstable) at P/P_cr = " + (
+                    f"{straight[0]:.3g}" if len(straight) == 1
+                    else f"{straight[0]:.3g}–{straight[-1]:.3g}"))
     ax.plot([], [], "--", color="k", lw=0.8, label="elastica (same loads)")
     ax.annotate("clamped", (0, 0), xytext=(-0.12 * L, -0.08 * L), fontsize=8,
                 arrowprops={"arrowstyle": "->"})
