@@ -282,9 +282,9 @@ K_G = geometric_stiffness(sigma0, du, v,  # embedded 3×3 ∇ matches a 3×3 σ�
                           lambda z: kinematics.displacement_gradient(z, model)) * dx
 loads, _ = critical_loads(K, K_G, bcs, W, n=3, prefix="beam_buckling_",
                           scale_dofs=fields.displacement_dofs)
-P_cr = loads[0]
+P_slepc = loads[0]  # the FE model's critical load; P_cr in the text is Euler's
 say(f"critical loads (SLEPc): {', '.join(f'{x:.6g}' for x in loads)}; Euler "
-    f"{P_euler:.6g} ({100 * (P_cr / P_euler - 1):+.3f} %)")
+    f"{P_euler:.6g} ({100 * (P_slepc / P_euler - 1):+.3f} %)")
 # -
 
 # ### Stability: the tangent's eigenvalue nearest 0, and a push along its mode
@@ -444,8 +444,8 @@ say(f"P/P_cr = {args.load_ratio:g}: tip rotation {alpha:.3f} deg (elastica "
     f"{path.iterations} Newton iterations, {path.failures} step cuts")
 reactions = boundary.reactions(residual, w, {"clamp": clamped}, space=V if args.mixed else None)
 out = {
-    "critical_load": P_cr, "critical_loads": loads, "euler_critical_load": P_euler,
-    "critical_load_rel_error": P_cr / P_euler - 1, "load_ratio": args.load_ratio,
+    "critical_load": P_slepc, "critical_loads": loads, "euler_critical_load": P_euler,
+    "critical_load_rel_error": P_slepc / P_euler - 1, "load_ratio": args.load_ratio,
     "tip_rotation_deg": alpha, "tip_deflection": abs(end["lateral"]),
     "tip_axial_displacement": end["axial"], "elastica_tip_rotation_deg": alpha_el,
     "elastica_tip_deflection": d_el * L, "elastica_tip_axial_displacement": (x_el - 1) * L,

@@ -177,13 +177,6 @@ def strip(cells, height):
     return msh, tags, V, u, supports, end
 
 
-def stress_at_end(internal, u, tags):
-    """σ = the right end's reaction over A, from the internal work (a compiled form in u)."""
-    held = boundary.reactions(internal, u, {"right": tags.find(RIGHT)}, {"right": [0]},
-                              space=u.function_space)["right"][0]
-    return held / height
-
-
 if local:
     law = CourseDamage(args.E, 0.0, w_c=args.wc)
     cells, height = args.cells, L / args.cells
@@ -193,6 +186,15 @@ else:
     cells = math.ceil(args.resolution * L / args.ell)
     height = L / cells
 msh, tags, V, u, supports, end = strip(cells, height)
+
+
+def stress_at_end(internal, u, tags):
+    """σ = the right end's reaction over A, from the internal work (a compiled form in u)."""
+    held = boundary.reactions(internal, u, {"right": tags.find(RIGHT)}, {"right": [0]},
+                              space=u.function_space)["right"][0]
+    return held / height
+
+
 bcs = [*supports, end]
 # the peak of the homogeneous response: ε_c for the local law and AT1, AT2's maximum
 peak_strain = law.critical_strain or math.sqrt(args.Gc / (3 * args.ell * args.E))

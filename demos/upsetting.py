@@ -260,7 +260,8 @@ def record(t, result):
                                       *contact.fields(weight)])
     say(f"  reduction {r:.3f}: F = {contact.force:.6g} (frictionless "
         f"{step['force_frictionless_exact']:.6g}), contact radius "
-        f"{step['contact_radius']:.4g}, stick {step['stick_radius']:.4g}; "
+        f"{step['contact_radius']:.4g}"
+        + (f", stick {step['stick_radius']:.4g}" if args.friction > 0 else "") + "; "
         f"{result.iterations} Newton / {result.active_set_iterations} status iterations")
 
 
@@ -308,8 +309,8 @@ else:
     say(f"f = {args.friction:g}: F = {last['force']:.6g} = "
         f"{last['force'] / last['force_frictionless_exact']:.4f} x frictionless, "
         f"{slab_ratio:.4f} x the slab estimate; stick radius {last['stick_radius']:.4g} of "
-        f"contact radius {last['contact_radius']:.4g}; {last['folded_nodes']} side nodes "
-        "folded onto the die")
+        f"contact radius {last['contact_radius']:.4g}; side nodes folded onto the die: "
+        f"{last['folded_nodes']}")
 # -
 
 # ## Outputs
