@@ -32,7 +32,7 @@ import ufl
 from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain
-from fenics_nl.materials.plasticity import quadrature_spaces
+from fenics_nl.materials.plasticity import hookes_tangent, quadrature_spaces, store_at_points
 
 __all__ = ["NEWTON_STEPS", "NortonCreep", "PerzynaViscoplasticity", "ViscousLaw", "ViscousState",
            "power_root"]
@@ -246,9 +246,7 @@ class ViscousLaw(Isotropic, SmallStrain):
         Returns:
             Hooke's tangent, a bilinear form (UFL) in `u`.
         """
-        v = ufl.TestFunction(u.function_space)
-        work = LinearElastic(self.E, self.nu).internal_work(u, v, model)
-        return ufl.derivative(work * dx, u)
+        return hookes_tangent(self, u, model, dx)
 
     def commit(self, u, model: str = "3d") -> None:
         """Store the step's viscous state of the displacement `u` (a converged step).
@@ -259,20 +257,11 @@ class ViscousLaw(Isotropic, SmallStrain):
             u: the displacement.
             model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
         """
-        from dolfinx import fem
-
         st = self._bound()
         if st.commit is None:  # compiled once
             eps_v, p, _, _ = self.return_map(kinematics.small_strain(u, model))
             st.commit = (Expression(eps_v, st.points), Expression(p, st.points))
-        new_eps_v, new_p = st.commit
-        # evaluate both before storing: each reads the committed state
-        a = fem.Function(st.eps_v.function_space)
-        a.interpolate(new_eps_v)
-        b = fem.Function(st.p.function_space)
-        b.interpolate(new_p)
-        st.eps_v.x.array[:] = a.x.array
-        st.p.x.array[:] = b.x.array
+        store_at_points((st.eps_v, st.p), st.commit)
 
 
 @dataclass(frozen=True, eq=False)

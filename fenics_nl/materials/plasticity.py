@@ -33,8 +33,8 @@ from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "cell_max", "per_cell",
-           "quadrature_spaces"]
+__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "cell_max",
+           "hookes_tangent", "per_cell", "quadrature_spaces", "store_at_points"]
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
 
@@ -64,6 +64,46 @@ class PlasticState:
         self.eps_p = fem.Function(T, name="plastic_strain")
         self.p = fem.Function(S, name="cumulated_plastic_strain")
         self.points, self.commit = T.element.interpolation_points, None
+
+
+def hookes_tangent(material, u, model: str, dx):
+    """The tangent of Hooke's law with the material's E and ν.
+
+    What a path-dependent law keeps for modified Newton: its own K(0) would read the
+    committed state.
+
+    Args:
+        material: the law (its `E` and `nu` are read).
+        u: the displacement (the unknown Function).
+        model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+        dx: the measure of the residual.
+
+    Returns:
+        Hooke's tangent, a bilinear form (UFL) in `u`.
+    """
+    v = ufl.TestFunction(u.function_space)
+    work = LinearElastic(material.E, material.nu).internal_work(u, v, model)
+    return ufl.derivative(work * dx, u)
+
+
+def store_at_points(targets, expressions) -> None:
+    """Evaluate every expression at the quadrature points, then store each in its target.
+
+    All are evaluated before any is stored: each reads the committed state it replaces.
+
+    Args:
+        targets: the state's quadrature Functions.
+        expressions: their new values (`fenics_nl.expression.Expression`, one per target).
+    """
+    from dolfinx import fem
+
+    values = []
+    for target, expression in zip(targets, expressions, strict=True):
+        new = fem.Function(target.function_space)
+        new.interpolate(expression)
+        values.append(new.x.array)
+    for target, value in zip(targets, values, strict=True):
+        target.x.array[:] = value
 
 
 def quadrature_spaces(mesh, degree: int):
@@ -207,9 +247,7 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         Returns:
             Hooke's tangent, a bilinear form (UFL) in `u`.
         """
-        v = ufl.TestFunction(u.function_space)
-        work = LinearElastic(self.E, self.nu).internal_work(u, v, model)
-        return ufl.derivative(work * dx, u)
+        return hookes_tangent(self, u, model, dx)
 
     def reset(self) -> None:
         """Back to the virgin state (a new load path on the same forms)."""
@@ -402,20 +440,11 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         Args:
             strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
         """
-        from dolfinx import fem
-
         st = self._bound()
         if st.commit is None:  # compiled once
             eps_p, p, _ = self.return_map(strain)
             st.commit = (Expression(eps_p, st.points), Expression(p, st.points))
-        new_eps_p, new_p = st.commit
-        # evaluate both before storing: each reads the committed state
-        a = fem.Function(st.eps_p.function_space)
-        a.interpolate(new_eps_p)
-        b = fem.Function(st.p.function_space)
-        b.interpolate(new_p)
-        st.eps_p.x.array[:] = a.x.array
-        st.p.x.array[:] = b.x.array
+        store_at_points((st.eps_p, st.p), st.commit)
 
 
 def cell_max(at_points, name: str):
