@@ -73,12 +73,13 @@ class ViscousState:
 
     eps_v: object = None  # the viscous strain εᵛ (quadrature Function, 3x3)
     p: object = None  # the cumulated viscous strain (quadrature Function)
+    q: object = None  # the equivalent stress σ_eq of the committed state (quadrature Function)
     dt: object = None  # the time step Δt (fem.Constant)
     points: object = None  # the quadrature points (reference cell)
-    commit: tuple | None = None  # (εᵛ, p) of the step as fem.Expressions, compiled once
+    commit: tuple | None = None  # (εᵛ, p, σ_eq) of the step as fem.Expressions, compiled once
 
     def bind(self, mesh, degree: int) -> None:
-        """Zero εᵛ and p at the quadrature points of `degree` on `mesh`; Δt = 0.
+        """Zero εᵛ, p and σ_eq at the quadrature points of `degree` on `mesh`; Δt = 0.
 
         Args:
             mesh: the mesh.
@@ -89,6 +90,7 @@ class ViscousState:
         T, S = quadrature_spaces(mesh, degree)
         self.eps_v = fem.Function(T, name="viscous_strain")
         self.p = fem.Function(S, name="cumulated_viscous_strain")
+        self.q = fem.Function(S, name="equivalent_stress")
         self.dt = fem.Constant(mesh, 0.0)
         self.points, self.commit = T.element.interpolation_points, None
 
@@ -134,8 +136,8 @@ class ViscousLaw(Isotropic, SmallStrain):
     def reset(self) -> None:
         """Back to the virgin state (a new load path on the same forms)."""
         st = self._bound()
-        st.eps_v.x.array[:] = 0.0
-        st.p.x.array[:] = 0.0
+        for f in (st.eps_v, st.p, st.q):
+            f.x.array[:] = 0.0
 
     @property
     def viscous_strain(self):
@@ -146,6 +148,15 @@ class ViscousLaw(Isotropic, SmallStrain):
     def cumulated_viscous_strain(self):
         """The committed cumulated viscous strain p (quadrature Function)."""
         return self._bound().p
+
+    @property
+    def equivalent_stress(self):
+        """The von Mises stress σ_eq of the committed state (quadrature Function).
+
+        Not a state variable (it follows from εᵛ and u): what the time driver's step control
+        and stationary test read.
+        """
+        return self._bound().q
 
     def state_functions(self) -> dict:
         """The committed state's quadrature Functions by name (to checkpoint and restore).
@@ -249,7 +260,7 @@ class ViscousLaw(Isotropic, SmallStrain):
         return hookes_tangent(self, u, model, dx)
 
     def commit(self, u, model: str = "3d") -> None:
-        """Store the step's viscous state of the displacement `u` (a converged step).
+        """Store the step's viscous state of the displacement `u` (a converged step), and σ_eq.
 
         The update is compiled for the first `u` given: one displacement per bound material.
 
@@ -259,9 +270,12 @@ class ViscousLaw(Isotropic, SmallStrain):
         """
         st = self._bound()
         if st.commit is None:  # compiled once
-            eps_v, p, _, _ = self.return_map(kinematics.small_strain(u, model))
-            st.commit = (Expression(eps_v, st.points), Expression(p, st.points))
-        store_at_points((st.eps_v, st.p), st.commit)
+            eps = kinematics.small_strain(u, model)
+            eps_v, p, _, _ = self.return_map(eps)
+            s = 2 * self.mu * ufl.dev(eps - eps_v)
+            st.commit = tuple(Expression(e, st.points)
+                              for e in (eps_v, p, ufl.sqrt(1.5 * ufl.inner(s, s))))
+        store_at_points((st.eps_v, st.p, st.q), st.commit)
 
 
 @dataclass(frozen=True, eq=False)
