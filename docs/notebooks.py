@@ -33,6 +33,7 @@ SMALL = {
     "bracket.py": ["--size", "20", "--steps", "1"],
     "buckling_beam.py": ["--load-ratio", "1.2", "--steps", "10"],
     "pressure_vessel.py": [],
+    "creep_vessel.py": [],
     "upsetting.py": [],
     "snap_through.py": [],
     "damage_bar.py": [],

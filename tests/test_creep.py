@@ -365,3 +365,37 @@ def test_a_creeping_vessel_on_two_ranks_gives_the_serial_answer():
     assert steps == serial_steps
     for where in serial:
         assert parallel[where] == pytest.approx(serial[where], abs=1e-9)
+
+
+# -- the demo ------------------------------------------------------------------------------
+
+def test_the_creep_vessel_demo_goes_from_lame_to_the_stationary_state(demo):
+    # its defaults (cylinder, n = 5, 10 elements through the wall, 40 relaxation times):
+    # measured along y = 0 at nine radii (boundary points included), σ_rr and σ_θθ within
+    # 0.41 % of p of Lamé at the end of the ramp (0.01 h: 8e-5 relaxation times, but 2e-3
+    # of the bore's own, where σ_eq is 2.3 p and the flow 28 times faster) and 0.12 % of
+    # the stationary closed form at the end; the bore's stationary rate within 0.003 %
+    # (backward Euler is exact at a constant rate: the mesh's error only)
+    d = demo.json("creep_vessel.py")
+    assert d["profile_error_lame"] < 0.006 and d["profile_error_stationary"] < 0.0025
+    assert abs(d["bore_displacement_rate_error"]) < 5e-4
+    assert d["stationary_since"] is not None and not d["warnings"]
+    assert d["bore_hoop_stress"] < d["bore_hoop_stress_lame"] / 2  # it fell, and outside
+    assert d["outer_hoop_stress"] > 1.2 * d["pressure"]  # it rose (Lamé: 0.667 p)
+
+
+def test_a_killed_creep_run_restarts_to_the_uninterrupted_answer(tmp_path, demo):
+    # killed after its 20th time step, restarted from its last checkpoint: the same steps
+    # (the driver's last viscous strain rate and σ_eq come back with the state), the same
+    # profiles and the same answer
+    import sys
+
+    from conftest import DEMOS, run_and_kill
+    from demo_snapshot import differences
+
+    flags = ["--end", "1000", "--tolerance", "1e-2"]
+    whole = demo.json("creep_vessel.py", *flags)
+    run_and_kill([sys.executable, DEMOS / "creep_vessel.py", *flags, "--checkpoint", "ck"],
+                 tmp_path, "  step 20:")
+    resumed = demo.json("creep_vessel.py", *flags, "--restart", tmp_path / "ck")
+    assert differences(whole, resumed, "json") == []

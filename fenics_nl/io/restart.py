@@ -4,9 +4,10 @@ After a converged step a checkpoint holds the Functions of the state (the unknow
 pressure of a mixed form; the internal variables at the quadrature points), the contact's
 active set, Newton's force reference, the step records of the run's JSON, and where the
 driver stands: `loading.DriverState` under load control (with the load path so far, its
-phase: a demo's loading and unloading, a case's segment), or `arclength.ArcState` under
-arc-length control. A restart puts all of it back; the steps after it are then those of the
-uninterrupted run, to round-off.
+phase: a demo's loading and unloading, a case's segment), `time_stepping.TimeState` in time
+(with the last step's viscous strain rate and σ_eq, which size the next step), or
+`arclength.ArcState` under arc-length control. A restart puts all of it back; the steps
+after it are then those of the uninterrupted run, to round-off.
 
 The identity (JSON-able, the same on every rank: what the run is) and each rank's layout
 (the size of its unknowns and a hash of its mesh nodes) are checked on reading: a restart
@@ -23,6 +24,7 @@ from fenics_nl.io.checkpoint import CheckpointError, Checkpoints, fingerprint
 from fenics_nl.solvers.arclength import ArcState
 from fenics_nl.solvers.loading import DriverState, LoadPath
 from fenics_nl.solvers.result import SolveResult, WorkCounts
+from fenics_nl.solvers.time_stepping import TimePath, TimeState
 
 __all__ = ["PathCheckpoints", "Resumed"]
 
@@ -32,11 +34,11 @@ class Resumed:
     """Where a restarted run goes on from."""
 
     phase: int  # the phase (or segment) of the load path the checkpoint was taken in
-    driver: DriverState | None  # where in it (None under arc-length control); t = 1: done
+    driver: DriverState | TimeState | None  # where in it (None under arc-length control)
     steps: list[dict]  # the step records of the JSON so far
     work: WorkCounts  # of the load-controlled phases (an arc's is in its state's path)
     arc: ArcState | None = None  # under arc-length control: where the path goes on from
-    path: LoadPath | None = None  # the phase's path so far (its totals go on from it)
+    path: LoadPath | TimePath | None = None  # the phase's path so far (its totals go on)
     kept: dict | None = None  # what the run's `kept` gave
 
 
@@ -69,12 +71,19 @@ class PathCheckpoints:
 
     # -- what is saved -----------------------------------------------------------------
 
-    def save(self, phase: int, driver: DriverState, steps: list[dict], work: WorkCounts,
-             path: LoadPath | None = None) -> None:
+    def save(self, phase: int, driver: DriverState | TimeState, steps: list[dict],
+             work: WorkCounts, path: LoadPath | None = None) -> None:
         """The state after the converged step that ended with `driver` (collective).
 
         `work`: of the phases before this one; `path`: this phase's so far.
         """
+        if isinstance(driver, TimeState):
+            self._save({"phase": phase, "time": driver.t, "dt": driver.dt,
+                        "stationary_since": driver.stationary_since,
+                        "work": dataclasses.asdict(work),
+                        "path": None if path is None else _path_record(path)},
+                       {"rate": driver.rate, "stress": driver.stress}, steps)
+            return
         arrays = {} if driver.previous is None else {"previous": driver.previous}
         self._save({"phase": phase, "t": driver.t, "dt": driver.dt,
                     "dt_previous": driver.dt_previous,
@@ -119,8 +128,12 @@ class PathCheckpoints:
         if "arc" in state:
             return Resumed(0, None, state["steps"], WorkCounts(),
                            ArcState.saved(state["arc"], arrays), kept=state["kept"])
-        driver = DriverState(state["t"], state["dt"], state["dt_previous"],
-                             arrays["previous"] if state["has_previous"] else None)
+        if "time" in state:
+            driver = TimeState(state["time"], state["dt"], arrays["rate"], arrays["stress"],
+                               state["stationary_since"])
+        else:
+            driver = DriverState(state["t"], state["dt"], state["dt_previous"],
+                                 arrays["previous"] if state["has_previous"] else None)
         work = WorkCounts(**state["work"])
         path = None if state.get("path") is None else _path_from(state["path"])
         return Resumed(state["phase"], driver, state["steps"], work, path=path,
@@ -129,11 +142,20 @@ class PathCheckpoints:
 
 def _path_record(path: LoadPath) -> dict:
     """What a restart needs of a load path so far (its steps' iterations, not their norms)."""
-    return {"factors": path.factors, "iterations": [r.iterations for r in path.results],
-            "failures": path.failures, "work": dataclasses.asdict(path.work)}
+    record = {"factors": path.factors, "iterations": [r.iterations for r in path.results],
+              "failures": path.failures, "work": dataclasses.asdict(path.work)}
+    if isinstance(path, TimePath):
+        record["time"] = {"times": path.times, "errors": path.errors,
+                          "rejected": path.rejected, "stationary_since": path.stationary_since}
+    return record
 
 
 def _path_from(record: dict) -> LoadPath:
-    return LoadPath(list(record["factors"]),
-                    [SolveResult.restored(its) for its in record["iterations"]],
-                    record["failures"], WorkCounts(**record["work"]))
+    common = (list(record["factors"]),
+              [SolveResult.restored(its) for its in record["iterations"]],
+              record["failures"], WorkCounts(**record["work"]))
+    if "time" not in record:
+        return LoadPath(*common)
+    t = record["time"]
+    return TimePath(*common, list(t["times"]), list(t["errors"]), t["rejected"],
+                    t["stationary_since"])

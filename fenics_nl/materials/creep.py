@@ -32,7 +32,12 @@ import ufl
 from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain
-from fenics_nl.materials.plasticity import hookes_tangent, quadrature_spaces, store_at_points
+from fenics_nl.materials.plasticity import (
+    cell_max,
+    hookes_tangent,
+    quadrature_spaces,
+    store_at_points,
+)
 
 __all__ = ["NEWTON_STEPS", "NortonCreep", "PerzynaViscoplasticity", "ViscousLaw", "ViscousState",
            "power_root"]
@@ -167,6 +172,16 @@ class ViscousLaw(Isotropic, SmallStrain):
         """
         st = self._bound()
         return {"viscous_strain": st.eps_v, "cumulated_viscous_strain": st.p}
+
+    def output_fields(self) -> list:
+        """What a time series writes of the state: p and σ_eq, each cell's largest (DG0).
+
+        Returns:
+            New DG0 Functions "cumulated_viscous_strain" and "equivalent_stress_at_points".
+        """
+        st = self._bound()
+        return [cell_max(st.p, "cumulated_viscous_strain"),
+                cell_max(st.q, "equivalent_stress_at_points")]
 
     def return_map(self, eps):
         """(εᵛ, p, Δp, the step's stress measure) after the time step: the law's own.

@@ -7,7 +7,10 @@ quarter (`vessel_plastic_zone`), the die and the contact statuses on the billet
 inner displacement with Lamé and the perfectly plastic sphere (`vessel_pressure_curve`),
 the die's force against the height reduction with the homogeneous compression and the slab
 method (`upsetting_force_curve`). `demos/pressure_vessel.py` and `demos/upsetting.py` draw
-them.
+them. And the vessel creeping under a held pressure (`demos/creep_vessel.py`): its stress
+profiles at several times against Lamé's and the stationary closed form, the bore's stresses
+and displacement against time (`creep_vessel_figure`), the cumulated viscous strain on the
+deformed quarter (`creep_vessel_picture`).
 """
 
 from __future__ import annotations
@@ -21,8 +24,8 @@ from mpi4py import MPI
 from fenics_nl.plots import deformed, figures
 from fenics_nl.theory import vessels
 
-__all__ = ["VesselRun", "billet_picture", "upsetting_force_curve", "vessel_plastic_zone",
-           "vessel_pressure_curve"]
+__all__ = ["VesselRun", "billet_picture", "creep_vessel_figure", "creep_vessel_picture",
+           "upsetting_force_curve", "vessel_plastic_zone", "vessel_pressure_curve"]
 
 
 @dataclass
@@ -198,3 +201,94 @@ def upsetting_force_curve(history: list[dict], friction: float, path: str, title
     ax.grid(alpha=0.3)
     ax.legend()
     figures.save_figure(fig, path)
+
+
+def creep_vessel_figure(shape: str, a: float, b: float, p: float, n: float, tau: float,
+                        profiles: dict, times: list, bore_hoop: list, outer_hoop: list,
+                        bore_u: list, rate_exact: float, path: str,
+                        comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """A creeping vessel: stress profiles, the hoop stresses and the bore against time.
+
+    Args:
+        shape: ``cylinder`` or ``sphere``.
+        a: the inner radius.
+        b: the outer radius.
+        p: the pressure.
+        n: Norton's exponent.
+        tau: the relaxation time (the time axis's unit).
+        profiles: time → (σ_rr, σ_θθ) at equally spaced radii from a to b.
+        times: the accepted steps' times, from 0.
+        bore_hoop: the hoop stress at the bore at those times.
+        outer_hoop: the hoop stress outside at those times.
+        bore_u: the bore's radial displacement at those times.
+        rate_exact: the stationary closed form's u̇(a).
+        path: the PNG, written by rank 0 of `comm`.
+        comm: the run's communicator.
+    """
+    if comm.rank != 0:
+        return
+    plt = figures.pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    r = np.linspace(a, b, 200)
+    lame = vessels.stationary_creep_stresses(shape, a, b, p, 1.0, r)
+    final = vessels.stationary_creep_stresses(shape, a, b, p, n, r)
+    ax = axes[0]
+    for k, (name, style) in enumerate((("σ_rr", "--"), ("σ_θθ", "-"))):
+        ax.plot(r, lame[k] / p, "k" + style, lw=0.8, alpha=0.5,
+                label=f"{name}: Lamé (elastic)")
+        ax.plot(r, final[k] / p, "C3" + style, lw=1.2, label=f"{name}: stationary creep")
+    colours = plt.get_cmap("viridis")(np.linspace(0.0, 0.9, len(profiles)))
+    for colour, (t, (sr, st)) in zip(colours, sorted(profiles.items()), strict=True):
+        radii = np.linspace(a, b, len(st))
+        ax.plot(radii, np.array(sr) / p, "s", ms=3, mfc="none", color=colour)
+        ax.plot(radii, np.array(st) / p, "o", ms=4, color=colour,
+                label=f"FE at t = {t / tau:.2g} τ")
+    ax.set_xlabel("radius r [length]")
+    ax.set_ylabel("stress / p")
+    ax.set_title("profiles along y = 0 (FE: circles σ_θθ, squares σ_rr)", fontsize=9)
+    ax.legend(fontsize=7, loc="center right")
+    ax.grid(alpha=0.3)
+    t = np.array(times[1:]) / tau
+    ax = axes[1]
+    ax.semilogx(t, np.array(bore_hoop[1:]) / p, "o-", ms=3, label="FE: σ_θθ at the bore")
+    ax.semilogx(t, np.array(outer_hoop[1:]) / p, "s-", ms=3, label="FE: σ_θθ outside")
+    for k, style in ((0, "-"), (-1, "--")):
+        ax.axhline(final[1][k] / p, color="C3", ls=style, lw=1,
+                   label="stationary: " + ("bore" if k == 0 else "outside"))
+        ax.axhline(lame[1][k] / p, color="k", ls=style, lw=0.8, alpha=0.5,
+                   label="Lamé: " + ("bore" if k == 0 else "outside"))
+    ax.set_xlabel("time / τ (τ = 1/(E A pⁿ⁻¹); each marker a time step)")
+    ax.set_ylabel("hoop stress / p")
+    ax.set_title("the redistribution", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    ax = axes[2]
+    ax.plot(np.array(times) / tau, bore_u, "o-", ms=3, label="FE: u(a)")
+    t_line = np.array([times[len(times) // 2], times[-1]])
+    ax.plot(t_line / tau, bore_u[-1] + rate_exact * (t_line - times[-1]), "C3--", lw=1.2,
+            label=f"stationary rate {rate_exact:.4g} (closed form)")
+    ax.set_xlabel("time / τ")
+    ax.set_ylabel("bore displacement u(a) [length]")
+    ax.set_title("the bore's creep", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.suptitle(f"{shape}, b/a = {b / a:g}, Norton n = {n:g}: from Lamé to stationary creep "
+                 f"(bore σ_θθ {bore_hoop[-1] / p:.3f} p, stationary {final[1][0] / p:.3f} p)",
+                 fontsize=11)
+    figures.save_figure(fig, path)
+
+
+def creep_vessel_picture(displacement: fem.Function, viscous_strain_per_cell: fem.Function,
+                         path: str, title: str) -> None:
+    """The deformed quarter coloured by each cell's largest cumulated viscous strain.
+
+    Collective; rank 0 writes `path`.
+
+    Args:
+        displacement: u (a Function of its own space).
+        viscous_strain_per_cell: p, each cell's largest (DG0).
+        path: the PNG.
+        title: the picture's title.
+    """
+    deformed.deformed_picture(displacement, viscous_strain_per_cell, path, title,
+                              label="cumulated viscous strain")

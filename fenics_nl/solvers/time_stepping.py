@@ -188,8 +188,10 @@ def solve_in_time(solver, law, set_load: Callable[[float], None], history: LoadH
     while t < end * (1 - 1e-12):
         if not adaptive:
             dt = end / steps
-        dt = min(dt, next(c for c in corners if c > t * (1 + 1e-12)) - t)
-        f = history(t + dt)
+        corner = next(c for c in corners if c > t * (1 + 1e-12))
+        target = corner if t + dt >= corner else t + dt  # a corner's time exactly
+        dt = target - t
+        f = history(target)
         set_load(f)
         law.set_time_step(dt)
         before = {k: g.x.array.copy() for k, g in state.items()}
@@ -204,11 +206,11 @@ def solve_in_time(solver, law, set_load: Callable[[float], None], history: LoadH
             _undo(x, saved, state, before, q, q_before)
             if not adaptive or dt / 2 < min_step:
                 set_load(history(t))
-                raise LoadStepError(f"time {t + dt:.4g} not reached from {t:.4g}: {err}",
-                                    err.result, reached=t, target=t + dt) from err
+                raise LoadStepError(f"time {target:.4g} not reached from {t:.4g}: {err}",
+                                    err.result, reached=t, target=target) from err
             dt /= 2
             if progress:
-                progress(f"  the step to time {t + 2 * dt:.4g} is not taken ({err}): "
+                progress(f"  the step to time {target:.4g} is not taken ({err}): "
                          f"retried with dt = {dt:.4g}")
             continue
         increment = eps_v.x.array[: 9 * owned] - before["viscous_strain"][: 9 * owned]
@@ -219,17 +221,17 @@ def solve_in_time(solver, law, set_load: Callable[[float], None], history: LoadH
             _undo(x, saved, state, before, q, q_before)
             if dt * SHRINK < min_step:
                 set_load(history(t))
-                raise LoadStepError(f"time {t + dt:.4g} not reached from {t:.4g}: the local "
+                raise LoadStepError(f"time {target:.4g} not reached from {t:.4g}: the local "
                                     f"error stays above {tolerance:g}", result,
-                                    reached=t, target=t + dt)
+                                    reached=t, target=target)
             if progress:
-                progress(f"  the step to time {t + dt:.4g} is undone: local error "
+                progress(f"  the step to time {target:.4g} is undone: local error "
                          f"{error:.2e} > {tolerance:g}")
             dt *= max(SHRINK, SAFETY * math.sqrt(tolerance / error))
             continue
         law.set_time_step(0.0)  # the stress forms now read the committed state
         held = history(t) == f
-        t += dt
+        t = target
         x.copy(saved)
         rate = increment / dt
         stress = q.x.array[:owned].copy()

@@ -15,6 +15,21 @@ A < B, λ_a = a/A, λ_b = b/B with λ_b³ = 1 + (λ_a³ − 1) A³/B³ (the volu
     p = 2μ [(1/λ_b + 1/(4λ_b⁴)) − (1/λ_a + 1/(4λ_a⁴))],
 
 which rises to a maximum and falls: a limit point under pressure control.
+
+And Norton creep (ε̇ = A σ_eqⁿ uniaxially) once the stresses no longer change (exact for any
+elasticity, as the elastic strains are then constant and the flow incompressible), k = 2/n
+(cylinder, plane strain) or 3/n (sphere):
+
+    σ_r = −p [(b/r)^k − 1]/[(b/a)^k − 1],
+    σ_θ = p [(k − 1)(b/r)^k + 1]/[(b/a)^k − 1]  (cylinder; σ_z = (σ_r + σ_θ)/2),
+    σ_θ = p [(k/2 − 1)(b/r)^k + 1]/[(b/a)^k − 1]  (sphere),
+
+Lamé's at n = 1. The velocity is C/r (cylinder) or C/r² (sphere): from σ_eq = (√3/2)(σ_θ −
+σ_r) and ε̇_eq = (2/√3) C/r² (cylinder), σ_eq = σ_θ − σ_r and ε̇_eq = 2C/r³ (sphere),
+integrating equilibrium from the bore's −p to the outside's 0,
+
+    C = (√3/2) A b² [(√3/2) p k/((b/a)^k − 1)]ⁿ (cylinder),  (A/2) b³ [p k/(2((b/a)^k − 1))]ⁿ
+    (sphere).
 """
 
 from __future__ import annotations
@@ -32,6 +47,8 @@ __all__ = [
     "plastic_radius",
     "residual_hoop_stress_inner",
     "sphere_inner_displacement",
+    "stationary_creep_bore_rate",
+    "stationary_creep_stresses",
     "von_mises",
     "yield_onset_pressure",
 ]
@@ -53,6 +70,49 @@ def elastic_stresses(shape: str, a: float, b: float, p: float, r: float, nu: flo
     k = p * a * a / (b * b - a * a)
     sr, st = k * (1 - b * b / (r * r)), k * (1 + b * b / (r * r))
     return sr, st, nu * (sr + st)
+
+
+def stationary_creep_stresses(shape: str, a: float, b: float, p: float, n: float, r):
+    """(σ_r, σ_θ) of stationary Norton creep at radius r (scalar or array; module).
+
+    Args:
+        shape: ``cylinder`` (plane strain) or ``sphere``.
+        a: the inner radius.
+        b: the outer radius.
+        p: the inner pressure.
+        n: Norton's exponent (1: Lamé's elastic stresses).
+        r: the radius.
+
+    Returns:
+        (σ_r, σ_θ), tension positive.
+    """
+    k = (2.0 if shape == "cylinder" else 3.0) / n
+    ratio, scale = (b / r) ** k, p / ((b / a) ** k - 1)
+    hoop = (k - 1) if shape == "cylinder" else (k / 2 - 1)
+    return -scale * (ratio - 1), scale * (hoop * ratio + 1)
+
+
+def stationary_creep_bore_rate(shape: str, a: float, b: float, p: float, A: float,
+                               n: float) -> float:
+    """The bore's radial velocity u̇(a) of stationary Norton creep: C/a or C/a² (module).
+
+    Args:
+        shape: ``cylinder`` (plane strain) or ``sphere``.
+        a: the inner radius.
+        b: the outer radius.
+        p: the inner pressure.
+        A: Norton's coefficient (ε̇ = A σⁿ uniaxially).
+        n: Norton's exponent.
+
+    Returns:
+        u̇(a), outwards positive.
+    """
+    if shape == "cylinder":
+        k = 2 / n
+        c = math.sqrt(3) / 2 * A * b**2 * (math.sqrt(3) / 2 * p * k / ((b / a) ** k - 1)) ** n
+        return c / a
+    k = 3 / n
+    return A / 2 * b**3 * (p * k / (2 * ((b / a) ** k - 1))) ** n / a**2
 
 
 def von_mises(s1: float, s2: float, s3: float) -> float:
