@@ -399,3 +399,66 @@ def test_a_killed_creep_run_restarts_to_the_uninterrupted_answer(tmp_path, demo)
                  tmp_path, "  step 20:")
     resumed = demo.json("creep_vessel.py", *flags, "--restart", tmp_path / "ck")
     assert differences(whole, resumed, "json") == []
+
+
+# -- case files --------------------------------------------------------------------------
+
+def test_a_creep_case_file_reaches_the_stationary_stresses(demo):
+    # cases/creeping_cylinder.toml (n = 5, 30 MPa held for 3000 h, h = 1.5 mm on a 10 mm
+    # wall): its probes' hoop stresses at the bore and outside within 0.1 % of p of the
+    # stationary closed form (measured 0.02 % and 0.03 %), every step with its time, the
+    # ramp's end among them, and the stationary state said
+    from test_case import CASES
+
+    from fenics_nl.theory import vessels
+
+    d = demo.case(CASES / "creeping_cylinder.toml")
+    p = 30.0
+    _, st = vessels.stationary_creep_stresses("cylinder", 10.0, 20.0, p, 5.0,
+                                               np.array([10.0, 20.0]))
+    for name, exact in (("inner", st[0]), ("outer", st[1])):
+        assert d["probes"][name]["stress"][1][1] == pytest.approx(exact, abs=1e-3 * p)
+    times = [s["time"] for s in d["steps"]]
+    assert 0.01 in times and times[-1] == d["time"] == 3000.0
+    assert d["stationary_since"] is not None and d["law"] == "norton"
+
+
+def test_a_creep_case_restarts_in_time_to_the_same_path(tmp_path, demo):
+    # the case restarted one checkpoint short of its end: the same times, steps and probes
+    from conftest import same_answer
+    from test_case import CASES, rewound
+
+    path = CASES / "creeping_cylinder.toml"
+    whole = demo.case(path, "--checkpoint", tmp_path / "ck")
+    rewound(tmp_path / "ck")
+    resumed = demo.case(path, "--restart", tmp_path / "ck")
+    same_answer(whole, resumed)
+    assert [s["time"] for s in whole["steps"]] == [s["time"] for s in resumed["steps"]]
+
+
+@pytest.mark.parametrize("change,words", [
+    (("time = { end = 3000.0, steps = 20, tolerance = 1e-2 }\nfactor = [[0.0, 0.0], "
+      "[0.01, 1.0]]", "steps = 4"), "loading.time: missing: norton is rate-dependent"),
+    (('law = "norton"', 'law = "j2"\nsigma0 = 100.0'), "loading.time: only with a rate-"),
+    (("[0.01, 1.0]]", "[0.01, 0.0]]"), "no load is applied"),
+    (("[0.01, 1.0]]", "[5000.0, 1.0]]"), "its last time 5000 is past the end 3000"),
+    (("steps = 20,", "stpes = 20,"), "loading.time.stpes: unknown key (did you mean 'steps'?"),
+    (('model = "plane_strain"', 'model = "plane_stress"'), "norton has no plane-stress"),
+])
+def test_a_creep_case_file_refuses_what_has_no_meaning(tmp_path, change, words):
+    # a rate-dependent law without time, time for a law without rate, a load factor 0 at
+    # every time (nothing is loaded), a history past the end, a misspelt key, plane stress
+    import re
+
+    from test_case import CASES
+
+    from fenics_nl.case.spec import CaseError, read_case
+
+    text = (CASES / "creeping_cylinder.toml").read_text().replace(*change)
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    (tmp_path / "c.toml").write_text(text)
+    if 'model = "plane_stress"' in text:
+        text = text.replace('formulation = "mixed"\n', "")
+        (tmp_path / "c.toml").write_text(text)
+    with pytest.raises(CaseError, match=re.escape(words)):
+        read_case(tmp_path / "c.toml")

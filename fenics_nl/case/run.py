@@ -20,6 +20,7 @@ from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength, ArcState
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
+from fenics_nl.solvers.time_stepping import LoadHistory, solve_in_time
 
 __all__ = ["fields", "load_path_plot", "solve_case", "step_record", "warnings", "write_outputs"]
 
@@ -71,14 +72,14 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     first, start = 0, None  # the segment to begin with, and the driver's state in it
     if resumed is not None:
         steps, first, start = resumed.steps, resumed.phase, resumed.driver
-        if start is not None and start.t >= 1.0 - 1e-12:  # its segment was complete
+        if case.time is None and start is not None and start.t >= 1.0 - 1e-12:  # complete
             first, start = first + 1, None
         work.add(resumed.work)
         for record in steps:
             cli.converged_step(record)
 
     def converged(t, result, **extra):
-        steps.append(step_record(problem, t, result) | extra)
+        steps.append(step_record(problem, t, result, extra.get("time")) | extra)
         cli.converged_step(steps[-1], fields=lambda: fields(problem))
 
     def save(segment):  # after each converged step, with the driver's state
@@ -102,8 +103,18 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
         if not message.startswith("step "):
             say("  " + message)
 
-    critical, ended_by = None, None
-    if case.arc is not None:  # the load factor is an unknown: through limit points
+    critical, ended_by, in_time = None, None, None
+    if case.time is not None:  # a rate-dependent law: time is the load parameter
+        axis = case.time
+        in_time = solve_in_time(
+            solver, problem.material, problem.set_load, LoadHistory(axis["factor"]),
+            axis["end"], axis["steps"], commit=problem.commit, adaptive=axis["adaptive"],
+            tolerance=axis["tolerance"], stationary=axis["stationary"],
+            on_step=lambda time, f, result: converged(f, result, time=time),
+            progress=lambda line: say(line) if line.startswith("  ") else None,  # cuts
+            start=start, on_state=save(0))
+        work.add(in_time.work)
+    elif case.arc is not None:  # the load factor is an unknown: through limit points
         critical, ended_by = _follow_path(problem, solver, converged, steps, work, commit, show,
                                 saving, resumed.arc if resumed else None)
     elif case.equal_steps:  # one pass: the predictor extrapolates from the last two steps
@@ -148,6 +159,10 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
            "factorizations": work.factorizations, "tangent_assemblies": work.tangent_assemblies,
            "probes": last["probes"], "reactions": last["reactions"],
            "warnings": warnings(problem)}
+    if in_time is not None:
+        out |= {"time": last["time"], "time_steps": len(in_time.times),
+                "time_steps_undone": in_time.rejected,
+                "stationary_since": in_time.stationary_since}
     if critical is not None:
         out["control"] = "arc-length"
         out["critical_points"], out["ended_by"] = critical, ended_by
@@ -245,8 +260,8 @@ def _stop_condition(stop: dict | None, steps: list[dict], model: str):
     return lambda: _probe_component(steps[-1], stop, model) / stop["value"] >= 1.0
 
 
-def step_record(problem: CaseProblem, t: float, result) -> dict:
-    """What one converged step reports (collective)."""
+def step_record(problem: CaseProblem, t: float, result, time: float | None = None) -> dict:
+    """What one converged step reports (collective); `time`: in time, the step's."""
     rec = {"load_factor": t, "newton_iterations": result.iterations,
            "probes": problem.probe_values(), "reactions": problem.reactions()}
     if problem.damage:
@@ -265,7 +280,8 @@ def step_record(problem: CaseProblem, t: float, result) -> dict:
     if problem.damage:
         extra = (f" in {rec['alternate_iterations']} alternate iterations, largest damage "
                  f"{rec['largest_damage']:.3g}")
-    say(f"load factor {t:.4g}: {result.iterations} Newton iterations{extra}")
+    when = "" if time is None else f"time {time:.6g}, "
+    say(f"{when}load factor {t:.4g}: {result.iterations} Newton iterations{extra}")
     return rec
 
 

@@ -10,12 +10,14 @@ required one, a value of the wrong type or out of range. Each message names the 
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from fenics_nl.materials import laws
+from fenics_nl.materials.creep import NortonCreep, PerzynaViscoplasticity
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
@@ -46,6 +48,10 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
+# norton (creep: uniaxially de/dt = A sigma^n): E, nu, A, n; perzyna (viscoplasticity on J2:
+# dp/dt = <(sigma_eq - sigma0 - H p)/K>^m): E, nu, sigma0, K, m, optionally H (default 0).
+# Both are rate-dependent: [loading] takes a time axis, not steps. Not plane stress, no
+# contact; formulation = "mixed" for creep that goes on (an incompressible flow)
 # at1, at2 (gradient damage: a damage field 0 <= alpha <= 1 that never decreases, minimized
 # with u at each step by alternate minimization, Anderson-accelerated): also Gc (toughness,
 # energy per unit crack area) and ell (length; the mesh's cells at most ell/2 where a crack
@@ -79,6 +85,15 @@ contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
 steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
+# or, for a rate-dependent law (norton, perzyna), time as the load parameter:
+# time = { end = 200.0, steps = 40, adaptive = true }   # the first step end/steps; adaptive:
+#                        # each step's local error (the viscous strain rate's change over
+#                        # it, over the largest sigma_eq) at most `tolerance` (1e-3), steps
+#                        # undone and retaken above it (adaptive = false: equal steps);
+#                        # `stationary` (1e-6): sigma_eq changing less over a held step
+# factor = [[0.0, 0.0], [0.01, 1.0], [200.0, 1.0]]     # load factor against time, piecewise
+#                        # linear, held after its last point (default [[0.0, 1.0]]: the load
+#                        # at once, then held); every load scales with it
 # or path following through limit points (loads only: no prescribed displacement, no
 # contact, not snes; the load factor is an unknown, and the tangent's inertia is checked
 # each step: the JSON lists the limit points and bifurcations met in "critical_points"; a
@@ -122,14 +137,22 @@ KEYS = [
     ("mesh", "formulation", "`displacement`, or `mixed`: Taylor–Hood u–p (degree ≥ 2, not "
      "plane stress), no locking as ν → 0.5, ν = 0.5 allowed", "displacement", "—"),
     ("material", "law", "`linear-elastic`, `power-law`, `saint-venant-kirchhoff`, "
-     "`neo-hookean`, `j2`, `j2-finite`, `at1` or `at2`", "required", "—"),
+     "`neo-hookean`, `j2`, `j2-finite`, `at1`, `at2`, `norton` or `perzyna`", "required",
+     "—"),
     ("material", "E", "Young's modulus, > 0", "required", "stress"),
     ("material", "nu", "Poisson's ratio, −1 < ν ≤ 0.5 (0.5: the mixed formulation)",
      "required", "—"),
-    ("material", "sigma0", "power-law: its reference stress; j2, j2-finite: the yield stress",
-     "required there", "stress"),
-    ("material", "n", "power-law: its exponent (1: Hooke's law)", "required there", "—"),
-    ("material", "H", "j2, j2-finite: the linear isotropic hardening modulus", "0", "stress"),
+    ("material", "sigma0", "power-law: its reference stress; j2, j2-finite, perzyna: the "
+     "yield stress", "required there", "stress"),
+    ("material", "n", "power-law: its exponent (1: Hooke's law); norton: its exponent, ≥ 1 "
+     "(1: linear viscosity)", "required there", "—"),
+    ("material", "A", "norton: the creep coefficient, uniaxially dε/dt = A σⁿ",
+     "required there", "1 / (stressⁿ time)"),
+    ("material", "K", "perzyna: the viscous stress, dp/dt = ⟨(σ_eq − σ0 − H p)/K⟩^m",
+     "required there", "stress time^(1/m)"),
+    ("material", "m", "perzyna: the rate exponent, ≥ 1", "required there", "—"),
+    ("material", "H", "j2, j2-finite, perzyna: the linear isotropic hardening modulus", "0",
+     "stress"),
     ("material", "C", "j2: the kinematic hardening modulus", "0", "stress"),
     ("material", "saturation", "j2-finite: Voce's saturation stress, σ_y = σ0 + H p + "
      "(saturation − σ0)(1 − e^(−delta p))", "none", "stress"),
@@ -158,6 +181,16 @@ KEYS = [
      "load factors to visit", "required there", "—"),
     ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
      "—"),
+    ("loading", "time", "norton, perzyna (and only they): the time axis `{ end, steps, "
+     "adaptive, tolerance, stationary }`: the last time; the first step end/`steps` (20); "
+     "`adaptive` (true) sizes the steps by their local error, at most `tolerance` (1e-3: "
+     "the viscous strain rate's change over a step, in units of the largest σ_eq), false "
+     "takes equal steps; `stationary` (1e-6): σ_eq changing by less over a step at a held "
+     "load is the stationary state (the JSON's `stationary_since`)", "required there",
+     "time"),
+    ("loading", "factor", "with time: the load factor against time, `[[t, f], ...]` from "
+     "t = 0, piecewise linear, held after its last point; the steps land on its points",
+     "[[0.0, 1.0]]", "time, —"),
     ("loading", "control", "`load`, or `arc-length` (loads only: the load factor an unknown, "
      "through limit points)", "load", "—"),
     ("loading", "target", "arc-length: the load factor that ends the run", "1", "—"),
@@ -199,12 +232,15 @@ LAWS: dict[str, type[laws.Material]] = {
     "j2-finite": FiniteJ2Plasticity,
     "at1": AT1,
     "at2": AT2,
+    "norton": NortonCreep,
+    "perzyna": PerzynaViscoplasticity,
 }
 DAMAGE = ("at1", "at2")
+VISCOUS = ("norton", "perzyna")  # rate-dependent: driven in time ([loading] time)
 # parameters a case may leave out, and their values: J2 without hardening is perfect
 # plasticity; a broken cell of a damage law keeps 1e-6 of its stiffness (a body cut in two
 # by a crack would otherwise have a singular tangent)
-OPTIONAL = {"j2": {"H": 0.0, "C": 0.0},
+OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 WORDS = {"split": SPLITS}  # parameters that are words, and their choices
@@ -267,6 +303,8 @@ class Case:
     probes: list[Probe] = field(default_factory=list)
     formulation: str = "displacement"  # or "mixed": Taylor–Hood (u, p), materials.mixed
     refine_near: dict | None = None  # .geo: groups, size, distance (`case.mesh`)
+    time: dict | None = None  # a viscous law's time axis: end, steps, adaptive, tolerance,
+    # stationary, and factor (the load factor against time, [[t, f], ...])
 
     @property
     def dim(self) -> int:
@@ -416,6 +454,15 @@ def read_case(path: str | Path) -> Case:
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
+    time_axis = _time_axis(r, data, law)
+    if law in VISCOUS:
+        if model == "plane_stress":
+            r.fail("mesh.model", f"{law} has no plane-stress form yet: use plane_strain, 3d "
+                                 "or axisymmetric")
+        for c in conditions:
+            if c.kind == "contact":
+                r.fail(c.key, f"{law}: no contact (an undone time step does not put the "
+                              "active set back)")
     s = r.table(data, "solver", ("newton", "linear_solver", "tolerance", "max_it"),
                 required=False)
     newton = r.get(s, "newton", "solver", str, default="full", choices=NEWTON)
@@ -443,7 +490,7 @@ def read_case(path: str | Path) -> Case:
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
-                refine_near)
+                refine_near, time_axis)
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
@@ -624,7 +671,16 @@ def _obstacle(r: _Reader, table, key: str, dim: int):
 
 
 def _loading(r: _Reader, data: dict):
-    t = r.table(data, "loading", ("steps", "adaptive", "control", *ARC_KEYS))
+    t = r.table(data, "loading", ("steps", "adaptive", "control", "time", "factor", *ARC_KEYS))
+    if "time" in t:
+        for k in ("steps", "adaptive", "control", *ARC_KEYS):
+            if k in t:
+                r.fail(f"loading.{k}", "not with time (the time axis takes end, steps, "
+                                       "adaptive, tolerance, stationary in its braces)")
+        return [], True, None
+    if "factor" in t:
+        r.fail("loading.factor", "only with time = { end = ..., steps = ... } (the load "
+                                 "factor against time)")
     control = r.get(t, "control", "loading", str, default="load",
                     choices=("load", "arc-length"))
     if control == "arc-length":
@@ -679,6 +735,53 @@ def _arc_length(r: _Reader, t: dict) -> dict | None:
     if top is not None and first is not None and top < first:
         r.fail("loading.max_arc_length", f"must be >= arc_length ({first}), got {top}")
     return arc
+
+
+TIME_KEYS = ("end", "steps", "adaptive", "tolerance", "stationary")
+
+
+def _time_axis(r: _Reader, data: dict, law: str | None) -> dict | None:
+    """`loading.time` and `loading.factor`: a viscous law's time axis (None: none given)."""
+    t = data.get("loading", {})
+    table = t.get("time") if isinstance(t, dict) else None
+    viscous = law in VISCOUS
+    if table is None:
+        if viscous:
+            r.fail("loading.time", f"missing: {law} is rate-dependent, its load path is in "
+                                   "time, e.g. time = { end = 100.0, steps = 20 }")
+        return None
+    if law is not None and not viscous:
+        r.fail("loading.time", f"only with a rate-dependent law ({', '.join(VISCOUS)}): "
+                               f"{law} has no time; give steps")
+    where = "loading.time"
+    if not isinstance(table, dict):
+        r.fail(where, "must be a table, e.g. { end = 100.0, steps = 20 }")
+        return None
+    r.unknown(table, where, TIME_KEYS)
+    axis = {"end": r.get(table, "end", where, float, required=True, positive=True),
+            "steps": r.get(table, "steps", where, int, default=20, minimum=1),
+            "adaptive": r.get(table, "adaptive", where, bool, default=True),
+            "tolerance": r.get(table, "tolerance", where, float, default=1e-3, positive=True),
+            "stationary": r.get(table, "stationary", where, float, default=1e-6,
+                                positive=True)}
+    points = t.get("factor", [[0.0, 1.0]])
+    pairs = None
+    if isinstance(points, list) and all(isinstance(q, list) and len(q) == 2 for q in points):
+        pairs = [r.vector(q, "loading.factor", 2) for q in points]
+    if pairs is None or any(q is None for q in pairs) or not pairs:
+        r.fail("loading.factor", f"must be a list of [time, load factor] pairs, e.g. "
+                                 f"[[0.0, 0.0], [1.0, 1.0]], got {points!r}")
+        return None
+    times = [q[0] for q in pairs]
+    if times[0] != 0 or any(b <= a for a, b in itertools.pairwise(times)):
+        r.fail("loading.factor", f"its times must start at 0 and increase, got {times}")
+    elif axis["end"] is not None and times[-1] > axis["end"]:
+        r.fail("loading.factor", f"its last time {times[-1]:g} is past the end "
+                                 f"{axis['end']:g}")
+    if not any(f for _, f in pairs):
+        r.fail("loading.factor", "is 0 at every time: no load is applied")
+    axis["factor"] = pairs
+    return axis
 
 
 def _refine_near_table(r: _Reader, table) -> dict | None:
