@@ -100,7 +100,7 @@ test-mpi: $(VENV)/.installed
 # and every capability on the iterative path at ~1M (about an hour more)
 BENCHMARKS := newton contact buckling bracket iterative arch_iterative plasticity sphere_ranks \
 	plasticity_peer mixed secant \
-	friction continuation newtonal damage damage_peer identification forming
+	friction continuation newtonal damage damage_peer identification forming creep
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done

@@ -44,14 +44,14 @@ law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff |
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
-                         # plane stress: linear-elastic, saint-venant-kirchhoff or j2
+                         # plane stress: linear-elastic, saint-venant-kirchhoff, j2, norton, perzyna
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
 # norton (creep: uniaxially de/dt = A sigma^n): E, nu, A, n; perzyna (viscoplasticity on J2:
 # dp/dt = <(sigma_eq - sigma0 - H p)/K>^m): E, nu, sigma0, K, m, optionally H (default 0).
-# Both are rate-dependent: [loading] takes a time axis, not steps. Not plane stress, no
-# contact; formulation = "mixed" for creep that goes on (an incompressible flow)
+# Both are rate-dependent: [loading] takes a time axis, not steps. No contact;
+# formulation = "mixed" for creep that goes on (an incompressible flow; not plane stress)
 # at1, at2 (gradient damage: a damage field 0 <= alpha <= 1 that never decreases, minimized
 # with u at each step by alternate minimization, Anderson-accelerated): also Gc (toughness,
 # energy per unit crack area) and ell (length; the mesh's cells at most ell/2 where a crack
@@ -446,19 +446,17 @@ def read_case(path: str | Path) -> Case:
     dim = 3 if model == "3d" else 2
 
     law, parameters = _material(r, data, model)
-    if law == "j2" and model == "plane_stress" and degree is not None and degree > 2:
+    if (law in ("j2", *VISCOUS) and model == "plane_stress" and degree is not None
+            and degree > 2):
         # ε_zz needs one function per quadrature point (materials.plane_stress): P3's rule
         # on a triangle has 12 points, and no discontinuous space has 12 functions
-        r.fail("mesh.degree", f"j2 in plane stress takes degree 1 or 2, got {degree}")
+        r.fail("mesh.degree", f"{law} in plane stress takes degree 1 or 2, got {degree}")
     if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"):
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
     time_axis = _time_axis(r, data, law)
     if law in VISCOUS:
-        if model == "plane_stress":
-            r.fail("mesh.model", f"{law} has no plane-stress form yet: use plane_strain, 3d "
-                                 "or axisymmetric")
         for c in conditions:
             if c.kind == "contact":
                 r.fail(c.key, f"{law}: no contact (an undone time step does not put the "

@@ -33,6 +33,7 @@ from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain
 from fenics_nl.materials.plasticity import (
+    StressAtPoints,
     cell_max,
     hookes_tangent,
     quadrature_spaces,
@@ -101,11 +102,12 @@ class ViscousState:
 
 
 @dataclass(frozen=True, eq=False)
-class ViscousLaw(Isotropic, SmallStrain):
+class ViscousLaw(StressAtPoints, Isotropic, SmallStrain):
     """What Norton's and Perzyna's laws share: the state, the time step, σ, the commit.
 
     A law gives `return_map` (its inelastic strain after the step) and `dissipated` (the
-    condensed energy's terms beyond Hooke's). Models: 3D, plane strain, axisymmetric (3x3).
+    condensed energy's terms beyond Hooke's). Models: 3D, plane strain, axisymmetric (3x3),
+    and plane stress with ε_zz an unknown at the points (`materials.plane_stress`).
     """
 
     state: ViscousState = field(default_factory=ViscousState, init=False, repr=False,
@@ -143,6 +145,10 @@ class ViscousLaw(Isotropic, SmallStrain):
         st = self._bound()
         for f in (st.eps_v, st.p, st.q):
             f.x.array[:] = 0.0
+
+    def quadrature_space(self):
+        """The scalar quadrature space of the state (σ_eq per cell is averaged over it)."""
+        return self._bound().p.function_space
 
     @property
     def viscous_strain(self):
@@ -283,9 +289,17 @@ class ViscousLaw(Isotropic, SmallStrain):
             u: the displacement.
             model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
         """
+        self.commit_strain(kinematics.small_strain(u, model))
+
+    def commit_strain(self, strain) -> None:
+        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
+
+        Args:
+            strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
+        """
         st = self._bound()
         if st.commit is None:  # compiled once
-            eps = kinematics.small_strain(u, model)
+            eps = strain
             eps_v, p, _, _ = self.return_map(eps)
             s = 2 * self.mu * ufl.dev(eps - eps_v)
             st.commit = tuple(Expression(e, st.points)

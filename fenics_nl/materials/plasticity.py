@@ -124,12 +124,62 @@ def quadrature_spaces(mesh, degree: int):
         cell, value_shape=shape, scheme="default", degree=degree)) for shape in ((3, 3), ()))
 
 
-class QuadratureStateOutputs:
+class StressAtPoints:
+    """σ_eq per cell of a law whose state lives at the quadrature points.
+
+    J2 and the viscous laws: evaluated there, where the state is, and averaged over each
+    cell.
+    """
+
+    def quadrature_space(self):
+        """The law's scalar quadrature space (where its state is)."""
+        raise NotImplementedError
+
+    def cell_mean(self, expression, name: str):
+        """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
+
+        The state exists at the quadrature points only, so anything that reads it (σ_eq,
+        the mixed formulation's stress) is evaluated there.
+
+        Args:
+            expression: the scalar UFL expression.
+            name: the name of the returned Function.
+
+        Returns:
+            The means, a DG0 Function.
+        """
+        from dolfinx import fem
+
+        Q = self.quadrature_space()
+        at_points = fem.Function(Q)
+        at_points.interpolate(Expression(expression, Q.element.interpolation_points))
+        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
+        per_cell(at_points, f, np.mean)
+        return f
+
+    def von_mises(self, u, model: str = "3d"):
+        """σ_eq per cell (DG0): the mean of its quadrature points' values.
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+
+        Returns:
+            σ_eq, a DG0 Function named "von_mises".
+        """
+        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
+
+
+class QuadratureStateOutputs(StressAtPoints):
     """Per-cell outputs of a law whose state lives at the quadrature points.
 
     J2 at small and finite strain: the law has `cumulated_plastic_strain`, a quadrature
     Function.
     """
+
+    def quadrature_space(self):
+        """The space of `cumulated_plastic_strain`."""
+        return self.cumulated_plastic_strain.function_space
 
     def cumulated_plastic_strain_per_cell(self):
         """The largest committed p of each cell's quadrature points (DG0 Function).
@@ -163,41 +213,6 @@ class QuadratureStateOutputs:
         yielded = r.x.array[:n][p.x.array[:n] > 0]
         return max(least, Q.mesh.comm.allreduce(float(yielded.max(initial=least)),
                                                 op=MPI.MAX))
-
-    def cell_mean(self, expression, name: str):
-        """The mean of a scalar UFL expression over each cell's quadrature points (DG0).
-
-        The state exists at the quadrature points only, so anything that reads it (σ_eq,
-        the mixed formulation's stress) is evaluated there.
-
-        Args:
-            expression: the scalar UFL expression.
-            name: the name of the returned Function.
-
-        Returns:
-            The means, a DG0 Function.
-        """
-        from dolfinx import fem
-
-        Q = self.cumulated_plastic_strain.function_space
-        at_points = fem.Function(Q)
-        at_points.interpolate(Expression(expression, Q.element.interpolation_points))
-        f = fem.Function(fem.functionspace(Q.mesh, ("DG", 0)), name=name)
-        per_cell(at_points, f, np.mean)
-        return f
-
-    def von_mises(self, u, model: str = "3d"):
-        """σ_eq per cell (DG0): the mean of its quadrature points' values.
-
-        Args:
-            u: the displacement.
-            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
-
-        Returns:
-            σ_eq, a DG0 Function named "von_mises".
-        """
-        return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
-
 
 @dataclass(frozen=True, eq=False)
 class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
