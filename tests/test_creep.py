@@ -298,17 +298,18 @@ def stationary_vessel(shape, n, size, comm=MPI.COMM_WORLD):
     return errors, len(path.times)
 
 
-@pytest.mark.parametrize("shape,n", [("cylinder", 3.0), ("cylinder", 5.0), ("sphere", 3.0)])
+@pytest.mark.parametrize("shape,n", [("cylinder", 3.0), ("cylinder", 5.0), ("sphere", 3.0),
+                                     ("sphere", 5.0)])
 def test_a_creeping_vessel_reaches_the_stationary_closed_form(shape, n):
     # the stationary stresses (the hoop stress falls at the bore, rises outside) against
     # the closed forms, k = 2/n (tube, plane strain) or 3/n (sphere); measured at h = 0.1
-    # (P2–P1): at most 0.09 %, 0.07 %, 0.11 % of p at the bore (cylinder n = 3, 5;
-    # sphere), 0.06 % mid-wall, 0.011 % outside, reached in 34 to 42 steps (local error
-    # 1e-2); bounded at 0.25 % of p: the mesh's share, O(h²) (at h = 0.05: 0.024 %,
+    # (P2–P1): at most 0.09 %, 0.07 %, 0.11 %, 0.09 % of p at the bore (cylinder n = 3,
+    # 5; sphere n = 3, 5), 0.06 % mid-wall, 0.012 % outside, reached in 34 to 51 steps
+    # (local error 1e-2); bounded at 0.25 % of p: the mesh's share, O(h²) (at h = 0.05: 0.024 %,
     # 0.007 %, 0.003 %)
     errors, steps = stationary_vessel(shape, n, 0.1)
     assert max(errors.values()) < 2.5e-3, errors
-    assert steps < 50
+    assert steps < 60
 
 
 def test_perzyna_tends_to_j2_as_the_step_outgrows_the_relaxation_time():
