@@ -101,8 +101,7 @@ def implicit(adaptive: bool, steps: int, tolerance: float = 1e-3, method: str = 
 
     t0 = time.perf_counter()
     path = solve_in_time(vessel.solver, vessel.law, vessel.load,
-                         LoadHistory([(0.0, 0.0), (RAMP, 1.0)] + [(t, 1.0) for t in OUTPUT]),
-                         END, steps,
+                         LoadHistory([(0.0, 0.0), (RAMP, 1.0)]), END, steps, land_on=OUTPUT,
                          adaptive=adaptive, tolerance=tolerance, commit=vessel.commit,
                          on_step=on_step)
     seconds = time.perf_counter() - t0
@@ -160,10 +159,13 @@ def path_error(history, reference) -> float:
     return max(abs(at[t] - ref[t]) for t in OUTPUT) / P
 
 
-def critical_step(n: float) -> float:
-    """2/(3μ A n qⁿ⁻¹), q the bore's σ_eq (√3/2 (σ_θθ − σ_rr)) of exponent `n`'s stationary
-    state (n = 1: Lamé's): a material point's forward-Euler bound, linearized there."""
-    sr, st = vessels.stationary_creep_stresses("cylinder", A_IN, B_OUT, P, n, A_IN)
+def critical_step(state: float) -> float:
+    """2/(3μ A n qⁿ⁻¹) (n = N): a material point's forward-Euler bound, linearized at q.
+
+    q is the bore's σ_eq (√3/2 (σ_θθ − σ_rr)) in the stationary state of the exponent
+    `state` (1: Lamé's, the first instant; N: the stationary state of the run).
+    """
+    sr, st = vessels.stationary_creep_stresses("cylinder", A_IN, B_OUT, P, state, A_IN)
     q = math.sqrt(3) / 2 * (st - sr)
     return 2 / (3 * E / (2 * (1 + NU)) * A * N * q ** (N - 1))
 

@@ -15,7 +15,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from fenics_nl.domain import boundary
-from fenics_nl.materials import kinematics
+from fenics_nl.materials import kinematics, mixed
 from fenics_nl.materials.creep import NEWTON_STEPS, NortonCreep
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.time_stepping import LoadHistory, solve_in_time
@@ -163,22 +163,40 @@ def test_steps_sized_by_their_error_follow_relaxation_in_half_the_steps():
     coarse = adaptive_relaxation(1e-2)[1]
     assert len(path.times) <= 90 and fine < 0.0198
     assert coarse / fine == pytest.approx(math.sqrt(10), rel=0.2)
-    assert max(path.errors) <= 1e-3
 
 
 def test_a_step_undone_for_its_error_leaves_no_trace():
-    # the accepted steps of an adaptive run (6 undone on the way) retaken by hand on a
-    # fresh cube end at the same stress, to round-off: undoing a step put back the
-    # displacement and the law's state exactly
-    path, _, (_, _, read, _, _) = adaptive_relaxation(1e-2)
-    assert path.rejected > 0
-    again = NortonCreep(E, NU, A=A, n=3.0)
-    solver, read_again, pull, u = cube(again)
-    pull(0.01)
+    # each time a step is undone (6 in this run), the displacement and the law's state are
+    # those of the last accepted step, bit for bit; and the accepted steps retaken by hand
+    # on a fresh cube end at the same stress, to round-off
+    n, strain = 3.0, 0.01
+    law = NortonCreep(E, NU, A=A, n=n)
+    solver, read, pull, u = cube(law)
+    accepted, undone = {}, []
+
+    def on_step(t, f, result):
+        accepted["u"] = u.x.array.copy()
+        accepted["state"] = [g.x.array.copy() for g in law.state_functions().values()]
+
+    def progress(line):
+        if "undone" in line:
+            undone.append(np.array_equal(u.x.array, accepted["u"]) and all(
+                np.array_equal(g.x.array, kept) for g, kept in
+                zip(law.state_functions().values(), accepted["state"], strict=True)))
+
+    sigma1 = E * strain
+    t_end = ((sigma1 / 5) ** (1 - n) - sigma1 ** (1 - n)) / ((n - 1) * E * A)
+    path = solve_in_time(solver, law, lambda f: pull(f * strain), LoadHistory([(0.0, 1.0)]),
+                         t_end, 10, tolerance=1e-2, commit=lambda: law.commit(u),
+                         on_step=on_step, progress=progress)
+    assert len(undone) == path.rejected > 0 and all(undone)
+    again = NortonCreep(E, NU, A=A, n=n)
+    by_hand, read_again, pull_again, u_again = cube(again)
+    pull_again(strain)
     for t0, t1 in itertools.pairwise(path.times):
         again.set_time_step(t1 - t0)
-        solver.solve()
-        again.commit(u)
+        by_hand.solve()
+        again.commit(u_again)
     again.set_time_step(0.0)
     assert read_again()[0] == pytest.approx(read()[0], rel=1e-12)
 
@@ -199,6 +217,34 @@ def test_creep_under_a_ramped_load_is_stationary_once_the_load_is_held():
     assert path.stationary_since == path.times[first_held]
     slope = (strains[-1] - strains[first_held]) / (path.times[-1] - path.times[first_held])
     assert slope == pytest.approx(A * sigma**n, rel=1e-10)
+
+
+def test_perzyna_relaxes_to_its_yield_stress_as_the_closed_form():
+    # m = 1, a strain held above yield: the overstress y = σ − σ0 − H p relaxes as
+    # y0 exp(−(E + H) t/K) (uniaxially ṗ = y/K, σ = E(ε − p)), to σ0 + H p∞; through the
+    # time driver at a local error of 1e-4 (192 steps): its largest error along the way
+    # 0.29 % of y0 (0.87 % at 1e-3: ∝ √tol), bounded at 0.5 %; the stationary state said
+    # once y has gone
+    from fenics_nl.materials.creep import PerzynaViscoplasticity
+
+    sigma0, H, K, strain = 1.0, 20.0, 2.0, 3.0 / E
+    law = PerzynaViscoplasticity(E, NU, sigma0=sigma0, H=H, K=K, m=1.0)
+    solver, read, pull, u = cube(law)
+    y0 = E * strain - sigma0
+    rate = (E + H) / K
+    errors = []
+
+    def on_step(t, f, result):
+        exact = sigma0 + H * (y0 - y0 * math.exp(-rate * t)) / (E + H) \
+            + y0 * math.exp(-rate * t)
+        errors.append(abs(read()[0] - exact) / y0)
+
+    path = solve_in_time(solver, law, lambda f: pull(f * strain), LoadHistory([(0.0, 1.0)]),
+                         40 / rate, 10, tolerance=1e-4, commit=lambda: law.commit(u),
+                         on_step=on_step)
+    assert max(errors) < 5e-3
+    assert path.stationary_since is not None
+    assert read()[0] == pytest.approx(sigma0 + H * y0 / (E + H), rel=1e-6)
 
 
 def test_the_local_equation_is_solved_to_round_off_over_24_decades():
@@ -373,13 +419,13 @@ def test_a_creeping_vessel_on_two_ranks_gives_the_serial_answer():
 def test_the_creep_vessel_demo_goes_from_lame_to_the_stationary_state(demo):
     # its defaults (cylinder, n = 5, 10 elements through the wall, 40 relaxation times):
     # measured along y = 0 at nine radii (boundary points included), σ_rr and σ_θθ within
-    # 0.41 % of p of Lamé at the end of the ramp (0.01 h: 8e-5 relaxation times, but 2e-3
+    # 0.43 % of p of Lamé at the end of the ramp (0.01 h: 8e-5 relaxation times, but 2e-3
     # of the bore's own, where σ_eq is 2.3 p and the flow 28 times faster) and 0.12 % of
     # the stationary closed form at the end; the bore's stationary rate within 0.003 %
-    # (backward Euler is exact at a constant rate: the mesh's error only)
+    # (backward Euler is exact at a constant rate: the mesh's error only; bounded at 0.02 %)
     d = demo.json("creep_vessel.py")
     assert d["profile_error_lame"] < 0.006 and d["profile_error_stationary"] < 0.0025
-    assert abs(d["bore_displacement_rate_error"]) < 5e-4
+    assert abs(d["bore_displacement_rate_error"]) < 2e-4
     assert d["stationary_since"] is not None and not d["warnings"]
     assert d["bore_hoop_stress"] < d["bore_hoop_stress_lame"] / 2  # it fell, and outside
     assert d["outer_hoop_stress"] > 1.2 * d["pressure"]  # it rose (Lamé: 0.667 p)
@@ -425,16 +471,50 @@ def test_a_creep_case_file_reaches_the_stationary_stresses(demo):
 
 
 def test_a_creep_case_restarts_in_time_to_the_same_path(tmp_path, demo):
-    # the case restarted one checkpoint short of its end: the same times, steps and probes
+    # the case restarted one checkpoint short of its end: the same times, steps, probes and
+    # totals (the steps taken and undone, the Newton iterations, the stationary state)
     from conftest import same_answer
     from test_case import CASES, rewound
 
     path = CASES / "creeping_cylinder.toml"
     whole = demo.case(path, "--checkpoint", tmp_path / "ck")
-    rewound(tmp_path / "ck")
+    assert rewound(tmp_path / "ck") == f"step-{len(whole['steps']) - 1:06d}"
     resumed = demo.case(path, "--restart", tmp_path / "ck")
+    assert resumed["restarted_after_load_factor"] == 1.0
     same_answer(whole, resumed)
     assert [s["time"] for s in whole["steps"]] == [s["time"] for s in resumed["steps"]]
+    for key in ("time", "time_steps", "time_steps_undone", "stationary_since",
+                "newton_iterations", "factorizations"):
+        assert resumed[key] == whole[key], key
+
+
+def test_a_perzyna_case_at_rest_is_j2s_answer(tmp_path, demo):
+    # the creeping cylinder in Perzyna's law (σ0 = 40, perfect plasticity, K = 2e5, m = 1:
+    # an overstress relaxation time K/(3μ) of about 1 h) held to rest, against the same
+    # case in J2 reached in 10 load steps: the overstress gone, the same plastic state.
+    # Measured: σ_eq at the bore 39.991 (J2: 40.000), the hoop stresses within 0.13 % of p,
+    # u_r within 9e-4 (what remains: the paths differ, relaxing from Lamé's state against
+    # loading step by step, and a perfectly plastic cylinder at ν = 0.3 keeps some of its
+    # path in σ_zz)
+    from test_case import CASES
+
+    (tmp_path / "thick_cylinder.geo").write_text((CASES / "thick_cylinder.geo").read_text())
+    text = (CASES / "creeping_cylinder.toml").read_text().replace(
+        'law = "norton"', 'law = "perzyna"').replace("A = 5e-14\nn = 5.0",
+        "sigma0 = 40.0\nK = 2.0e5\nm = 1.0")
+    (tmp_path / "pz.toml").write_text(text)
+    (tmp_path / "j2.toml").write_text(text.replace('law = "perzyna"', 'law = "j2"').replace(
+        "K = 2.0e5\nm = 1.0\n", "").replace(
+        "time = { end = 3000.0, steps = 20, tolerance = 1e-2 }\n"
+        "factor = [[0.0, 0.0], [0.01, 1.0]]", "steps = 10"))
+    viscous, plastic = demo.case(tmp_path / "pz.toml"), demo.case(tmp_path / "j2.toml")
+    assert viscous["stationary_since"] is not None
+    for name in ("inner", "outer"):
+        a, b = viscous["probes"][name], plastic["probes"][name]
+        assert a["von_mises"] == pytest.approx(b["von_mises"], rel=1e-3)
+        assert a["stress"][1][1] == pytest.approx(b["stress"][1][1], abs=5e-3 * 30.0)
+        assert a["displacement"][0] == pytest.approx(b["displacement"][0], rel=2e-3)
+    assert plastic["probes"]["inner"]["von_mises"] == pytest.approx(40.0, rel=1e-9)  # yielded
 
 
 @pytest.mark.parametrize("change,words", [
@@ -482,3 +562,49 @@ def test_creep_in_plane_stress_is_the_closed_form(biaxial):
     flow = A * sigma**n * t * (0.5 if biaxial else 1.0)
     assert sheet.mean("exx") == pytest.approx(elastic + flow, rel=1e-10)
     assert sheet.largest_szz() < 1e-10 * sigma
+
+
+def test_p2_displacements_alone_drift_under_stationary_creep():
+    # why the demo and the case take Taylor–Hood: the cylinder (a = 1, b = 2, h = 0.1) at
+    # n = 1, whose stationary stresses are Lamé's, held for 4 steps of 10 relaxation times
+    # after the pressure applied at once: on P2 displacements alone the hoop stress at the
+    # bore (at the probe on y = 0) drifts by −0.037 p at every step, on Taylor–Hood it
+    # stays where it was (to 1.2e-6 p; 0.0024 p from Lamé's, the mesh's error at that point)
+    from plasticity_problems import thick_vessel
+
+    from fenics_nl.theory import vessels
+
+    p = 0.1
+    lame = vessels.elastic_stresses("cylinder", 1.0, 2.0, p, 1.0)[1]
+
+    def hoops(with_pressure):
+        vessel = thick_vessel("cylinder", 1.0, 2.0, size=0.1, mixed=with_pressure)
+        law = NortonCreep(1.0, 0.3, A=1.0, n=1.0)
+        law.bind(vessel.mesh, vessel.quadrature_degree)
+        f = vessel.fields
+        if with_pressure:
+            internal = mixed.internal_work(law, f.u, f.p, f.v, f.q, vessel.model)
+            sigma = mixed.cauchy_stress(law, f.u, f.p, vessel.model)
+        else:
+            eps = kinematics.small_strain(f.u, vessel.model)
+            internal = ufl.inner(law.stress(eps), kinematics.small_strain(f.v, vessel.model)) \
+                * vessel.weight
+            sigma = law.stress(eps)
+        residual = internal * vessel.dx + vessel.pressure * ufl.dot(
+            vessel.normal, f.v) * vessel.weight * vessel.ds_inner
+        vessel.pressure.value = p
+        solver = NewtonSolver(residual, vessel.unknown, vessel.supports, rtol=1e-11,
+                              atol=1e-10, force_scale=p)
+        out = []
+        for dt in (0.0, 10.0, 10.0, 10.0, 10.0):
+            law.set_time_step(dt)
+            solver.solve()
+            law.commit(f.u, vessel.model)
+            law.set_time_step(0.0)
+            out.append(vessel.probes.discontinuous("hoop", sigma[1, 1], 2)[0] / p)
+        return np.array(out)
+
+    drift = np.diff(hoops(False))
+    held = hoops(True)
+    assert (drift < -0.01).all(), drift
+    assert np.abs(np.diff(held)).max() < 1e-5 and np.abs(held - lame / p).max() < 5e-3, held

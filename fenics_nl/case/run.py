@@ -43,9 +43,10 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     saving = case_checkpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
     resumed = case_checkpoints(problem, restart).restore() if restart else None
     if resumed is not None:
-        say(f"restarted from {restart}: {len(resumed.steps)} converged steps, load factor "
-            f"{resumed.steps[-1]['load_factor']:.6g}" if resumed.steps else
-            f"restarted from {restart}")
+        last = resumed.steps[-1] if resumed.steps else None
+        where = "" if last is None else (f", time {last['time']:.6g}" if "time" in last else
+                                         f", load factor {last['load_factor']:.6g}")
+        say(f"restarted from {restart}: {len(resumed.steps)} converged steps{where}")
     out = _solve(problem, solver, saving, resumed)
     out["solver_setup_time_s"] = setup
     if resumed is not None and resumed.steps:
@@ -87,6 +88,9 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
             return None
 
         def checkpoint(driver, path):  # the work so far: the segments before, and this one's
+            if case.time is not None:  # one segment: the path itself (its work, its times)
+                saving.save(segment, driver, steps, WorkCounts(), path)
+                return
             total = WorkCounts()
             total.add(work)
             total.add(path.work)
@@ -110,9 +114,10 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
             solver, problem.material, problem.set_load, LoadHistory(axis["factor"]),
             axis["end"], axis["steps"], commit=problem.commit, adaptive=axis["adaptive"],
             tolerance=axis["tolerance"], stationary=axis["stationary"],
-            on_step=lambda time, f, result: converged(f, result, time=time),
+            on_step=lambda at, f, result: converged(f, result, time=at),
             progress=lambda line: say(line) if line.startswith("  ") else None,  # cuts
-            start=start, on_state=save(0))
+            start=start, path_so_far=resumed.path if resumed is not None else None,
+            on_state=save(0))
         work.add(in_time.work)
     elif case.arc is not None:  # the load factor is an unknown: through limit points
         critical, ended_by = _follow_path(problem, solver, converged, steps, work, commit, show,
@@ -260,8 +265,8 @@ def _stop_condition(stop: dict | None, steps: list[dict], model: str):
     return lambda: _probe_component(steps[-1], stop, model) / stop["value"] >= 1.0
 
 
-def step_record(problem: CaseProblem, t: float, result, time: float | None = None) -> dict:
-    """What one converged step reports (collective); `time`: in time, the step's."""
+def step_record(problem: CaseProblem, t: float, result, at: float | None = None) -> dict:
+    """What one converged step reports (collective); `at`: in time, the step's time."""
     rec = {"load_factor": t, "newton_iterations": result.iterations,
            "probes": problem.probe_values(), "reactions": problem.reactions()}
     if problem.damage:
@@ -280,7 +285,7 @@ def step_record(problem: CaseProblem, t: float, result, time: float | None = Non
     if problem.damage:
         extra = (f" in {rec['alternate_iterations']} alternate iterations, largest damage "
                  f"{rec['largest_damage']:.3g}")
-    when = "" if time is None else f"time {time:.6g}, "
+    when = "" if at is None else f"time {at:.6g}, "
     say(f"{when}load factor {t:.4g}: {result.iterations} Newton iterations{extra}")
     return rec
 
@@ -317,7 +322,8 @@ def load_path_plot(out: dict, path: str) -> None:
     from fenics_nl.plots import figures
 
     steps = out["steps"]
-    t = [0.0] + [s["load_factor"] for s in steps]
+    in_time = bool(steps) and "time" in steps[0]  # a viscous law's: against time
+    t = [0.0] + [s["time" if in_time else "load_factor"] for s in steps]
     plt = figures.pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     names = COMPONENTS[out["model"]]
@@ -337,7 +343,7 @@ def load_path_plot(out: dict, path: str) -> None:
         for label, values in series.items():
             if max(abs(v) for v in values) > 1e-9 * peak:
                 ax.plot(t, [0.0, *values], "o-", ms=3, label=label)
-        ax.set_xlabel("load factor")
+        ax.set_xlabel("time" if in_time else "load factor")
         ax.set_title(title, fontsize=10)
         ax.grid(alpha=0.3)
         if ax.lines:

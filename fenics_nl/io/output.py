@@ -76,11 +76,16 @@ class FieldSeries:
         self.times: list[float] = []
         self._last = 0.0  # the last load factor
 
-    def write(self, t: float, functions) -> None:
-        """Every field of the current state, `functions()`, at load factor t."""
+    def write(self, t: float, functions, time: float | None = None) -> None:
+        """Every field of the current state, `functions()`, at load factor t.
+
+        Its time in the files is Σ|Δt| of the load factors so far, or `time` if given (a
+        viscous law's own time).
+        """
         from dolfinx.io import VTXWriter
 
-        tau = (self.times[-1] if self.times else 0.0) + abs(t - self._last)
+        tau = time if time is not None else (
+            (self.times[-1] if self.times else 0.0) + abs(t - self._last))
         self._last = t
         for f in functions():
             if f.name not in self._series:

@@ -72,7 +72,7 @@ class PathCheckpoints:
     # -- what is saved -----------------------------------------------------------------
 
     def save(self, phase: int, driver: DriverState | TimeState, steps: list[dict],
-             work: WorkCounts, path: LoadPath | None = None) -> None:
+             work: WorkCounts, path: LoadPath | TimePath | None = None) -> None:
         """The state after the converged step that ended with `driver` (collective).
 
         `work`: of the phases before this one; `path`: this phase's so far.
@@ -80,6 +80,7 @@ class PathCheckpoints:
         if isinstance(driver, TimeState):
             self._save({"phase": phase, "time": driver.t, "dt": driver.dt,
                         "stationary_since": driver.stationary_since,
+                        "held_since": driver.held_since,
                         "work": dataclasses.asdict(work),
                         "path": None if path is None else _path_record(path)},
                        {"rate": driver.rate, "stress": driver.stress}, steps)
@@ -130,7 +131,7 @@ class PathCheckpoints:
                            ArcState.saved(state["arc"], arrays), kept=state["kept"])
         if "time" in state:
             driver = TimeState(state["time"], state["dt"], arrays["rate"], arrays["stress"],
-                               state["stationary_since"])
+                               state["stationary_since"], state["held_since"])
         else:
             driver = DriverState(state["t"], state["dt"], state["dt_previous"],
                                  arrays["previous"] if state["has_previous"] else None)
