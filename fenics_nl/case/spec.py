@@ -86,11 +86,13 @@ steps = 10               # equal steps to the load factor 1 (cut in half on fail
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
 # or, for a rate-dependent law (norton, perzyna), time as the load parameter:
-# time = { end = 200.0, steps = 40, adaptive = true }   # the first step end/steps; adaptive:
-#                        # each step's local error (the viscous strain rate's change over
-#                        # it, over the largest sigma_eq) at most `tolerance` (1e-3), steps
-#                        # undone and retaken above it (adaptive = false: equal steps);
-#                        # `stationary` (1e-6): sigma_eq changing less over a held step
+# time = { end = 200.0, steps = 40, adaptive = true }   # the first step end/steps (or less,
+#                        # to land on factor's first point); adaptive: each step's local
+#                        # error (3 mu dt/2 times the change of the viscous strain rate over
+#                        # it, over the largest sigma_eq: dimensionless) at most `tolerance`
+#                        # (1e-3), a step above it undone and retaken shorter (adaptive =
+#                        # false: equal steps); `stationary` (1e-6): sigma_eq, at its rate of
+#                        # change, would change by less over the time the load is held
 # factor = [[0.0, 0.0], [0.01, 1.0], [200.0, 1.0]]     # load factor against time, piecewise
 #                        # linear, held after its last point (default [[0.0, 1.0]]: the load
 #                        # at once, then held); every load scales with it
@@ -182,12 +184,13 @@ KEYS = [
     ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
      "—"),
     ("loading", "time", "norton, perzyna (and only they): the time axis `{ end, steps, "
-     "adaptive, tolerance, stationary }`: the last time; the first step end/`steps` (20); "
-     "`adaptive` (true) sizes the steps by their local error, at most `tolerance` (1e-3: "
-     "the viscous strain rate's change over a step, in units of the largest σ_eq), false "
-     "takes equal steps; `stationary` (1e-6): σ_eq changing by less over a step at a held "
-     "load is the stationary state (the JSON's `stationary_since`)", "required there",
-     "time"),
+     "adaptive, tolerance, stationary }`: the last time; the first step end/`steps` (20), "
+     "or less to land on the first point of `factor`; `adaptive` (true) sizes the steps by "
+     "their local error, at most `tolerance` (1e-3: 3μ Δt/2 times the change of the "
+     "viscous strain rate over the step, over the largest σ_eq), false takes equal steps; "
+     "`stationary` (1e-6): the state is stationary (the JSON's `stationary_since`) once "
+     "σ_eq, at its rate of change, would change by less than that fraction over the time "
+     "the load has been held", "required there", "time"),
     ("loading", "factor", "with time: the load factor against time, `[[t, f], ...]` from "
      "t = 0, piecewise linear, held after its last point; the steps land on its points",
      "[[0.0, 1.0]]", "time, —"),
