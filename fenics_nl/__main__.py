@@ -44,7 +44,8 @@ def parser() -> argparse.ArgumentParser:
                            "plastic strains, the contact pressure and active set)",
                     png="the deformed body coloured by von Mises stress",
                     plot="each probe's displacement and von Mises stress, and each support's "
-                         "reaction, against the load factor (matplotlib)")
+                         "reaction, against the load factor (in time: against time, "
+                         "logarithmic) (matplotlib)")
     p.add_argument("--checkpoint", metavar="DIR",
                    help="save the state after every converged step (or every "
                         "--checkpoint-every N) in DIR, to restart from")
@@ -89,7 +90,10 @@ def main(argv=None) -> int:
     n, ranks = len(case.factors), MPI.COMM_WORLD.size
     say(f"{case.path.name}: {case.model}, P{case.degree}, {problem.dofs} unknowns, "
         f"{case.law}, " + (f"arc-length to load factor {case.arc['target']:g}" if case.arc
-                            else f"{n} load factor{'s' * (n != 1)}")
+                            else f"in time to {case.time['end']:g}"
+                            + (", steps sized by their error" if case.time["adaptive"]
+                               else f", {case.time['steps']} equal steps")
+                            if case.time else f"{n} load factor{'s' * (n != 1)}")
         + f", {ranks} rank{'s' * (ranks != 1)}")
     if args.command == "check":
         say("check: the case is complete and consistent with its mesh")

@@ -323,7 +323,11 @@ def load_path_plot(out: dict, path: str) -> None:
 
     steps = out["steps"]
     in_time = bool(steps) and "time" in steps[0]  # a viscous law's: against time
-    t = [0.0] + [s["time" if in_time else "load_factor"] for s in steps]
+    if in_time:  # on a logarithmic axis, from the first step after time 0
+        steps = [s for s in steps if s["time"] > 0]
+        t = [s["time"] for s in steps]
+    else:  # from the unloaded start
+        t = [0.0] + [s["load_factor"] for s in steps]
     plt = figures.pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
     names = COMPONENTS[out["model"]]
@@ -342,16 +346,21 @@ def load_path_plot(out: dict, path: str) -> None:
         peak = max((abs(v) for values in series.values() for v in values), default=0.0)
         for label, values in series.items():
             if max(abs(v) for v in values) > 1e-9 * peak:
-                ax.plot(t, [0.0, *values], "o-", ms=3, label=label)
-        ax.set_xlabel("time" if in_time else "load factor")
+                ax.plot(t, values if in_time else [0.0, *values], "o-", ms=3, label=label)
+        if in_time:  # a creep transient is short against the hold: a logarithmic axis
+            ax.set_xscale("log")
+        ax.set_xlabel("time (logarithmic; the case's unit)" if in_time else "load factor")
         ax.set_title(title, fontsize=10)
         ax.grid(alpha=0.3)
         if ax.lines:
             ax.legend(fontsize=7)
         else:
             ax.text(0.5, 0.5, "none in this case", ha="center", transform=ax.transAxes)
-    fig.suptitle(f"{Path(out['case']).name}: {out['law']}, {out['model']}, {len(steps)} "
-                 f"converged steps, load factor {out['load_factor']:.4g}", fontsize=11)
+    fig.suptitle(f"{Path(out['case']).name}: {out['law']}, {out['model']}, "
+                 f"{len(out['steps'])} converged steps, " + (f"time {out['time']:.4g}"
+                                                              if in_time else
+                                         f"load factor {out['load_factor']:.4g}"),
+                 fontsize=11)
     figures.save_figure(fig, path)
 
 
@@ -390,7 +399,8 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                 values = out["steps"][-1]["probes"]
                 labels = {f"{p.name}: {values[p.name]['von_mises']:.4g} at the point": p.point
                           for p in problem.case.probes}
-            title = (f"{problem.case.path.name}: load factor {t:.3g}, "
+            when = (f"time {out['time']:.4g}" if "time" in out else f"load factor {t:.3g}")
+            title = (f"{problem.case.path.name}: {when}, "
                      f"{problem.case.law}, {problem.case.model}")
             focus = obstacle = None
             if problem.contact is not None:

@@ -40,7 +40,7 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
-                         # | j2-finite | at1 | at2
+                         # | j2-finite | at1 | at2 | norton | perzyna
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
@@ -48,10 +48,11 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
-# norton (creep: uniaxially de/dt = A sigma^n): E, nu, A, n; perzyna (viscoplasticity on J2:
-# dp/dt = <(sigma_eq - sigma0 - H p)/K>^m): E, nu, sigma0, K, m, optionally H (default 0).
-# Both are rate-dependent: [loading] takes a time axis, not steps. No contact;
-# formulation = "mixed" for creep that goes on (an incompressible flow; not plane stress)
+# norton (creep: uniaxially de/dt = A sigma^n): E, nu, A (1/(stress^n time)), n; perzyna
+# (viscoplasticity on J2: dp/dt = <(sigma_eq - sigma0 - H p)/K>^m): E, nu, sigma0,
+# K (stress time^(1/m)), m, optionally H (default 0). Both are rate-dependent: [loading]
+# takes a time axis, not steps. No contact. norton needs formulation = "mixed" (its flow is
+# incompressible and grows without bound: P2 displacements alone lock), except in plane stress
 # at1, at2 (gradient damage: a damage field 0 <= alpha <= 1 that never decreases, minimized
 # with u at each step by alternate minimization, Anderson-accelerated): also Gc (toughness,
 # energy per unit crack area) and ell (length; the mesh's cells at most ell/2 where a crack
@@ -87,12 +88,14 @@ steps = 10               # equal steps to the load factor 1 (cut in half on fail
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
 # or, for a rate-dependent law (norton, perzyna), time as the load parameter:
 # time = { end = 200.0, steps = 40, adaptive = true }   # the first step end/steps (or less,
-#                        # to land on factor's first point); adaptive: each step's local
-#                        # error (3 mu dt/2 times the change of the viscous strain rate over
-#                        # it, over the largest sigma_eq: dimensionless) at most `tolerance`
-#                        # (1e-3), a step above it undone and retaken shorter (adaptive =
-#                        # false: equal steps); `stationary` (1e-6): sigma_eq, at its rate of
-#                        # change, would change by less over the time the load is held
+#                        # to land on factor's first point after 0); adaptive: each step's
+#                        # local error (3 mu dt/2 times the change of the viscous strain
+#                        # rate over it, over the largest sigma_eq: dimensionless) at most
+#                        # `tolerance` (1e-3), a step above it undone and retaken shorter
+#                        # (adaptive = false: equal steps); `stationary` (1e-6): the state is
+#                        # stationary once sigma_eq, at its rate of change, would change by
+#                        # less than this fraction of its largest value over the time the
+#                        # load has been held
 # factor = [[0.0, 0.0], [0.01, 1.0], [200.0, 1.0]]     # load factor against time, piecewise
 #                        # linear, held after its last point (default [[0.0, 1.0]]: the load
 #                        # at once, then held); every load scales with it
@@ -459,6 +462,10 @@ def read_case(path: str | Path) -> Case:
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
     time_axis = _time_axis(r, data, law)
+    if law == "norton" and formulation != "mixed" and model not in (None, "plane_stress"):
+        r.fail("mesh.formulation", 'norton needs "mixed": its flow is incompressible and '
+                                   "grows without bound, and P2 displacements alone lock "
+                                   "(the stresses drift step after step)")
     if law in VISCOUS:
         for c in conditions:
             if c.kind == "contact":
@@ -766,12 +773,13 @@ def _time_axis(r: _Reader, data: dict, law: str | None) -> dict | None:
             "stationary": r.get(table, "stationary", where, float, default=1e-6,
                                 positive=True)}
     points = t.get("factor", [[0.0, 1.0]])
-    pairs = None
-    if isinstance(points, list) and all(isinstance(q, list) and len(q) == 2 for q in points):
-        pairs = [r.vector(q, "loading.factor", 2) for q in points]
-    if pairs is None or any(q is None for q in pairs) or not pairs:
+    if not (isinstance(points, list) and points and all(
+            isinstance(q, list) and len(q) == 2 for q in points)):
         r.fail("loading.factor", f"must be a list of [time, load factor] pairs, e.g. "
                                  f"[[0.0, 0.0], [1.0, 1.0]], got {points!r}")
+        return None
+    pairs = [r.vector(q, "loading.factor", 2) for q in points]  # each bad number said once
+    if any(q is None for q in pairs):
         return None
     times = [q[0] for q in pairs]
     if times[0] != 0 or any(b <= a for a, b in itertools.pairwise(times)):

@@ -147,7 +147,8 @@ def _path_record(path: LoadPath) -> dict:
               "failures": path.failures, "work": dataclasses.asdict(path.work)}
     if isinstance(path, TimePath):
         record["time"] = {"times": path.times, "errors": path.errors,
-                          "rejected": path.rejected, "stationary_since": path.stationary_since}
+                          "rejected": path.rejected, "stationary_since": path.stationary_since,
+                          "stationary_after": path.stationary_after, "change": path.change}
     return record
 
 
@@ -159,4 +160,4 @@ def _path_from(record: dict) -> LoadPath:
         return LoadPath(*common)
     t = record["time"]
     return TimePath(*common, list(t["times"]), list(t["errors"]), t["rejected"],
-                    t["stationary_since"])
+                    t["stationary_since"], t["stationary_after"], t["change"])

@@ -228,7 +228,7 @@ def creep_vessel_figure(shape: str, a: float, b: float, p: float, n: float, tau:
     if comm.rank != 0:
         return
     plt = figures.pyplot()
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.6))
     r = np.linspace(a, b, 200)
     lame = vessels.stationary_creep_stresses(shape, a, b, p, 1.0, r)
     final = vessels.stationary_creep_stresses(shape, a, b, p, n, r)
@@ -246,7 +246,7 @@ def creep_vessel_figure(shape: str, a: float, b: float, p: float, n: float, tau:
     ax.set_xlabel("radius r [length]")
     ax.set_ylabel("stress / p")
     ax.set_title("profiles along y = 0 (FE: circles σ_θθ, squares σ_rr)", fontsize=9)
-    ax.legend(fontsize=7, loc="center right")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     ax.grid(alpha=0.3)
     t = np.array(times[1:]) / tau
     ax = axes[1]
@@ -266,7 +266,7 @@ def creep_vessel_figure(shape: str, a: float, b: float, p: float, n: float, tau:
     ax.plot(np.array(times) / tau, bore_u, "o-", ms=3, label="FE: u(a)")
     t_line = np.array([times[len(times) // 2], times[-1]])
     ax.plot(t_line / tau, bore_u[-1] + rate_exact * (t_line - times[-1]), "C3--", lw=1.2,
-            label=f"stationary rate {rate_exact:.4g} (closed form)")
+            label=f"stationary rate (closed form): {rate_exact * tau:.4g} per τ")
     ax.set_xlabel("time / τ")
     ax.set_ylabel("bore displacement u(a) [length]")
     ax.set_title("the bore's creep", fontsize=9)
@@ -291,4 +291,5 @@ def creep_vessel_picture(displacement: fem.Function, viscous_strain_per_cell: fe
         title: the picture's title.
     """
     deformed.deformed_picture(displacement, viscous_strain_per_cell, path, title,
-                              label="cumulated viscous strain")
+                              label="cumulated viscous strain",
+                              axes=("x (length)", "y (length)"))

@@ -15,8 +15,8 @@ unknown and the law's state put back) and retaken shorter; after an accepted one
 step is Δt · min(2, 0.9 √(tol/e)) (the error of a first-order method grows as Δt²). Steps
 land on the load history's points, on the times asked for (`land_on`) and on the end: a
 step that would end just short of one is replaced by two equal ones reaching it (no
-sliver), and a step shortened to land keeps the step size wanted for the next. A step
-whose Newton solve fails is halved. With `adaptive = False` every step is end/steps (cut
+sliver); the next step grows from the one taken. A step whose Newton solve fails is
+halved. With `adaptive = False` every step is end/steps (cut
 to land; the error is still reported).
 
 Between steps (in `on_step`, `on_state`) the law's Δt is 0: its stress is the committed
@@ -104,7 +104,9 @@ class TimePath(LoadPath):
     times: list[float] = field(default_factory=list)
     errors: list[float] = field(default_factory=list)
     rejected: int = 0  # steps undone for their error (`failures`: for their solve)
-    stationary_since: float | None = None
+    stationary_since: float | None = None  # the end of the first stationary step
+    stationary_after: float | None = None  # its start: the state settled in between
+    change: float | None = None  # the last step's stationary measure (module docstring)
 
 
 def step_error(increment, previous_rate, dt: float, mu: float, scale: float, comm) -> float:
@@ -129,7 +131,7 @@ def step_error(increment, previous_rate, dt: float, mu: float, scale: float, com
     return error / scale if scale > 0 else 0.0
 
 
-def next_step(t: float, dt: float, stops: list[float]) -> tuple[float, bool]:
+def next_step(t: float, dt: float, stops: list[float]) -> float:
     """The end of the step from t wanted as long as dt, landing on the next of `stops`.
 
     Args:
@@ -138,17 +140,17 @@ def next_step(t: float, dt: float, stops: list[float]) -> tuple[float, bool]:
         stops: the times to land on, increasing, the last the end.
 
     Returns:
-        (the step's end, whether it is shorter than dt): the next stop itself if dt reaches
-        it, half the way to it if dt reaches more than half of it (two equal steps rather
-        than one and a sliver), else t + dt.
+        The step's end: the next stop itself if dt reaches it, half the way to it if dt
+        reaches more than half of it (two equal steps rather than one and a sliver), else
+        t + dt.
     """
     stop = next(s for s in stops if s > t * (1 + 1e-12))
     remaining = stop - t
     if dt >= remaining * (1 - 1e-12):
-        return stop, dt > remaining * (1 + 1e-12)
+        return stop
     if dt > 0.5 * remaining:
-        return t + 0.5 * remaining, True
-    return t + dt, False
+        return t + 0.5 * remaining
+    return t + dt
 
 
 class _Steps:
@@ -275,7 +277,7 @@ def solve_in_time(solver, law, set_load: Callable[[float], None], history: LoadH
         stress_before, held_since = start.stress, start.held_since
     while t < end * (1 - 1e-12):
         wanted = dt if adaptive else end / steps
-        target, shortened = next_step(t, wanted, stops)
+        target = next_step(t, wanted, stops)
         taken = target - t
         f = history(target)
         set_load(f)
@@ -319,24 +321,25 @@ def solve_in_time(solver, law, set_load: Callable[[float], None], history: LoadH
         if held_since is not None and stress_before is not None:
             # σ_eq's largest change at this step's rate over the time held
             change = kept.largest(stress - stress_before) / taken * (t - held_since)
-            settled = change <= stationary * scale
+            path.change = change / scale if scale > 0 else 0.0
+            settled = path.change <= stationary
             if settled and since is None:
-                since = t
+                since, path.stationary_after = t, t - taken
                 if progress:
-                    progress(f"  stationary from time {t:.6g}: at σ_eq's rate of change, "
-                             f"the time held would change it by {change / scale:.1e} of "
-                             "its largest value")
+                    progress(f"  stationary between times {t - taken:.4g} and {t:.4g}: at "
+                             f"σ_eq's rate of change, the time held would change it by "
+                             f"{path.change:.1e} of its largest value")
             elif not settled:
-                since = None
+                since = path.stationary_after = None
         else:
-            since = None
+            since = path.stationary_after = path.change = None
         stress_before = stress
         path.errors.append(error)
         path.stationary_since = since
         _accept(path, t, f, result, error, on_step, progress)
         if adaptive:
-            grow = min(GROWTH, GROWTH if error == 0 else SAFETY * math.sqrt(tolerance / error))
-            dt = max(taken * grow, wanted) if shortened and grow >= 1 else taken * grow
+            dt = taken * min(GROWTH, GROWTH if error == 0 else
+                             SAFETY * math.sqrt(tolerance / error))
         if on_state:
             on_state(TimeState(t, dt, rate.copy(), stress.copy(), since, held_since), path)
         if until_stationary and since is not None:
