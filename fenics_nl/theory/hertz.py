@@ -1,6 +1,9 @@
 """Hertz's closed forms for a rigid indenter on an elastic half-space (frictionless).
 
-And Sneddon's for a rigid cone, the other axisymmetric indenter of instrumented indentation.
+And for two elastic bodies (`pair_modulus`, `relative_radius`: 1/E* = (1 − ν1²)/E1 +
+(1 − ν2²)/E2, 1/R = 1/R1 + 1/R2, in the same laws with E* and R), Sneddon's for a rigid
+cone, the other axisymmetric indenter of instrumented indentation, and the fit of Hertz's
+pressure ellipse to a computed profile (`fitted_ellipse`).
 """
 
 from __future__ import annotations
@@ -17,7 +20,10 @@ __all__ = [
     "contact_radius_for",
     "cylinder_from_force",
     "effective_modulus",
+    "fitted_ellipse",
+    "pair_modulus",
     "pressure_profile",
+    "relative_radius",
     "sphere_from_force",
     "sphere_from_indentation",
 ]
@@ -26,6 +32,33 @@ __all__ = [
 def effective_modulus(E: float, nu: float) -> float:
     """E* = E / (1 − ν²) (rigid indenter)."""
     return E / (1 - nu**2)
+
+
+def pair_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
+    """E* of two elastic bodies: 1/E* = (1 − ν1²)/E1 + (1 − ν2²)/E2.
+
+    Hertz's laws below take it as E with ν = 0 (`effective_modulus(E*, 0) = E*`).
+    """
+    return 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+
+
+def relative_radius(R1: float, R2: float | None = None) -> float:
+    """R of two convex bodies: 1/R = 1/R1 + 1/R2 (R2 None: a plane; negative: a hollow)."""
+    return 1.0 / (1.0 / R1 + (0.0 if R2 is None else 1.0 / R2))
+
+
+def fitted_ellipse(r, p) -> tuple[float, float]:
+    """(p0, a) of Hertz's p = p0 √(1 − r²/a²) fitted to a profile: p² linear in r².
+
+    Args:
+        r: the radii (the distances from the centre) of nodes inside the contact.
+        p: their pressures.
+
+    Returns:
+        (p0, a) of the least-squares line p² = p0² − (p0/a)² r².
+    """
+    slope, intercept = np.polyfit(np.asarray(r, float) ** 2, np.asarray(p, float) ** 2, 1)
+    return math.sqrt(intercept), math.sqrt(-intercept / slope)
 
 
 def sphere_from_indentation(E: float, nu: float, R: float, delta: float) -> dict[str, float]:

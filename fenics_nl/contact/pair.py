@@ -1,0 +1,375 @@
+"""Contact between two deformable bodies: the course's active set on a slave–master pair.
+
+The *slave* surface's nodes are projected on the *master* surface's facets (2D: segments;
+the closest point, its parameter ξ and the master's outward normal n there; small
+sliding: the projection is made once, in the reference configuration). At a slave node s
+projected at ξ on the master facet with nodes m_j (shape functions N_j), the gap is
+
+    g_s(u) = γ_s + (u_s − Σ_j N_j(ξ) u_{m_j}) · n ≥ 0,     γ_s = (x_s − x_m(ξ)) · n,
+
+a linear condition B_s u + γ_s ≥ 0: B has one row per slave node, +n on the slave node's
+components, −N_j(ξ) n on the master nodes'. Each active-set iteration solves the
+equilibrium with the relative normal displacement prescribed on the active nodes and no
+traction elsewhere, by Lagrange multipliers (the course's saddle point, with A coupling
+both bodies):
+
+    [ K   −B_Aᵀ ] [u]   [f   ]
+    [−B_A   0   ] [λ] = [γ_A ],
+
+λ_s ≥ 0 the normal force that node s and the master exchange (compression), and then
+updates the set by the course's two rules: an active node in tension (λ_s < 0) leaves, an
+inactive node that penetrates (g_s < 0) joins; until the set repeats. With a non-linear
+residual each iteration is a Newton solve of the same saddle point (K the tangent).
+
+The master's facets are gathered on every rank (a surface is small against the body), so
+that a slave node finds its facet wherever its nodes are owned; B and the saddle point are
+PETSc matrices in the unknowns' global numbering, solved by MUMPS.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from fenics_nl.errors import SolveError
+from fenics_nl.solvers.result import SolveResult, WorkCounts
+
+__all__ = ["ContactPair", "PairContact", "PairState"]
+
+
+class ContactPair:
+    """Slave nodes on one body's facets against the master facets of the other (2D, P1).
+
+    Args:
+        V: the displacement space (vector, P1, 2D: plane strain or axisymmetric).
+        slave_facets: this rank's facets of the slave surface.
+        master_facets: this rank's facets of the master surface.
+        weight: the measure's weight (2πr in the axisymmetric model), for nodal areas.
+    """
+
+    def __init__(self, V: fem.FunctionSpace, slave_facets, master_facets, weight=1.0):
+        msh = V.mesh
+        if msh.geometry.dim != 2 or V.element.basix_element.degree != 1:
+            raise ValueError("a contact pair takes P1 displacements in 2D (plane strain or "
+                             "axisymmetric)")
+        self.V, self.mesh, self.comm = V, msh, msh.comm
+        self.bs = V.dofmap.index_map_bs
+        fdim = msh.topology.dim - 1
+        imap = V.dofmap.index_map
+        nodes = fem.locate_dofs_topological(V, fdim, np.asarray(slave_facets, np.int32))
+        self.slave = nodes[nodes < imap.size_local]  # the owned slave nodes (V's blocks)
+        x = V.tabulate_dof_coordinates()
+        self.x = x[self.slave, :2]
+        self.slave_global = imap.local_to_global(self.slave)
+        segments = _master_segments(V, np.asarray(master_facets, np.int32))
+        self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
+        self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
+        self.B = self._rows(np.arange(len(self.slave)))
+        self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
+
+    @property
+    def size(self) -> int:
+        """The slave nodes over every rank."""
+        return self.comm.allreduce(len(self.slave))
+
+    def _rows(self, which: np.ndarray) -> PETSc.Mat:
+        """B's rows of the owned slave nodes `which` (a new PETSc matrix, global columns)."""
+        n_local = len(which)
+        N = self.V.dofmap.index_map.size_global * self.bs
+        n_owned = self.V.dofmap.index_map.size_local * self.bs
+        B = PETSc.Mat().createAIJ(((n_local, None), (n_owned, N)), nnz=(6, 6), comm=self.comm)
+        B.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        start = B.getOwnershipRange()[0]
+        for row, i in enumerate(which):
+            n = self.normal[i]
+            cols = [self.bs * self.slave_global[i] + k for k in range(2)]
+            vals = list(n)
+            for j, w in ((0, 1 - self.xi[i]), (1, self.xi[i])):
+                cols += [self.bs * self.master_nodes[i, j] + k for k in range(2)]
+                vals += list(-w * n)
+            B.setValues(start + row, cols, vals, addv=PETSc.InsertMode.ADD_VALUES)
+        B.assemble()
+        return B
+
+    def gaps(self, u: fem.Function) -> np.ndarray:
+        """g_s(u) = γ_s + B_s u at this rank's slave nodes."""
+        g = self.B.createVecLeft()
+        self.B.mult(u.x.petsc_vec, g)
+        return g.array + self.gamma
+
+    def total(self, values) -> float:
+        """The sum over every rank's slave nodes."""
+        return self.comm.allreduce(float(np.sum(values)))
+
+
+def _master_segments(V, facets) -> dict:
+    """Every rank's master facets (2D segments), gathered on every rank.
+
+    Each: its two nodes' global blocks and coordinates, and the master body's outward
+    normal (pointing away from the cell the facet bounds).
+    """
+    msh = V.mesh
+    fdim = msh.topology.dim - 1
+    msh.topology.create_connectivity(fdim, fdim + 1)
+    msh.topology.create_connectivity(fdim, 0)
+    f2c, f2v = msh.topology.connectivity(fdim, fdim + 1), msh.topology.connectivity(fdim, 0)
+    imap = V.dofmap.index_map
+    nf = msh.topology.index_map(fdim).size_local
+    facets = facets[facets < nf]  # owned: each segment once
+    x = V.tabulate_dof_coordinates()
+    from fenics_nl.contact.surface import vertex_of_dof
+
+    dof_of_vertex = np.full(msh.topology.index_map(0).size_local
+                            + msh.topology.index_map(0).num_ghosts, -1, dtype=np.int64)
+    vod = vertex_of_dof(V)
+    dof_of_vertex[vod[vod >= 0]] = np.nonzero(vod >= 0)[0]
+    rows = []
+    geometry = msh.geometry.x
+    c2v = msh.topology.connectivity(fdim + 1, 0)
+    for f in facets:
+        v0, v1 = f2v.links(f)
+        d0, d1 = dof_of_vertex[v0], dof_of_vertex[v1]
+        p0, p1 = x[d0, :2], x[d1, :2]
+        t = p1 - p0
+        n = np.array([t[1], -t[0]]) / np.linalg.norm(t)
+        cell = f2c.links(f)[0]
+        centre = geometry[c2v.links(cell), :2].mean(axis=0)
+        if np.dot(n, 0.5 * (p0 + p1) - centre) < 0:
+            n = -n
+        g0, g1 = imap.local_to_global(np.array([d0, d1], dtype=np.int32))
+        rows.append([*p0, *p1, *n, g0, g1])
+    local = np.array(rows, dtype=float).reshape(-1, 8)
+    every = np.vstack(msh.comm.allgather(local))
+    return {"p0": every[:, 0:2], "p1": every[:, 2:4], "normal": every[:, 4:6],
+            "nodes": every[:, 6:8].astype(np.int64)}
+
+
+def _project(points: np.ndarray, segments: dict):
+    """Each point's closest master segment: (its index, ξ, the normal, the gap γ)."""
+    p0, p1, normals = segments["p0"], segments["p1"], segments["normal"]
+    t = p1 - p0
+    length2 = np.einsum("ij,ij->i", t, t)
+    facet = np.zeros(len(points), dtype=np.int64)
+    xi = np.zeros(len(points))
+    for i, x in enumerate(points):
+        s = np.clip(np.einsum("ij,ij->i", x - p0, t) / length2, 0.0, 1.0)
+        closest = p0 + s[:, None] * t
+        d = np.linalg.norm(x - closest, axis=1)
+        k = int(np.argmin(d))  # at a vertex two segments tie: either (small sliding)
+        facet[i], xi[i] = k, s[k]
+    closest = p0[facet] + xi[:, None] * t[facet]
+    normal = normals[facet]
+    gamma = np.einsum("ij,ij->i", points - closest, normal)
+    return facet, xi, normal, gamma
+
+
+def _nodal_areas(V, facets, weight) -> np.ndarray:
+    """∫ N_i weight ds over `facets` for every node of V's first component (local blocks)."""
+    from dolfinx import mesh
+
+    msh = V.mesh
+    tags = mesh.meshtags(msh, msh.topology.dim - 1, np.sort(facets),
+                         np.ones(len(facets), dtype=np.int32))
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+    V0, dofs = V.sub(0).collapse()
+    q = ufl.TestFunction(V0)
+    b = petsc.assemble_vector(fem.form(q * weight * ds(1)))
+    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+    b.ghostUpdate(PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+    with b.localForm() as local:
+        values = local.array_r.copy()
+    out = np.zeros(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts)
+    out[np.asarray(dofs) // V.dofmap.index_map_bs] = values
+    return out
+
+
+@dataclass
+class PairState:
+    """The pair after a solve: each owned slave node's status, force λ and pressure."""
+
+    active: np.ndarray
+    force: np.ndarray  # λ_s (compression > 0) at the owned slave nodes, 0 where inactive
+    pressure: np.ndarray  # λ_s over the node's area
+
+
+class PairContact:
+    """The active-set loop on a contact pair; each iteration a (Newton) saddle-point solve.
+
+    Args:
+        residual: R(u; v), the bodies' equilibrium without contact (UFL form).
+        u: the displacement (P1, 2D).
+        bcs: the Dirichlet conditions.
+        pair: the contact pair.
+        rtol: Newton's relative tolerance on ‖R‖.
+        atol: its absolute tolerance (times `force_scale`).
+        force_scale: the scale of the forces (the load).
+        max_it: Newton iterations per active-set iteration.
+        max_iterations: active-set iterations before giving up.
+    """
+
+    def __init__(self, residual, u, bcs, pair: ContactPair, *, rtol: float = 1e-10,
+                 atol: float = 1e-10, force_scale: float = 1.0, max_it: int = 20,
+                 max_iterations: int = 50):
+        self.u, self.bcs, self.pair = u, list(bcs), pair
+        self.F = fem.form(residual)
+        self.J = fem.form(ufl.derivative(residual, u))
+        self.rtol, self.atol, self.scale = rtol, atol * force_scale, force_scale
+        self.max_it, self.max_iterations = max_it, max_iterations
+        self.active = pair.gamma <= 0.0  # touching in the reference configuration
+        self.lam = np.zeros(len(pair.slave))
+        dofs = np.concatenate([bc.dof_indices()[0] for bc in self.bcs]) if self.bcs else \
+            np.zeros(0, dtype=np.int32)
+        n_owned = u.function_space.dofmap.index_map.size_local * pair.bs
+        owned = dofs[dofs < n_owned]
+        start = u.x.petsc_vec.getOwnershipRange()[0]
+        self.held = PETSc.IS().createGeneral((owned + start).astype(np.int32),
+                                             comm=pair.comm)
+        self.history: list[dict] = []
+
+    def solve(self) -> SolveResult:
+        """The active-set loop from the current set (warm start) to a set that repeats.
+
+        Returns:
+            The result, its iterations the Newton iterations summed, its
+            `active_set_iterations` the loop's, `history` each iteration's set changes.
+
+        Raises:
+            SolveError: the set did not settle within `max_iterations`.
+        """
+        t0, work, its, history, seen = time.perf_counter(), WorkCounts(), 0, [], set()
+        for k in range(1, self.max_iterations + 1):
+            its += self._newton(work)
+            g = self.pair.gaps(self.u)
+            leave = self.active & (self.lam < 0)
+            join = ~self.active & (g < -1e-12 * self._length())
+            changes = self.pair.comm.allreduce(int(leave.sum() + join.sum()))
+            history.append({"iteration": k, "active": self.pair.comm.allreduce(
+                int(self.active.sum())), "leave": self.pair.comm.allreduce(int(leave.sum())),
+                "join": self.pair.comm.allreduce(int(join.sum()))})
+            if changes == 0:
+                self.history = history
+                return SolveResult(True, "converged", its, [], work,
+                                   time.perf_counter() - t0, active_set_iterations=k,
+                                   history=history)
+            new = (self.active & ~leave) | join
+            key = tuple(np.sort(np.concatenate(self.pair.comm.allgather(  # every rank's
+                self.pair.slave_global[new]))))
+            if key in seen:
+                raise SolveError(f"the active set cycles (iteration {k})")
+            seen.add(key)
+            self.active = new
+        raise SolveError(f"the active set did not settle in {self.max_iterations} iterations")
+
+    def _length(self) -> float:
+        x = self.pair.mesh.geometry.x
+        return self.pair.comm.allreduce(float(np.ptp(x, axis=0).max()), op=MPI.MAX)
+
+    def state(self) -> PairState:
+        """Statuses, forces and pressures at this rank's owned slave nodes."""
+        areas = np.where(self.pair.areas > 0, self.pair.areas, 1.0)
+        return PairState(self.active.copy(), self.lam.copy(), self.lam / areas)
+
+    def force(self) -> np.ndarray:
+        """The force the master exerts on the slave body, Σ λ_s n_s (every rank's)."""
+        return np.array([self.pair.total(self.lam * self.pair.normal[:, k]) for k in (0, 1)])
+
+    def profile(self) -> tuple[np.ndarray, np.ndarray]:
+        """(x, pressure) of the active slave nodes, gathered on every rank (x: n × 2)."""
+        st = self.state()
+        rows = np.c_[self.pair.x[st.active], st.pressure[st.active]]
+        every = np.vstack(self.pair.comm.allgather(rows.reshape(-1, 3)))
+        return every[:, :2], every[:, 2]
+
+    def _newton(self, work: WorkCounts) -> int:
+        """Newton on the saddle point for the current active set; returns its iterations."""
+        pair, u = self.pair, self.u
+        which = np.flatnonzero(self.active)
+        B = pair._rows(which)
+        lam = np.zeros(len(which))
+        for bc in self.bcs:  # the prescribed values, then increments of 0 there
+            bc.set(u.x.array)
+        u.x.scatter_forward()
+        for it in range(1, self.max_it + 1):
+            R = petsc.assemble_vector(self.F)
+            R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            work.residual_assemblies += 1
+            Bt_lam = B.createVecRight()
+            B.multTranspose(_vec(B, lam), Bt_lam)
+            R.axpy(-1.0, Bt_lam)  # R(u) − Bᵀλ
+            _zero(R, self.held)  # the prescribed dofs: no equation
+            g = B.createVecLeft()
+            B.mult(u.x.petsc_vec, g)
+            g.array[:] += pair.gamma[which]
+            norm = np.sqrt(R.norm() ** 2 + g.norm() ** 2)
+            if norm <= max(self.atol, 0.0) and it > 1:
+                self.lam[:] = 0.0
+                self.lam[which] = lam
+                return it - 1
+            K = petsc.assemble_matrix(self.J, self.bcs)
+            K.assemble()
+            work.tangent_assemblies += 1
+            du, dlam = _saddle_solve(K, B, R, g, self.held, work)
+            u.x.petsc_vec.axpy(-1.0, du)
+            u.x.scatter_forward()
+            lam -= dlam
+            if norm <= self.atol:
+                self.lam[:] = 0.0
+                self.lam[which] = lam
+                return it
+        raise SolveError(f"contact pair: Newton did not converge in {self.max_it} iterations "
+                         f"(|R| = {norm:.2e})")
+
+
+def _vec(B: PETSc.Mat, values: np.ndarray) -> PETSc.Vec:
+    v = B.createVecLeft()
+    v.array[:] = values
+    return v
+
+
+def _zero(R: PETSc.Vec, rows: PETSc.IS) -> None:
+    start = R.getOwnershipRange()[0]
+    R.array[rows.indices - start] = 0.0
+
+
+def _saddle_solve(K, B, R, g, held, work: WorkCounts):
+    """[K −Bᵀ; −B 0] [du; dλ] = [R; −g] by MUMPS LU: (du, dλ), a Vec and an array.
+
+    The prescribed dofs (`held`, identity rows of K) take no multiplier: their rows of Bᵀ
+    are zero, so du = 0 there.
+    """
+    Bt = B.transpose(PETSc.Mat())  # a new matrix (without `out`, B itself is transposed)
+    Bt.scale(-1.0)
+    Bn = B.copy()
+    Bn.scale(-1.0)
+    Bt.zeroRows(held, diag=0.0)  # the prescribed dofs keep their value: no multiplier there
+    nest = PETSc.Mat().createNest([[K, Bt], [Bn, None]], comm=K.comm)
+    A = nest.convert("aij")
+    rhs = A.createVecRight()
+    n_u = R.getLocalSize()
+    rhs.array[:n_u] = R.array
+    rhs.array[n_u:] = -g.array
+    ksp = PETSc.KSP().create(K.comm)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    x = A.createVecLeft()
+    t0 = time.perf_counter()
+    ksp.solve(rhs, x)
+    work.factorizations += 1
+    work.linear_solves += 1
+    work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
+    if ksp.getConvergedReason() < 0:
+        raise SolveError("contact pair: the saddle point solve failed "
+                         f"({ksp.getConvergedReason()})")
+    du = R.duplicate()
+    du.array[:] = x.array[:n_u]
+    dlam = x.array[n_u:].copy()
+    return du, dlam

@@ -1,0 +1,111 @@
+"""Contact between two deformable bodies (issue 58): the course's active set on a pair.
+
+The upper body (a sphere in the axisymmetric model, a cylinder in plane strain) is pushed
+onto the lower one (a block, or another sphere or cylinder) of another material: each
+active-set iteration a saddle-point solve with the relative normal displacement prescribed
+on the active slave nodes (`fenics_nl.contact.pair`). Hertz for two bodies: 1/E* =
+(1 − ν1²)/E1 + (1 − ν2²)/E2, 1/R = 1/R1 + 1/R2, the contact radius and the peak pressure of
+the force transmitted, fitted to the computed pressures (the ellipse p² = p0² (1 − r²/a²)
+through the active nodes but the outermost: the nodal pressures themselves are a node
+spacing coarse at the edge and the lumped area on the axis is off by O(h)).
+"""
+
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.contact.pair import ContactPair, PairContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.two_bodies import sphere_on_body
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import LinearElastic
+from fenics_nl.theory import hertz
+
+
+def pressed(model, R1, R2, upper, lower, delta, a, fine=20.0, comm=MPI.COMM_WORLD):
+    """The upper body pushed down by δ at its equator onto the lower one (held at its
+    bottom): Hertz's a and p0 for the force, and the fitted ones; the loop's counts."""
+    d = sphere_on_body(comm, R1, a, R2=R2, fine=fine)
+    msh = d.mesh
+
+    def tag(name):
+        return d.facet_tags.find(d.physical_groups[name].tag)
+
+    V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    weight = kinematics.measure_weight(msh, model)
+    dx = ufl.Measure("dx", msh, subdomain_data=d.cell_tags)
+    eps, eps_v = kinematics.small_strain(u, model), kinematics.small_strain(v, model)
+    residual = sum(ufl.inner(LinearElastic(*m).stress(eps), eps_v) * weight * dx(i)
+                   for i, m in ((1, upper), (2, lower)))
+    top = boundary.component(V, 1, tag("upper_top"))
+    top.g.x.array[:] = -delta
+    bcs = [top, boundary.component(V, 0, np.concatenate([tag("upper_axis"),
+                                                         tag("lower_axis")])),
+           boundary.component(V, 1, tag("lower_bottom"))]
+    pair = ContactPair(V, tag("upper_contact"), tag("lower_contact"), weight=weight)
+    contact = PairContact(residual, u, bcs, pair, force_scale=upper[0] * a * a)
+    result = contact.solve()
+    half = 2.0 if model == "plane_strain" else 1.0  # the model is half the contact
+    force = contact.force()[1] * half
+    # the push's reaction: the force the top holds, against the multipliers' sum
+    held = boundary.reactions(residual, u, {"top": tag("upper_top")}, {"top": [1]})
+    reaction = -held["top"][1] * half
+    x, p = contact.profile()
+    r = np.abs(x[:, 0])
+    p0, a_fit = hertz.fitted_ellipse(r[r < 0.85 * r.max()], p[r < 0.85 * r.max()])
+    Es, R = hertz.pair_modulus(*upper, *lower), hertz.relative_radius(R1, R2)
+    law = hertz.sphere_from_force if model == "axisymmetric" else hertz.cylinder_from_force
+    ref = law(Es, 0.0, R, force)
+    return {"force": force, "reaction": reaction, "contact_radius": a_fit, "max_pressure": p0,
+            "contact_radius_hertz": ref["contact_radius"], "max_pressure_hertz":
+            ref["max_pressure"], "iterations": result.active_set_iterations,
+            "newton": result.iterations, "nodes": len(r), "h": a / fine,
+            "outermost": r.max()}
+
+
+@pytest.mark.parametrize("model,R2", [("axisymmetric", None), ("plane_strain", 2.0)])
+def test_two_bodies_of_two_materials_are_hertz(model, R2):
+    # a sphere (E = 3, ν = 0.2) on a block (E = 1, ν = 0.35), and two cylinders of radii 1
+    # and 2 of the same materials; h = a/20 near the contact: measured a +0.63 %, p0
+    # −0.57 % (sphere), a +0.21 %, p0 −0.01 % (cylinders); bounded at 1.5 % (the
+    # issue's); the multipliers' sum is the force the push's support holds (to 1e-8); the
+    # active set settles in 6 iterations, each one linear solve (one Newton iteration)
+    run = pressed(model, 1.0, R2, (3.0, 0.2), (1.0, 0.35), 0.012, 0.1)
+    for key in ("contact_radius", "max_pressure"):
+        assert run[key] == pytest.approx(run[f"{key}_hertz"], rel=0.015), (key, run)
+    assert run["force"] == pytest.approx(run["reaction"], rel=1e-8)
+    assert run["newton"] == run["iterations"] and run["nodes"] >= 10
+
+
+def test_code_aster_ssnv104_two_hemispheres():
+    # two hemispheres R = 50 mm, E = 20 GPa, ν = 0.3, crushed by 4 mm between their
+    # equators: Hertz (1/R = 2/50, E* = E/(2(1 − ν²))) gives a = 10 mm, p0 = 2798.3 MPa for an
+    # approach of 4 mm. The computed a is +0.6 % from 10 mm (−0.2 % at h/2) and p0 +5.5 %
+    # (+6.0 % at h/2): not the mesh's error but Hertz's assumptions, half-spaces and
+    # a ≪ R where a/R = 0.2 (the approach of the equators is not that of Hertz's distant
+    # points: the force is 9 % above Hertz's for 4 mm; against Hertz for the computed
+    # force, a −2.4 %, p0 +2.4 %, converging to −3.2 %, +2.8 %). Bounded at 1.5 % (a) and
+    # 7 % (p0) of the reference, and 4 % of Hertz for the force
+    run = pressed("axisymmetric", 50.0, 50.0, (20e3, 0.3), (20e3, 0.3), 4.0, 10.0)
+    assert run["contact_radius"] == pytest.approx(10.0, rel=0.015)
+    assert run["max_pressure"] == pytest.approx(2798.3, rel=0.07)
+    for key in ("contact_radius", "max_pressure"):
+        assert run[key] == pytest.approx(run[f"{key}_hertz"], rel=0.04), (key, run)
+    assert run["force"] == pytest.approx(run["reaction"], rel=1e-8)
+
+
+@pytest.mark.mpi
+def test_a_contact_pair_on_two_ranks_gives_the_serial_answer():
+    # the sphere on the block: the same active set (its size, its iterations), force,
+    # contact radius and peak pressure as one rank's run of the same mesh
+    assert MPI.COMM_WORLD.size > 1
+    args = ("axisymmetric", 1.0, None, (3.0, 0.2), (1.0, 0.35), 0.012, 0.1)
+    parallel, serial = pressed(*args), pressed(*args, comm=MPI.COMM_SELF)
+    for key in ("iterations", "nodes"):
+        assert parallel[key] == serial[key], key
+    for key in ("force", "contact_radius", "max_pressure"):
+        assert parallel[key] == pytest.approx(serial[key], rel=1e-9), key
