@@ -34,6 +34,7 @@ SMALL = {
     "buckling_beam.py": ["--load-ratio", "1.2", "--steps", "10"],
     "pressure_vessel.py": [],
     "creep_vessel.py": [],
+    "bearing.py": [],
     "upsetting.py": [],
     "snap_through.py": [],
     "damage_bar.py": [],

@@ -56,7 +56,7 @@ def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
                                   "indentation.py", "buckling_beam.py",
                                   "pressure_vessel.py", "snap_through.py",
                                   "bracket.py", "indentation_identification.py",
-                                  "creep_vessel.py"])
+                                  "creep_vessel.py", "bearing.py"])
 def test_help_describes_the_demo_and_states_defaults_once(demo, name):
     text = demo.run([name, "--help"]).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40

@@ -11,6 +11,8 @@ spacing coarse at the edge and the lumped area on the axis is off by O(h)).
 """
 
 
+import itertools
+
 import numpy as np
 import pytest
 import ufl
@@ -109,3 +111,20 @@ def test_a_contact_pair_on_two_ranks_gives_the_serial_answer():
         assert parallel[key] == serial[key], key
     for key in ("force", "contact_radius", "max_pressure"):
         assert parallel[key] == pytest.approx(serial[key], rel=1e-9), key
+
+
+def test_the_bearing_demo_is_hertz_at_light_load_then_leaves_it(demo):
+    # its defaults (R1 = 10, c = 0.1, steel in bronze, h = 0.025, 6 pushes): at the lightest
+    # load (P = 18 per unit length, 22 nodes in contact) Hertz for a cylinder in a hole,
+    # 1/R = 1/R1 − 1/R2: a +0.32 %, p0 +0.10 % (bounded 1.5 %); at the heaviest the arc is
+    # ±41° and the conforming contact has left Hertz: a/a_H = 0.71, p0/p0_H = 1.46
+    # (bounded: below 0.8, above 1.3); the force grows with the push, each step's set
+    # settles in at most 8 iterations (measured 7–8)
+    d = demo.json("bearing.py")
+    assert abs(d["contact_radius_error"]) < 0.015 and abs(d["max_pressure_error"]) < 0.015
+    heavy = d["steps"][-1]
+    assert heavy["contact_radius"] / heavy["contact_radius_hertz"] < 0.8
+    assert heavy["max_pressure"] / heavy["max_pressure_hertz"] > 1.3
+    forces = [s["force"] for s in d["steps"]]
+    assert all(b > a for a, b in itertools.pairwise(forces))
+    assert max(s["iterations"] for s in d["steps"]) <= 10

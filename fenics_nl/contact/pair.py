@@ -245,7 +245,7 @@ class PairContact:
         """
         t0, work, its, history, seen = time.perf_counter(), WorkCounts(), 0, [], set()
         for k in range(1, self.max_iterations + 1):
-            its += self._newton(work)
+            its += self.equilibrium(self.active, work)
             g = self.pair.gaps(self.u)
             leave = self.active & (self.lam < 0)
             join = ~self.active & (g < -1e-12 * self._length())
@@ -287,9 +287,23 @@ class PairContact:
         every = np.vstack(self.pair.comm.allgather(rows.reshape(-1, 3)))
         return every[:, :2], every[:, 2]
 
-    def _newton(self, work: WorkCounts) -> int:
-        """Newton on the saddle point for the current active set; returns its iterations."""
+    def equilibrium(self, active: np.ndarray, work: WorkCounts | None = None) -> int:
+        """The equilibrium with g_s = 0 on the `active` slave nodes and no force elsewhere.
+
+        Newton on the saddle point (one iteration for a linear residual); `lam` then holds
+        each owned slave node's λ (0 where inactive), and `active` (what `state`, `force`
+        and `profile` report) the set.
+
+        Args:
+            active: one flag per owned slave node.
+            work: the counts to add this solve's to.
+
+        Returns:
+            Newton's iterations.
+        """
         pair, u = self.pair, self.u
+        work = work if work is not None else WorkCounts()
+        self.active = np.asarray(active, dtype=bool).copy()  # what `state` reports
         which = np.flatnonzero(self.active)
         B = pair._rows(which)
         lam = np.zeros(len(which))

@@ -1,4 +1,4 @@
-"""Two bodies touching at a point: a sphere (or a cylinder) on a block, or on another one.
+"""Two bodies: a sphere (or a cylinder) on a block or on another one; a shaft in its bearing.
 
 The section of an axisymmetric model (x = r, y = z) or of a plane-strain one: the upper
 body is the quarter disc of radius R1 whose lowest point is the origin (centre (0, R1)),
@@ -12,6 +12,12 @@ Cell tags ``upper``, ``lower``; facet tags ``upper_contact`` (the upper body's a
 ``upper_top`` (its equator, where it is pushed), ``upper_axis``, ``lower_contact`` (the
 lower arc or the block's top), ``lower_bottom`` (the equator or the block's bottom),
 ``lower_axis``, and ``lower_side`` (the block's).
+
+`shaft_in_bearing`: the half (x ≥ 0) of a shaft of radius R1 in a housing of bore R2 =
+R1 + clearance and outer radius R3, both centred at the origin (plane strain), a node at
+the shaft's centre (where it may be pushed): they do not touch; pushed down, the shaft's
+lowest point meets the bore's. Triangles of size h along the
+lower halves of both circles (where the contact arc grows), growing away from them.
 """
 
 from __future__ import annotations
@@ -22,7 +28,7 @@ from mpi4py import MPI
 
 from fenics_nl.domain.meshes import _graded_size_field, start_model
 
-__all__ = ["TWO_BODY_TAGS", "sphere_on_body"]
+__all__ = ["BEARING_TAGS", "TWO_BODY_TAGS", "shaft_in_bearing", "sphere_on_body"]
 
 TWO_BODY_TAGS = ("upper_contact", "upper_top", "upper_axis", "lower_contact", "lower_bottom",
                  "lower_axis", "lower_side")
@@ -81,6 +87,94 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
         gmsh.model.addPhysicalGroup(2, [lower[0][1]], 2, name="lower")
         far = max(width, depth, r1, r2 or 0.0)
         _graded_size_field(a / fine / unit, 1.5, a / fine / unit + growth * far, far)
+        gmsh.model.mesh.generate(2)
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    data.mesh.geometry.x[:] *= unit
+    return data
+
+
+BEARING_TAGS = ("shaft_surface", "shaft_symmetry", "hub", "bore", "housing_outer",
+                "housing_symmetry")
+
+
+def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: float,
+                     growth: float = 0.15) -> gmshio.MeshData:
+    """The half shaft (around its hub) in the half housing, refined along the lower arcs.
+
+    Args:
+        comm: the communicator.
+        R1: the shaft's radius.
+        clearance: the radial clearance R2 − R1 (> 0).
+        R3: the housing's outer radius (> R1 + clearance).
+        h: the element size along the lower halves of the shaft's surface and the bore.
+        growth: the elements' growth per unit distance beyond.
+
+    Returns:
+        The mesh with its cell tags (``shaft`` 1, ``housing`` 2) and facet tags
+        (`BEARING_TAGS`).
+    """
+    if not (clearance > 0 and R3 > R1 + clearance):
+        raise ValueError(f"need clearance > 0 and R3 > R1 + clearance, got clearance = "
+                         f"{clearance}, R1 = {R1}, R3 = {R3}")
+    unit = R1
+    r1, r2, r3, hh, hub = 1.0, (R1 + clearance) / unit, R3 / unit, h / unit, 0.2
+    if comm.rank == 0:
+        start_model("bearing")
+        occ = gmsh.model.occ
+
+        def half(disc_out, disc_in):
+            """The half x ≥ 0 of the annulus between two radii."""
+            ring = occ.cut([(2, occ.addDisk(0, 0, 0, disc_out, disc_out))],
+                           [(2, occ.addDisk(0, 0, 0, disc_in, disc_in))])[0]
+            return occ.intersect(ring, [(2, occ.addRectangle(0, -r3, 0, r3, 2 * r3))])[0]
+
+        shaft, housing = half(r1, hub), half(r3, r2)
+        occ.synchronize()
+        tol = 1e-6
+        groups = {name: [] for name in BEARING_TAGS}
+        for body, (dim, surface) in (("shaft", shaft[0]), ("housing", housing[0])):
+            _, curves = gmsh.model.getAdjacencies(dim, surface)
+            for c in curves:
+                x, _, _ = occ.getCenterOfMass(1, c)
+                if abs(x) < tol:
+                    groups[f"{body}_symmetry"].append(c)
+                    continue
+                lo, hi = gmsh.model.getParametrizationBounds(1, c)
+                px, py, _ = gmsh.model.getValue(1, c, [0.5 * (lo[0] + hi[0])])
+                r = (px * px + py * py) ** 0.5
+                if body == "shaft":
+                    groups["hub" if abs(r - hub) < 1e-3 else "shaft_surface"].append(c)
+                else:
+                    groups["bore" if abs(r - r2) < 1e-3 else "housing_outer"].append(c)
+        for i, (name, tags) in enumerate(groups.items(), start=1):
+            if tags:
+                gmsh.model.addPhysicalGroup(1, tags, i, name=name)
+        gmsh.model.addPhysicalGroup(2, [shaft[0][1]], 1, name="shaft")
+        gmsh.model.addPhysicalGroup(2, [housing[0][1]], 2, name="housing")
+        field = gmsh.model.mesh.field
+        fields = []
+        for curves, size in ((groups["shaft_surface"], hh), (groups["bore"], hh)):
+            dist = field.add("Distance")
+            field.setNumbers(dist, "CurvesList", curves)
+            field.setNumber(dist, "Sampling", 400)
+            thr = field.add("Threshold")
+            field.setNumber(thr, "InField", dist)
+            field.setNumber(thr, "SizeMin", size)
+            field.setNumber(thr, "SizeMax", size + growth * r3)
+            field.setNumber(thr, "DistMin", 2 * hh)
+            field.setNumber(thr, "DistMax", r3)
+            fields.append(thr)
+        nearest = field.add("Min")
+        field.setNumbers(nearest, "FieldsList", fields)
+        lower = field.add("MathEval")  # fine on the lower halves only
+        field.setString(lower, "F", f"{hh} + {growth} * max(y + 0.5, 0)")
+        coarser = field.add("Max")
+        field.setNumbers(coarser, "FieldsList", [nearest, lower])
+        field.setAsBackgroundMesh(coarser)
+        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
+            gmsh.option.setNumber(f"Mesh.{opt}", 0)
         gmsh.model.mesh.generate(2)
     data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
     if comm.rank == 0:

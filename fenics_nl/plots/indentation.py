@@ -8,6 +8,9 @@ rank 0 (`ContactSurface.gathered`, `output.section`), the punch's shape as a fun
 and an unloading after it) and the drawn state on the rest: a run that is unloaded is drawn
 at its largest load.
 
+And two deformable bodies in contact (`pair_curves`: the contact half-width and peak
+pressure against the force, and the pressure around the arc, against Hertz for the pair).
+
 And the identification's picture (`identification_figure`): the measured and identified
 curves, the course's figure, beside the misfit over (σ0, H) with the fit's iterates on it,
 which shows how the fit got there (`misfit_grid` runs the model on a grid).
@@ -25,7 +28,8 @@ from fenics_nl.errors import SolveError
 from fenics_nl.plots import figures
 from fenics_nl.theory import hertz, mindlin
 
-__all__ = ["PunchRun", "curves", "identification_figure", "misfit_grid", "section_picture"]
+__all__ = ["PunchRun", "curves", "identification_figure", "misfit_grid", "pair_curves",
+           "section_picture"]
 
 
 @dataclass
@@ -368,3 +372,51 @@ def _title(out: dict) -> str:
             parts.append(f"{symbol}: not identifiable")
     return (f"{', '.join(parts)}\n{out['iterations']} iterations, "
             f"{out['forward_solves']} model runs")
+
+
+def pair_curves(steps: list[dict], title: str, path: str,
+                comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+    """a and p0 against the force (log–log) and p around the arc, with Hertz's.
+
+    Args:
+        steps: each load step's record: `force`, `contact_radius`, `max_pressure`, their
+            `_hertz` values, and `profile` (`s`, the arc length from the centre of the
+            contact, and `pressure`), gathered on every rank.
+        title: the figure's title.
+        path: the PNG, written by rank 0 of `comm`.
+        comm: the run's communicator.
+    """
+    if comm.rank != 0:
+        return
+    plt = figures.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    P = np.array([s["force"] for s in steps])
+    ax = axes[0]
+    for key, name, colour in (("contact_radius", "half-width a", "C0"),
+                              ("max_pressure", "peak pressure p0", "C3")):
+        ax.loglog(P, [s[key] for s in steps], "o", color=colour, label=f"FE: {name}")
+        ax.loglog(P, [s[f"{key}_hertz"] for s in steps], "-", color=colour, lw=1,
+                  label=f"Hertz: {name}")
+    ax.set_xlabel("force per unit length P [force/length]")
+    ax.set_ylabel("a [length], p0 [stress]")
+    ax.set_title("the contact against Hertz (fitted ellipse: see the demo)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3, which="both")
+    ax = axes[1]
+    colours = plt.get_cmap("viridis")(np.linspace(0.0, 0.9, len(steps)))
+    for colour, st in zip(colours, steps, strict=True):
+        prof = st["profile"]
+        order = np.argsort(prof["s"])
+        sv, pv = np.array(prof["s"])[order], np.array(prof["pressure"])[order]
+        ax.plot(sv, pv, "o", ms=3, color=colour, label=f"FE, P = {st['force']:.3g}")
+        grid = np.linspace(0.0, st["contact_radius_hertz"], 60)
+        ax.plot(grid, hertz.pressure_profile(st["max_pressure_hertz"],
+                                             st["contact_radius_hertz"], grid),
+                "-", lw=0.8, color=colour)
+    ax.set_xlabel("arc length from the lowest point s [length]")
+    ax.set_ylabel("contact pressure [stress]")
+    ax.set_title("pressure around the arc (lines: Hertz for the same P)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=11)
+    figures.save_figure(fig, path)

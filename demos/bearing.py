@@ -1,0 +1,295 @@
+# # A shaft in its bearing: contact between two deformable bodies by the active set
+#
+# A steel shaft of radius $R_1$ sits in a bronze housing whose bore is larger by a radial
+# clearance $c$; the shaft is pushed down, radially, in steps. Both bodies deform, and
+# where they touch is not known in advance: the course's active-set algorithm finds it, on
+# a *pair* of surfaces (the shaft's, the slave; the bore, the master), and this demo
+# writes its loop out. At light load the contact is Hertz's between two cylinders, one in
+# the other; as the load grows the arc spreads over a good part of the circumference, where
+# Hertz's half-spaces no longer describe either body: the computed arc stays narrower than
+# Hertz's, its pressure higher.
+#
+# ## Problem definition
+#
+# Each slave node $s$ is projected on the master surface (closest point, the bore's
+# outward normal $n$ there, small sliding); the gap is
+#
+# $$ g_s(u) = \gamma_s + (u_s - u_m)\cdot n \ \ge 0, \qquad \lambda_s \ge 0, \qquad
+#    g_s \lambda_s = 0, $$
+#
+# with $\gamma_s$ the initial gap, $u_m$ the master surface's displacement at the projection
+# and $\lambda_s$ the normal force the bore exerts on node $s$. Iteration $k$ solves the
+# equilibrium with $g_s = 0$ on the active nodes and no force on the others (Lagrange
+# multipliers: the course's saddle point, the matrix $B$ of the gaps coupling both
+# bodies); then an active node in tension ($\lambda_s < 0$) leaves the set, an inactive
+# node that penetrates ($g_s < 0$) joins it, until the set repeats.
+#
+# Hertz for a cylinder in a hole (plane strain, force $P$ per unit length):
+# $1/R = 1/R_1 - 1/R_2$, $1/E^* = (1-\nu_1^2)/E_1 + (1-\nu_2^2)/E_2$,
+# $a = \sqrt{4PR/(\pi E^*)}$ and $p_0 = 2P/(\pi a)$: valid while $a \ll R_1$, that is
+# at light load: with a clearance of 1 % of the radius, $R = 101 R_1$, and a modest force
+# already spreads the arc over tens of degrees.
+#
+# ## Implementation
+
+# +
+import math
+import time
+from dataclasses import dataclass
+from typing import ClassVar
+
+import fenics_nl  # noqa: F401  (first: loads the wheel's MPI/PETSc before dolfinx)
+
+# isort: split
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from fenics_nl.contact.pair import ContactPair, PairContact
+from fenics_nl.domain import boundary
+from fenics_nl.domain.two_bodies import shaft_in_bearing
+from fenics_nl.errors import SolveError
+from fenics_nl.io import cli, output
+from fenics_nl.io.cli import say
+from fenics_nl.io.parameters import Parameters, number
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.laws import LinearElastic, von_mises_of
+from fenics_nl.plots import indentation as indentation_pictures
+from fenics_nl.solvers.result import WorkCounts
+from fenics_nl.theory import hertz
+
+cli.run_script(__name__)  # as a script: this file runs under the demo contract, then exits
+
+comm = MPI.COMM_WORLD
+# -
+
+# ### Parameters
+#
+# From the command line (`python demos/bearing.py --help`); in a notebook, the defaults
+# (N, mm, MPa).
+
+# +
+@dataclass
+class Bearing(Parameters):
+    """A shaft pushed radially into its bearing (plane strain, two elastic bodies, a
+    radial clearance): the contact arc and the pressure around it against Hertz for a
+    cylinder in a hole, and their departure from it as the load grows. Units are the
+    user's, consistent (e.g. N, mm, MPa)."""
+
+    OUTPUTS: ClassVar = {"png": "von Mises stress in the shaft and the housing, the nodes in "
+                                "contact marked",
+                         "plot": "the contact half-width and peak pressure against the "
+                                 "force, and the pressure around the arc, with Hertz's"}
+
+    radius: float = number(10.0, "the shaft's radius R1", unit="length", above=0)
+    clearance: float = number(0.1, "the radial clearance c = R2 - R1", unit="length",
+                              above=0)
+    outer_radius: float = number(20.0, "the housing's outer radius (held)", unit="length",
+                                 above=0)
+    E_shaft: float = number(210e3, "the shaft's Young's modulus", unit="stress", above=0)
+    nu_shaft: float = number(0.3, "the shaft's Poisson's ratio", unit="-")
+    E_housing: float = number(110e3, "the housing's Young's modulus (bronze)", unit="stress",
+                              above=0)
+    nu_housing: float = number(0.34, "the housing's Poisson's ratio", unit="-")
+    push: float = number(0.05, "how far the shaft's hub is pushed beyond the clearance at "
+                         "the last step", unit="length", above=0)
+    steps: int = number(6, "load steps, the push growing geometrically from push/100",
+                        at_least=2)
+    size: float = number(0.025, "element size along the lower halves of the shaft's surface "
+                         "and the bore", unit="length", above=0)
+
+    def check(self):
+        if not self.outer_radius > self.radius + self.clearance:
+            raise ValueError("--outer-radius must exceed --radius + --clearance")
+
+
+args = cli.arguments(Bearing, prefixes={})
+R1, c = args.radius, args.clearance
+# -
+
+# ### The mesh and its tags
+#
+# The half $x \ge 0$ of both bodies (the load is along the symmetry line), from gmsh
+# (`shaft_in_bearing`): cell tags `shaft` and `housing`, facet tags `shaft_surface` (the
+# slave), `bore` (the master), `hub`, `housing_outer`, and the symmetry lines; triangles
+# of `--size` along the lower halves of both surfaces, where the arc grows.
+
+# +
+mesh_data = shaft_in_bearing(comm, R1, c, args.outer_radius, args.size)
+msh = mesh_data.mesh
+
+
+def tagged(name):
+    """The facets of the physical group `name`."""
+    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+
+
+# -
+
+# ### The function space and the boundary conditions
+#
+# P1 displacements on both bodies (one space: they share no node). The symmetry lines hold
+# $u_x = 0$; the housing's outer surface is held; the shaft is driven by its hub (a rigid
+# core of radius $R_1/5$), pushed down by $c + \delta$ (`push`, a Dirichlet value).
+
+# +
+V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+u, v = fem.Function(V, name="displacement"), ufl.TestFunction(V)
+push = boundary.component(V, 1, tagged("hub"))  # its value: the hub's motion
+bcs = [push, boundary.component(V, 0, tagged("hub")),
+       boundary.component(V, 0, np.concatenate([tagged("shaft_symmetry"),
+                                                tagged("housing_symmetry")])),
+       boundary.component(V, 0, tagged("housing_outer")),
+       boundary.component(V, 1, tagged("housing_outer"))]
+# -
+
+# ### The materials and the residual
+#
+# Hooke's law in each cell group, $R(u; v) = \sum_g \int_{\Omega_g} \sigma_g(\varepsilon(u))
+# : \varepsilon(v)\,dx$: a steel shaft, a bronze housing.
+
+# +
+dx = ufl.Measure("dx", msh, subdomain_data=mesh_data.cell_tags)
+materials = {mesh_data.physical_groups["shaft"].tag: LinearElastic(args.E_shaft,
+                                                                   args.nu_shaft),
+             mesh_data.physical_groups["housing"].tag: LinearElastic(args.E_housing,
+                                                                     args.nu_housing)}
+eps, eps_v = (kinematics.small_strain(w, "plane_strain") for w in (u, v))
+residual = sum(ufl.inner(law.stress(eps), eps_v) * dx(group)
+               for group, law in materials.items())
+# -
+
+# ### The contact pair
+#
+# `ContactPair` projects each node of the shaft's surface on the bore's segments (closest
+# point and outward normal, once: small sliding) and keeps the gap $g = \gamma + B u$;
+# `PairContact.equilibrium(active)` solves the saddle point
+# $[K\ -B_A^T;\ -B_A\ 0]$ for a set (MUMPS), its multipliers the forces $\lambda_s$.
+
+pair = ContactPair(V, tagged("shaft_surface"), tagged("bore"))
+contact = PairContact(residual, u, bcs, pair, force_scale=args.E_housing * c)
+say(f"shaft R1 = {R1:g} in a bore of R2 = {R1 + c:g}: {output.dofs(V)} unknowns, "
+    f"{pair.size} slave nodes")
+
+
+# ### The active-set loop, written out
+#
+# From the last step's set (none at first): solve, then the two rules, until the set
+# repeats. Every rank takes the same decision (the counts are summed over ranks).
+
+def active_set_loop(active):
+    """The course's loop from `active`; returns the set it settles on and its count."""
+    for k in range(1, 51):
+        contact.equilibrium(active, work)
+        g = pair.gaps(u)
+        leave = active & (contact.lam < 0)  # in tension
+        join = ~active & (g < 0)  # penetrating
+        if comm.allreduce(int(leave.sum() + join.sum())) == 0:
+            return active, k
+        active = (active & ~leave) | join
+    raise SolveError("the active set did not settle in 50 iterations")
+
+
+# ### Load steps
+#
+# The push grows geometrically from a hundredth of `--push` beyond the clearance to it;
+# each step starts from the last step's set and displacement. The force per unit length
+# of the whole shaft is twice the half's contact force (the sum of the $\lambda_s$).
+
+# +
+work, history, active = WorkCounts(), [], np.zeros(len(pair.slave), dtype=bool)
+Es = hertz.pair_modulus(args.E_shaft, args.nu_shaft, args.E_housing, args.nu_housing)
+R = hertz.relative_radius(R1, -(R1 + c))  # the hole: a negative radius
+t0 = time.perf_counter()
+for delta in args.push * np.geomspace(1e-2, 1.0, args.steps):
+    push.g.x.array[:] = -(c + delta)
+    active, iterations = active_set_loop(active)
+    P = 2 * contact.force()[1]
+    x, p = contact.profile()  # the nodes in contact, gathered: x, pressure
+    if len(p) == 0:
+        raise SolveError(f"no contact with the shaft's hub pushed by c + {delta:.3g}: "
+                         "the bodies' own compliance takes it (a larger --push)")
+    s = R1 * np.arctan2(np.abs(x[:, 0]), -x[:, 1])  # arc length from the lowest point
+    inner = s < 0.85 * s.max()
+    p0, a = (hertz.fitted_ellipse(s[inner], p[inner]) if inner.sum() >= 3
+             else (p.max(), s.max()))
+    ref = hertz.cylinder_from_force(Es, 0.0, R, P)
+    history.append({"push": c + delta, "force": P, "iterations": iterations,
+                    "arc_degrees": math.degrees(s.max() / R1), "contact_radius": a,
+                    "max_pressure": p0, "contact_radius_hertz": ref["contact_radius"],
+                    "max_pressure_hertz": ref["max_pressure"], "nodes": len(s),
+                    "profile": {"s": s.tolist(), "pressure": p.tolist()}})
+    cli.converged_step({"load_factor": delta / args.push, "force": P,
+                        "active_set_iterations": iterations, "newton_iterations": iterations})
+    say(f"  push c + {delta:.4g}: P = {P:.5g} per unit length, arc "
+        f"±{history[-1]['arc_degrees']:.2f}°, a = {a:.4g} (Hertz {ref['contact_radius']:.4g}), "
+        f"p0 = {p0:.5g} (Hertz {ref['max_pressure']:.5g}), {iterations} active-set "
+        "iterations")
+solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+# -
+
+# ### Against Hertz
+#
+# The lightest step against Hertz for its force (a and $p_0$ fitted to the computed
+# pressures: $p^2 = p_0^2(1 - s^2/a^2)$ over the nodes in contact but the outermost), and
+# how far the heaviest has left it. (The nodal pressures show a faint moiré where the two
+# surfaces' nodes come in and out of line: node-to-segment contact; the fit is not
+# affected.) The largest $\sigma_{eq}$ of the picture is at the hub, where the load enters
+# the shaft; around the arc both bodies carry the contact stresses.
+
+# +
+light, heavy = history[0], history[-1]
+errors = {k: light[k] / light[f"{k}_hertz"] - 1 for k in ("contact_radius", "max_pressure")}
+say(f"lightest step: a {100 * errors['contact_radius']:+.2f} %, p0 "
+    f"{100 * errors['max_pressure']:+.2f} % from Hertz ({light['nodes']} nodes in contact, "
+    f"h = {args.size:g}); heaviest: a/a_Hertz = "
+    f"{heavy['contact_radius'] / heavy['contact_radius_hertz']:.3f}, p0/p0_Hertz = "
+    f"{heavy['max_pressure'] / heavy['max_pressure_hertz']:.3f} at an arc of "
+    f"±{heavy['arc_degrees']:.1f}°")
+# -
+
+# ## Outputs
+
+
+def summary():
+    """The quantities of the run, for --json."""
+    out = {"radius": R1, "clearance": c, "relative_radius": R, "modulus": Es,
+           "steps": history, "contact_radius_error": errors["contact_radius"],
+           "max_pressure_error": errors["max_pressure"], "force": heavy["force"],
+           "active_set_iterations": sum(h["iterations"] for h in history),
+           "factorizations": work.factorizations, "dofs": output.dofs(V), "ranks": comm.size,
+           "solve_time_s": solve_time, "warnings": []}
+    if light["nodes"] < 10:
+        out["warnings"].append(f"{light['nodes']} nodes in contact at the lightest step: "
+                               "a and p0 are coarse there (refine --size)")
+    return out
+
+
+def plot():
+    """a and p0 against P, and the pressure around the arc, with Hertz's."""
+    indentation_pictures.pair_curves(
+        history, f"a shaft (R1 = {R1:g}) in a bore with a clearance of {c:g}: Hertz at "
+        f"light load (a {100 * errors['contact_radius']:+.1f} %, p0 "
+        f"{100 * errors['max_pressure']:+.1f} %), then departing from it", args.plot)
+
+
+def picture():
+    """σ_eq in both bodies, on the deformed halves, the nodes in contact marked."""
+    from fenics_nl.plots.deformed import deformed_picture
+
+    Q = fem.functionspace(msh, ("DG", 0))
+    vm = fem.Function(Q, name="von_mises")
+    for group, law in materials.items():  # each body's law in its cells
+        vm.interpolate(fem.Expression(von_mises_of(law.stress(eps)),
+                                      Q.element.interpolation_points),
+                       cells0=mesh_data.cell_tags.find(group))
+    touching = pair.x[active]
+    deformed_picture(u, vm, args.png, f"P = {heavy['force']:.4g} per unit length, arc "
+                     f"±{heavy['arc_degrees']:.1f}°", marked={"nodes in contact": touching},
+                     label="von Mises stress [stress]", axes=("x (length)", "y (length)"))
+    say(f"wrote {args.png}")
+
+
+cli.results(summary(), [*([plot] if args.plot else []), *([picture] if args.png else [])])
