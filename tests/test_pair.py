@@ -128,3 +128,50 @@ def test_the_bearing_demo_is_hertz_at_light_load_then_leaves_it(demo):
     forces = [s["force"] for s in d["steps"]]
     assert all(b > a for a, b in itertools.pairwise(forces))
     assert max(s["iterations"] for s in d["steps"]) <= 10
+
+
+def test_cattaneo_mindlin_between_two_identical_cylinders():
+    # two identical cylinders (R = 1, E = 1, ν = 0.3: identical materials uncouple the
+    # normal and tangential problems), f = 0.3, pressed (a = 0.058, Hertz to 0.03 %) then
+    # pulled sideways by their top: Q/(fP) = 0.34, 0.66, 0.82. The stick zone's half-width
+    # (half the span of the stuck nodes) against c = a √(1 − Q/(fP)): −0.0026, −0.0015,
+    # −0.0025 at h = a/12 (within a node spacing, the test's bound; −0.0012, −0.0001,
+    # −0.0012 at h/2); the stick zone shrinks as Q grows. Its centre is shifted by −0.0074
+    # (−0.0062 at h/2), the same at every load: the top is held, and the couple Q·R of the
+    # contact force and the top's reaction tilts the pressure (half-spaces have no such couple)
+    from fenics_nl.contact.pair import FrictionalPair
+
+    R, a, E, nu, f, delta = 1.0, 0.1, 1.0, 0.3, 0.3, 0.012
+    d = sphere_on_body(MPI.COMM_WORLD, R, a, R2=R, both_sides=True)
+
+    def tag(name):
+        return d.facet_tags.find(d.physical_groups[name].tag)
+
+    V = fem.functionspace(d.mesh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    eps, eps_v = (kinematics.small_strain(w, "plane_strain") for w in (u, v))
+    residual = ufl.inner(LinearElastic(E, nu).stress(eps), eps_v) * ufl.dx
+    down, sideways = (boundary.component(V, k, tag("upper_top")) for k in (1, 0))
+    bcs = [down, sideways, *(boundary.component(V, k, tag("lower_bottom")) for k in (0, 1))]
+    pair = ContactPair(V, tag("upper_contact"), tag("lower_contact"))
+    contact = FrictionalPair(residual, u, bcs, pair, f, force_scale=E * a * a)
+    down.g.x.array[:] = -delta
+    contact.solve()
+    contact.commit()
+    x, p = contact.profile()
+    r = np.abs(x[:, 0])
+    _, a_fit = hertz.fitted_ellipse(r[r < 0.85 * r.max()], p[r < 0.85 * r.max()])
+    spacing = float(np.diff(np.sort(x[:, 0])).max())
+    widths = []
+    for shift in (0.002, 0.004, 0.005):
+        sideways.g.x.array[:] = shift
+        contact.solve()
+        contact.commit()
+        Q, P = contact.force()
+        stuck = np.concatenate(MPI.COMM_WORLD.allgather(
+            pair.x[contact.active & ~contact.slip, 0]))
+        width = 0.5 * (stuck.max() - stuck.min())
+        assert 0 < -Q < f * P
+        assert width == pytest.approx(a_fit * np.sqrt(1 - abs(Q) / (f * P)), abs=spacing)
+        widths.append(width)
+    assert widths[0] > widths[1] > widths[2]

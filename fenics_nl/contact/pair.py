@@ -41,7 +41,7 @@ from petsc4py import PETSc
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
-__all__ = ["ContactPair", "PairContact", "PairState"]
+__all__ = ["ContactPair", "FrictionalPair", "PairContact", "PairState"]
 
 
 class ContactPair:
@@ -71,7 +71,7 @@ class ContactPair:
         segments = _master_segments(V, np.asarray(master_facets, np.int32))
         self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
         self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
-        self.B = self._rows(np.arange(len(self.slave)))
+        self.B = self.rows(np.arange(len(self.slave)))
         self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
 
     @property
@@ -79,8 +79,17 @@ class ContactPair:
         """The slave nodes over every rank."""
         return self.comm.allreduce(len(self.slave))
 
-    def _rows(self, which: np.ndarray) -> PETSc.Mat:
-        """B's rows of the owned slave nodes `which` (a new PETSc matrix, global columns)."""
+    def rows(self, which: np.ndarray, tangential: bool = False) -> PETSc.Mat:
+        """B's rows of the owned slave nodes `which` (a new PETSc matrix, global columns).
+
+        Args:
+            which: indices into this rank's slave nodes.
+            tangential: the rows along the tangent t = (−n_y, n_x) (the relative tangential
+                displacement) instead of the normal.
+
+        Returns:
+            The matrix, one row per node of `which`.
+        """
         n_local = len(which)
         N = self.V.dofmap.index_map.size_global * self.bs
         n_owned = self.V.dofmap.index_map.size_local * self.bs
@@ -89,14 +98,23 @@ class ContactPair:
         start = B.getOwnershipRange()[0]
         for row, i in enumerate(which):
             n = self.normal[i]
+            d = np.array([-n[1], n[0]]) if tangential else n
             cols = [self.bs * self.slave_global[i] + k for k in range(2)]
-            vals = list(n)
+            vals = list(d)
             for j, w in ((0, 1 - self.xi[i]), (1, self.xi[i])):
                 cols += [self.bs * self.master_nodes[i, j] + k for k in range(2)]
-                vals += list(-w * n)
+                vals += list(-w * d)
             B.setValues(start + row, cols, vals, addv=PETSc.InsertMode.ADD_VALUES)
         B.assemble()
         return B
+
+    def tangential(self, u: fem.Function) -> np.ndarray:
+        """The relative tangential displacement (u_s − u_m)·t at this rank's slave nodes."""
+        if not hasattr(self, "Bt"):
+            self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
+        g = self.Bt.createVecLeft()
+        self.Bt.mult(u.x.petsc_vec, g)
+        return g.array.copy()
 
     def gaps(self, u: fem.Function) -> np.ndarray:
         """g_s(u) = γ_s + B_s u at this rank's slave nodes."""
@@ -301,12 +319,21 @@ class PairContact:
         Returns:
             Newton's iterations.
         """
-        pair, u = self.pair, self.u
         work = work if work is not None else WorkCounts()
         self.active = np.asarray(active, dtype=bool).copy()  # what `state` reports
         which = np.flatnonzero(self.active)
-        B = pair._rows(which)
-        lam = np.zeros(len(which))
+        lam = self._saddle(self.pair.rows(which), self.pair.gamma[which], None, work)[0]
+        self.lam[:] = 0.0
+        self.lam[which] = lam
+        return self._iterations
+
+    def _saddle(self, B, offset, forces, work):
+        """Newton on R(u) − Bᵀλ − forces = 0, B u + offset = 0: (λ, ) and the iterations.
+
+        `forces`: known contact forces (a PETSc Vec in u's layout: friction), or None.
+        """
+        u = self.u
+        lam = np.zeros(B.getLocalSize()[0])
         for bc in self.bcs:  # the prescribed values, then increments of 0 there
             bc.set(u.x.array)
         u.x.scatter_forward()
@@ -317,15 +344,16 @@ class PairContact:
             Bt_lam = B.createVecRight()
             B.multTranspose(_vec(B, lam), Bt_lam)
             R.axpy(-1.0, Bt_lam)  # R(u) − Bᵀλ
+            if forces is not None:
+                R.axpy(-1.0, forces)
             _zero(R, self.held)  # the prescribed dofs: no equation
             g = B.createVecLeft()
             B.mult(u.x.petsc_vec, g)
-            g.array[:] += pair.gamma[which]
+            g.array[:] += offset
             norm = np.sqrt(R.norm() ** 2 + g.norm() ** 2)
-            if norm <= max(self.atol, 0.0) and it > 1:
-                self.lam[:] = 0.0
-                self.lam[which] = lam
-                return it - 1
+            if norm <= self.atol and it > 1:
+                self._iterations = it - 1
+                return (lam,)
             K = petsc.assemble_matrix(self.J, self.bcs)
             K.assemble()
             work.tangent_assemblies += 1
@@ -334,9 +362,8 @@ class PairContact:
             u.x.scatter_forward()
             lam -= dlam
             if norm <= self.atol:
-                self.lam[:] = 0.0
-                self.lam[which] = lam
-                return it
+                self._iterations = it
+                return (lam,)
         raise SolveError(f"contact pair: Newton did not converge in {self.max_it} iterations "
                          f"(|R| = {norm:.2e})")
 
@@ -387,3 +414,128 @@ def _saddle_solve(K, B, R, g, held, work: WorkCounts):
     du.array[:] = x.array[:n_u]
     dlam = x.array[n_u:].copy()
     return du, dlam
+
+
+class FrictionalPair(PairContact):
+    """The active set on a pair with Coulomb friction (2D): open, stuck or slipping nodes.
+
+    The course's statuses, as on a rigid obstacle (`contact.friction`), between the bodies:
+    the relative tangential displacement g_t = (u_s − u_m)·t since the last committed state
+    (`commit`) is the slip. Each iteration solves the saddle point with
+
+    * open nodes free;
+    * stuck nodes: g_n = 0 and Δg_t = 0 (two multipliers, λ_n and λ_t);
+    * slipping nodes: g_n = 0 and the tangential force f λ_n s on the slave (its opposite,
+      by the shape functions, on the master), λ_n from the last iteration;
+
+    then updates the statuses: a closed node in tension opens, an open node that penetrates
+    closes (stuck); a stuck node whose |λ_t| exceeds f λ_n slips, s = sign(λ_t); a slipping
+    node whose slip goes along its friction force (Δg_t s > 0) sticks. The loop ends when no
+    status changes and the friction forces agree with the normal forces of the same solve
+    (to 1e-9 of the largest).
+
+    Args:
+        residual: R(u; v), the bodies' equilibrium without contact (UFL form).
+        u: the displacement (P1, 2D).
+        bcs: the Dirichlet conditions.
+        pair: the contact pair.
+        friction: Coulomb's coefficient f.
+        **options: `PairContact`'s (tolerances, iteration limits).
+    """
+
+    def __init__(self, residual, u, bcs, pair: ContactPair, friction: float, **options):
+        super().__init__(residual, u, bcs, pair, **options)
+        if not friction >= 0:
+            raise ValueError(f"the friction coefficient must be >= 0, got {friction}")
+        self.f = friction
+        n = len(pair.slave)
+        self.slip, self.s = np.zeros(n, dtype=bool), np.zeros(n)
+        self.lam_t = np.zeros(n)
+        self.committed = pair.tangential(u)
+
+    def commit(self) -> None:
+        """The converged step's tangential displacement: the next step's slip is from it."""
+        self.committed = self.pair.tangential(self.u)
+
+    def force(self) -> np.ndarray:
+        """The force the master exerts on the slave body, Σ λ_n n + λ_t t (every rank's)."""
+        n = self.pair.normal
+        t = np.c_[-n[:, 1], n[:, 0]]
+        return np.array([self.pair.total(self.lam * n[:, k] + self.lam_t * t[:, k])
+                         for k in (0, 1)])
+
+    def solve(self) -> SolveResult:
+        """The active-set loop with friction, from the current statuses (warm start).
+
+        Returns:
+            The result, its `history` each iteration's counts (active, slip, changes).
+
+        Raises:
+            SolveError: the statuses did not settle within `max_iterations`.
+        """
+        t0, work, its, history = time.perf_counter(), WorkCounts(), 0, []
+        comm = self.pair.comm
+        lam_n = self.lam.copy()
+        for k in range(1, self.max_iterations + 1):
+            its += self._equilibrium(lam_n, work)
+            g = self.pair.gaps(self.u)
+            dg = self.pair.tangential(self.u) - self.committed
+            stick = self.active & ~self.slip
+            opening = self.active & (self.lam < 0)
+            closing = ~self.active & (g < -1e-12 * self._length())
+            sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9))
+            holding = self.active & self.slip & (dg * self.s > 0)
+            scale = comm.allreduce(float(np.abs(self.lam).max(initial=0.0)), op=MPI.MAX)
+            drift = comm.allreduce(float(np.abs((self.lam - lam_n)[self.slip]).max(
+                initial=0.0)), op=MPI.MAX)
+            changes = comm.allreduce(int((opening | closing | sliding | holding).sum()))
+            history.append({"iteration": k, "active": comm.allreduce(int(self.active.sum())),
+                            "slip": comm.allreduce(int((self.active & self.slip).sum())),
+                            "changes": changes})
+            if changes == 0 and drift <= 1e-9 * max(scale, 1e-300):
+                self.history = history
+                return SolveResult(True, "converged", its, [], work, time.perf_counter() - t0,
+                                   active_set_iterations=k, history=history)
+            self.s = np.where(sliding, np.sign(self.lam_t), self.s)
+            self.slip = (self.slip & ~holding | sliding) & ~opening & ~closing
+            self.active = (self.active & ~opening) | closing
+            lam_n = self.lam.copy()
+        raise SolveError(f"the frictional statuses did not settle in {self.max_iterations} "
+                         "iterations")
+
+    def _equilibrium(self, lam_n: np.ndarray, work: WorkCounts) -> int:
+        """One saddle-point solve for the current statuses; the slip forces from `lam_n`."""
+        pair = self.pair
+        stick = np.flatnonzero(self.active & ~self.slip)
+        closed = np.flatnonzero(self.active)
+        sliding = np.flatnonzero(self.active & self.slip)
+        B = _stacked(pair.rows(closed), pair.rows(stick, tangential=True))
+        offset = np.concatenate([pair.gamma[closed], -self.committed[stick]])
+        forces = None
+        if self.pair.comm.allreduce(len(sliding)):
+            Bs = pair.rows(sliding, tangential=True)
+            forces = Bs.createVecRight()
+            Bs.multTranspose(_vec(Bs, self.f * lam_n[sliding] * self.s[sliding]), forces)
+        lam = self._saddle(B, offset, forces, work)[0]
+        self.lam[:] = 0.0
+        self.lam_t[:] = 0.0
+        self.lam[closed] = lam[: len(closed)]
+        self.lam_t[stick] = lam[len(closed):]
+        self.lam_t[sliding] = self.f * lam_n[sliding] * self.s[sliding]
+        return self._iterations
+
+
+def _stacked(top: PETSc.Mat, bottom: PETSc.Mat) -> PETSc.Mat:
+    """The rows of `top` over those of `bottom` (each rank's, in that order)."""
+    n_top, n_bottom = top.getLocalSize()[0], bottom.getLocalSize()[0]
+    B = PETSc.Mat().createAIJ(((n_top + n_bottom, None), top.getSizes()[1]), nnz=(6, 6),
+                              comm=top.comm)
+    B.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    start = B.getOwnershipRange()[0]
+    for offset, M in ((0, top), (n_top, bottom)):
+        first = M.getOwnershipRange()[0]
+        for i in range(M.getLocalSize()[0]):
+            cols, vals = M.getRow(first + i)
+            B.setValues(start + offset + i, cols, vals)
+    B.assemble()
+    return B

@@ -35,8 +35,8 @@ TWO_BODY_TAGS = ("upper_contact", "upper_top", "upper_axis", "lower_contact", "l
 
 
 def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = None,
-                   block: float = 4.0, fine: float = 20.0, growth: float = 0.05
-                   ) -> gmshio.MeshData:
+                   block: float = 4.0, fine: float = 20.0, growth: float = 0.05,
+                   both_sides: bool = False) -> gmshio.MeshData:
     """The upper quarter disc on the lower one (or on a block), touching at the origin.
 
     Args:
@@ -47,6 +47,8 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
         block: the block's size in R1.
         fine: a/h near the origin.
         growth: the elements' growth per unit distance beyond 1.5 a.
+        both_sides: the half discs on both sides of the axis (plane strain under a
+            tangential load: no ``upper_axis``, ``lower_axis``).
 
     Returns:
         The mesh with its cell tags (``upper`` 1, ``lower`` 2) and facet tags (module).
@@ -57,13 +59,19 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
     if comm.rank == 0:
         start_model("two_bodies")
         occ = gmsh.model.occ
+        k = 2 if both_sides else 1  # the rectangles' width, in radii
         upper = occ.intersect([(2, occ.addDisk(0, r1, 0, r1, r1))],
-                              [(2, occ.addRectangle(0, 0, 0, r1, r1))])[0]
+                              [(2, occ.addRectangle(-(k - 1) * r1, 0, 0, k * r1, r1))])[0]
         if r2 is None:
-            lower = [(2, occ.addRectangle(0, -depth, 0, width, depth))]
+            lower = [(2, occ.addRectangle(-(k - 1) * width, -depth, 0, k * width, depth))]
         else:
             lower = occ.intersect([(2, occ.addDisk(0, -r2, 0, r2, r2))],
-                                  [(2, occ.addRectangle(0, -r2, 0, r2, r2))])[0]
+                                  [(2, occ.addRectangle(-(k - 1) * r2, -r2, 0, k * r2, r2))])[0]
+        if both_sides:  # a vertex of each body at the origin (apart: they share no node)
+            upper = [e for e in occ.fragment(upper, [(0, occ.addPoint(0, 0, 0))])[0]
+                     if e[0] == 2]
+            lower = [e for e in occ.fragment(lower, [(0, occ.addPoint(0, 0, 0))])[0]
+                     if e[0] == 2]
         occ.synchronize()
         tol = 1e-6
         groups = {name: [] for name in TWO_BODY_TAGS}
@@ -71,7 +79,7 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
             _, curves = gmsh.model.getAdjacencies(dim, surface)
             for c in curves:
                 x, y, _ = occ.getCenterOfMass(1, c)
-                if abs(x) < tol:
+                if abs(x) < tol and not both_sides:
                     groups[f"{body}_axis"].append(c)
                 elif body == "upper":
                     groups["upper_top" if abs(y - r1) < tol else "upper_contact"].append(c)
