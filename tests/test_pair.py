@@ -130,19 +130,14 @@ def test_the_bearing_demo_is_hertz_at_light_load_then_leaves_it(demo):
     assert max(s["iterations"] for s in d["steps"]) <= 10
 
 
-def test_cattaneo_mindlin_between_two_identical_cylinders():
-    # two identical cylinders (R = 1, E = 1, ν = 0.3: identical materials uncouple the
-    # normal and tangential problems), f = 0.3, pressed (a = 0.058, Hertz to 0.03 %) then
-    # pulled sideways by their top: Q/(fP) = 0.34, 0.66, 0.82. The stick zone's half-width
-    # (half the span of the stuck nodes) against c = a √(1 − Q/(fP)): −0.0026, −0.0015,
-    # −0.0025 at h = a/12 (within a node spacing, the test's bound; −0.0012, −0.0001,
-    # −0.0012 at h/2); the stick zone shrinks as Q grows. Its centre is shifted by −0.0074
-    # (−0.0062 at h/2), the same at every load: the top is held, and the couple Q·R of the
-    # contact force and the top's reaction tilts the pressure (half-spaces have no such couple)
+def pulled_sideways(comm=MPI.COMM_WORLD):
+    """Two identical cylinders (R = 1, E = 1, ν = 0.3), f = 0.3, pressed then pulled
+    sideways by their top in three steps: each step's (Q, P, the stick zone's half-width),
+    the fitted a and the largest node spacing in the contact."""
     from fenics_nl.contact.pair import FrictionalPair
 
     R, a, E, nu, f, delta = 1.0, 0.1, 1.0, 0.3, 0.3, 0.012
-    d = sphere_on_body(MPI.COMM_WORLD, R, a, R2=R, both_sides=True)
+    d = sphere_on_body(comm, R, a, R2=R, both_sides=True)
 
     def tag(name):
         return d.facet_tags.find(d.physical_groups[name].tag)
@@ -162,16 +157,38 @@ def test_cattaneo_mindlin_between_two_identical_cylinders():
     r = np.abs(x[:, 0])
     _, a_fit = hertz.fitted_ellipse(r[r < 0.85 * r.max()], p[r < 0.85 * r.max()])
     spacing = float(np.diff(np.sort(x[:, 0])).max())
-    widths = []
+    steps = []
     for shift in (0.002, 0.004, 0.005):
         sideways.g.x.array[:] = shift
         contact.solve()
         contact.commit()
         Q, P = contact.force()
-        stuck = np.concatenate(MPI.COMM_WORLD.allgather(
-            pair.x[contact.active & ~contact.slip, 0]))
-        width = 0.5 * (stuck.max() - stuck.min())
+        stuck = np.concatenate(comm.allgather(pair.x[contact.active & ~contact.slip, 0]))
+        steps.append((Q, P, 0.5 * (stuck.max() - stuck.min())))
+    return steps, a_fit, spacing, f
+
+
+def test_cattaneo_mindlin_between_two_identical_cylinders():
+    # identical materials uncouple the normal and tangential problems; pressed (a = 0.058,
+    # Hertz to 0.03 %) then pulled sideways: Q/(fP) = 0.34, 0.66, 0.82. The stick zone's
+    # half-width (half the span of the stuck nodes) against c = a √(1 − Q/(fP)): −0.0026,
+    # −0.0015, −0.0025 at h = a/12 (within a node spacing, the test's bound; −0.0012,
+    # −0.0001, −0.0012 at h/2); the stick zone shrinks as Q grows. Its centre is shifted by
+    # −0.0074 (−0.0062 at h/2), the same at every load: the top is held, and the couple Q·R
+    # of the contact force and the top's reaction tilts the pressure (half-spaces have no
+    # such couple)
+    steps, a_fit, spacing, f = pulled_sideways()
+    for Q, P, width in steps:
         assert 0 < -Q < f * P
         assert width == pytest.approx(a_fit * np.sqrt(1 - abs(Q) / (f * P)), abs=spacing)
-        widths.append(width)
+    widths = [w for _, _, w in steps]
     assert widths[0] > widths[1] > widths[2]
+
+
+@pytest.mark.mpi
+def test_friction_on_a_pair_on_two_ranks_gives_the_serial_answer():
+    # the statuses are each rank's own slave nodes': the same forces and stick zones
+    assert MPI.COMM_WORLD.size > 1
+    parallel, serial = pulled_sideways()[0], pulled_sideways(MPI.COMM_SELF)[0]
+    for a, b in zip(parallel, serial, strict=True):
+        assert a == pytest.approx(b, rel=1e-8, abs=1e-12)
