@@ -41,7 +41,7 @@ from petsc4py import PETSc
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
-__all__ = ["ContactPair", "FrictionalPair", "PairContact", "PairState"]
+__all__ = ["ArchardWear", "ContactPair", "FrictionalPair", "PairContact", "PairState"]
 
 
 class ContactPair:
@@ -539,3 +539,50 @@ def _stacked(top: PETSc.Mat, bottom: PETSc.Mat) -> PETSc.Mat:
             B.setValues(start + offset + i, cols, vals)
     B.assemble()
     return B
+
+
+class ArchardWear:
+    """Archard's wear of the slave surface, integrated over the sliding distance.
+
+    The wear depth grows as dh = k p ds (k the wear coefficient over the hardness, p the
+    contact pressure, s the sliding distance), and moves the worn surface away: the gap of
+    each slave node grows by its wear, so that the pressure redistributes. Each step of
+    sliding Δs solves the contact at the current wear, then adds Δh_s = k λ_s Δs / A_s
+    (λ_s the node's normal force, A_s its area): the worn volume Σ Δh_s A_s is then
+    k Δs Σ λ_s = k F_n Δs exactly, a discrete identity of the integration.
+
+    The sliding is its distance per step, not a motion of the mesh: a pin sliding on a
+    long flat track meets the same flat everywhere (the track's own wear, spread over its
+    length, is left out).
+
+    Args:
+        contact: the pair's active set (`PairContact`), its slave surface the worn one.
+        k: the wear coefficient (volume per unit force and sliding distance).
+    """
+
+    def __init__(self, contact: PairContact, k: float):
+        if not k > 0:
+            raise ValueError(f"the wear coefficient must be > 0, got {k}")
+        self.contact, self.k = contact, k
+        self.depth = np.zeros(len(contact.pair.slave))  # each owned slave node's wear
+        self.volume = 0.0  # the worn volume so far (every rank's)
+        self.distance = 0.0
+
+    def slide(self, ds: float) -> SolveResult:
+        """The contact at the current wear, then the wear of a sliding distance `ds`.
+
+        Args:
+            ds: the sliding distance of the step.
+
+        Returns:
+            The contact solve's result.
+        """
+        result = self.contact.solve()
+        pair = self.contact.pair
+        areas = np.where(pair.areas > 0, pair.areas, 1.0)
+        dh = self.k * np.clip(self.contact.lam, 0.0, None) * ds / areas
+        self.depth += dh
+        pair.gamma += dh  # the worn slave surface moves away from the master
+        self.volume += pair.total(dh * pair.areas)
+        self.distance += ds
+        return result

@@ -28,7 +28,8 @@ from mpi4py import MPI
 
 from fenics_nl.domain.meshes import _graded_size_field, start_model
 
-__all__ = ["BEARING_TAGS", "TWO_BODY_TAGS", "shaft_in_bearing", "sphere_on_body"]
+__all__ = ["BEARING_TAGS", "PIN_TAGS", "TWO_BODY_TAGS", "pin_on_flat", "shaft_in_bearing",
+           "sphere_on_body"]
 
 TWO_BODY_TAGS = ("upper_contact", "upper_top", "upper_axis", "lower_contact", "lower_bottom",
                  "lower_axis", "lower_side")
@@ -181,6 +182,70 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
         coarser = field.add("Max")
         field.setNumbers(coarser, "FieldsList", [nearest, lower])
         field.setAsBackgroundMesh(coarser)
+        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
+            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        gmsh.model.mesh.generate(2)
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    data.mesh.geometry.x[:] *= unit
+    return data
+
+
+PIN_TAGS = ("pin_face", "pin_top", "pin_sides", "flat_top", "flat_bottom", "flat_sides")
+
+
+def pin_on_flat(comm: MPI.Comm, width: float, height: float, h: float,
+                flat: float = 4.0, growth: float = 0.2) -> gmshio.MeshData:
+    """A flat pin [−w/2, w/2] × [0, height] on a flat [−L, L] × [−L, 0] (plane strain).
+
+    Args:
+        comm: the communicator.
+        width: the pin's width w.
+        height: its height.
+        h: the element size along the pin's face and under it.
+        flat: the flat's half-width and depth L, in pin widths.
+        growth: the elements' growth per unit distance from the pin's face.
+
+    Returns:
+        The mesh with its cell tags (``pin`` 1, ``flat`` 2) and facet tags (`PIN_TAGS`).
+    """
+    unit = width
+    w, H, L, hh = 1.0, height / unit, flat, h / unit
+    if comm.rank == 0:
+        start_model("pin_on_flat")
+        occ = gmsh.model.occ
+        pin = occ.addRectangle(-w / 2, 0, 0, w, H)
+        base = occ.addRectangle(-L, -L, 0, 2 * L, L)
+        occ.synchronize()
+        tol = 1e-6
+        groups = {name: [] for name in PIN_TAGS}
+        for body, surface in (("pin", pin), ("flat", base)):
+            _, curves = gmsh.model.getAdjacencies(2, surface)
+            for c in curves:
+                _, y, _ = occ.getCenterOfMass(1, c)
+                if body == "pin":
+                    name = "pin_face" if abs(y) < tol else "pin_top" if abs(y - H) < tol \
+                        else "pin_sides"
+                else:
+                    name = "flat_top" if abs(y) < tol else "flat_bottom" \
+                        if abs(y + L) < tol else "flat_sides"
+                groups[name].append(c)
+        for i, (name, tags) in enumerate(groups.items(), start=1):
+            gmsh.model.addPhysicalGroup(1, tags, i, name=name)
+        gmsh.model.addPhysicalGroup(2, [pin], 1, name="pin")
+        gmsh.model.addPhysicalGroup(2, [base], 2, name="flat")
+        field = gmsh.model.mesh.field
+        dist = field.add("Distance")
+        field.setNumbers(dist, "CurvesList", groups["pin_face"])
+        field.setNumber(dist, "Sampling", 200)
+        thr = field.add("Threshold")
+        field.setNumber(thr, "InField", dist)
+        field.setNumber(thr, "SizeMin", hh)
+        field.setNumber(thr, "SizeMax", hh + growth * L)
+        field.setNumber(thr, "DistMin", 0.05)
+        field.setNumber(thr, "DistMax", L)
+        field.setAsBackgroundMesh(thr)
         for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
             gmsh.option.setNumber(f"Mesh.{opt}", 0)
         gmsh.model.mesh.generate(2)
