@@ -6,8 +6,9 @@ active-set iteration a saddle-point solve with the relative normal displacement 
 on the active slave nodes (`fenics_nl.contact.pair`). Hertz for two bodies: 1/E* =
 (1 − ν1²)/E1 + (1 − ν2²)/E2, 1/R = 1/R1 + 1/R2, the contact radius and the peak pressure of
 the force transmitted, fitted to the computed pressures (the ellipse p² = p0² (1 − r²/a²)
-through the active nodes but the outermost: the nodal pressures themselves are a node
-spacing coarse at the edge and the lumped area on the axis is off by O(h)).
+through the active nodes within 85 % of the outermost's radius: the nodal pressures
+themselves are a node spacing coarse at the edge and the lumped area on the axis is off by
+O(h)).
 """
 
 
@@ -80,7 +81,7 @@ def test_two_bodies_of_two_materials_are_hertz(model, R2):
     for key in ("contact_radius", "max_pressure"):
         assert run[key] == pytest.approx(run[f"{key}_hertz"], rel=0.015), (key, run)
     assert run["force"] == pytest.approx(run["reaction"], rel=1e-8)
-    assert run["newton"] == run["iterations"] and run["nodes"] >= 10
+    assert run["newton"] == run["iterations"] <= 8 and run["nodes"] >= 10
 
 
 def test_code_aster_ssnv104_two_hemispheres():

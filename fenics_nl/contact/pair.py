@@ -149,7 +149,7 @@ def _master_segments(V, facets) -> dict:
     vod = vertex_of_dof(V)
     dof_of_vertex[vod[vod >= 0]] = np.nonzero(vod >= 0)[0]
     rows = []
-    geometry = msh.geometry.x
+    msh.topology.create_connectivity(fdim + 1, 0)
     c2v = msh.topology.connectivity(fdim + 1, 0)
     for f in facets:
         v0, v1 = f2v.links(f)
@@ -157,8 +157,8 @@ def _master_segments(V, facets) -> dict:
         p0, p1 = x[d0, :2], x[d1, :2]
         t = p1 - p0
         n = np.array([t[1], -t[0]]) / np.linalg.norm(t)
-        cell = f2c.links(f)[0]
-        centre = geometry[c2v.links(cell), :2].mean(axis=0)
+        cell = f2c.links(f)[0]  # its vertices' coordinates: P1 dofs (not geometry.x,
+        centre = x[dof_of_vertex[c2v.links(cell)], :2].mean(axis=0)  # numbered apart)
         if np.dot(n, 0.5 * (p0 + p1) - centre) < 0:
             n = -n
         g0, g1 = imap.local_to_global(np.array([d0, d1], dtype=np.int32))
@@ -172,6 +172,7 @@ def _master_segments(V, facets) -> dict:
 def _project(points: np.ndarray, segments: dict):
     """Each point's closest master segment: (its index, ξ, the normal, the gap γ)."""
     p0, p1, normals = segments["p0"], segments["p1"], segments["normal"]
+    nodes = np.sort(segments["nodes"], axis=1)
     t = p1 - p0
     length2 = np.einsum("ij,ij->i", t, t)
     facet = np.zeros(len(points), dtype=np.int64)
@@ -180,7 +181,10 @@ def _project(points: np.ndarray, segments: dict):
         s = np.clip(np.einsum("ij,ij->i", x - p0, t) / length2, 0.0, 1.0)
         closest = p0 + s[:, None] * t
         d = np.linalg.norm(x - closest, axis=1)
-        k = int(np.argmin(d))  # at a vertex two segments tie: either (small sliding)
+        # at a master vertex two segments tie: the one of the lowest global nodes, so that
+        # the choice does not depend on the order of the ranks' segments
+        near = np.flatnonzero(d <= d.min() + 1e-12 * np.sqrt(length2.max()))
+        k = int(near[np.lexsort((nodes[near, 1], nodes[near, 0]))[0]])
         facet[i], xi[i] = k, s[k]
     closest = p0[facet] + xi[:, None] * t[facet]
     normal = normals[facet]
@@ -225,22 +229,22 @@ class PairContact:
         u: the displacement (P1, 2D).
         bcs: the Dirichlet conditions.
         pair: the contact pair.
-        rtol: Newton's relative tolerance on ‖R‖.
-        atol: its absolute tolerance (times `force_scale`).
+        atol: Newton's tolerance on ‖R‖ (times `force_scale`); the gaps of the active
+            nodes to 1e-12 of the bodies' size.
         force_scale: the scale of the forces (the load).
         max_it: Newton iterations per active-set iteration.
         max_iterations: active-set iterations before giving up.
     """
 
-    def __init__(self, residual, u, bcs, pair: ContactPair, *, rtol: float = 1e-10,
+    def __init__(self, residual, u, bcs, pair: ContactPair, *,
                  atol: float = 1e-10, force_scale: float = 1.0, max_it: int = 20,
                  max_iterations: int = 50):
         self.u, self.bcs, self.pair = u, list(bcs), pair
         self.F = fem.form(residual)
         self.J = fem.form(ufl.derivative(residual, u))
-        self.rtol, self.atol, self.scale = rtol, atol * force_scale, force_scale
+        self.atol, self.scale = atol * force_scale, force_scale
         self.max_it, self.max_iterations = max_it, max_iterations
-        self.active = pair.gamma <= 0.0  # touching in the reference configuration
+        self.active = pair.gamma <= 1e-12 * self._length()  # touching at the start
         self.lam = np.zeros(len(pair.slave))
         dofs = np.concatenate([bc.dof_indices()[0] for bc in self.bcs]) if self.bcs else \
             np.zeros(0, dtype=np.int32)
@@ -350,8 +354,9 @@ class PairContact:
             g = B.createVecLeft()
             B.mult(u.x.petsc_vec, g)
             g.array[:] += offset
-            norm = np.sqrt(R.norm() ** 2 + g.norm() ** 2)
-            if norm <= self.atol and it > 1:
+            norm = R.norm()
+            closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self._length()
+            if norm <= self.atol and closed and it > 1:
                 self._iterations = it - 1
                 return (lam,)
             K = petsc.assemble_matrix(self.J, self.bcs)
@@ -361,7 +366,7 @@ class PairContact:
             u.x.petsc_vec.axpy(-1.0, du)
             u.x.scatter_forward()
             lam -= dlam
-            if norm <= self.atol:
+            if norm <= self.atol and closed:
                 self._iterations = it
                 return (lam,)
         raise SolveError(f"contact pair: Newton did not converge in {self.max_it} iterations "
@@ -579,7 +584,7 @@ class ArchardWear:
         """
         result = self.contact.solve()
         pair = self.contact.pair
-        areas = np.where(pair.areas > 0, pair.areas, 1.0)
+        areas = np.where(pair.areas > 0, pair.areas, np.inf)  # a node of no area: no wear
         dh = self.k * np.clip(self.contact.lam, 0.0, None) * ds / areas
         self.depth += dh
         pair.gamma += dh  # the worn slave surface moves away from the master
