@@ -30,10 +30,9 @@ from dataclasses import dataclass, field
 import ufl
 
 from fenics_nl.expression import Expression
-from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain
 from fenics_nl.materials.plasticity import (
-    StressAtPoints,
+    StateAtPoints,
     cell_max,
     hookes_tangent,
     quadrature_spaces,
@@ -102,7 +101,7 @@ class ViscousState:
 
 
 @dataclass(frozen=True, eq=False)
-class ViscousLaw(StressAtPoints, Isotropic, SmallStrain):
+class ViscousLaw(StateAtPoints, Isotropic, SmallStrain):
     """What Norton's and Perzyna's laws share: the state, the time step, σ, the commit.
 
     A law gives `return_map` (its inelastic strain after the step) and `dissipated` (the
@@ -114,15 +113,6 @@ class ViscousLaw(StressAtPoints, Isotropic, SmallStrain):
                                 compare=False)
 
     path_dependent = True
-
-    def bind(self, mesh, degree: int) -> None:
-        """Create the state (zero) at the quadrature points of `degree` on `mesh`.
-
-        Args:
-            mesh: the mesh.
-            degree: the quadrature degree (the residual's rule).
-        """
-        self.state.bind(mesh, degree)
 
     def _bound(self) -> ViscousState:
         if self.state.eps_v is None:
@@ -280,28 +270,18 @@ class ViscousLaw(StressAtPoints, Isotropic, SmallStrain):
         """
         return hookes_tangent(self, u, model, dx)
 
-    def commit(self, u, model: str = "3d") -> None:
-        """Store the step's viscous state of the displacement `u` (a converged step), and σ_eq.
-
-        The update is compiled for the first `u` given: one displacement per bound material.
-
-        Args:
-            u: the displacement.
-            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
-        """
-        self.commit_strain(kinematics.small_strain(u, model))
-
     def commit_strain(self, strain) -> None:
-        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
+        """Store the step's viscous state of a 3x3 strain expression, and σ_eq (`commit`).
+
+        Plane stress: `plane_stress.whole_strain`.
 
         Args:
             strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
         """
         st = self._bound()
         if st.commit is None:  # compiled once
-            eps = strain
-            eps_v, p, _, _ = self.return_map(eps)
-            s = 2 * self.mu * ufl.dev(eps - eps_v)
+            eps_v, p, _, _ = self.return_map(strain)
+            s = 2 * self.mu * ufl.dev(strain - eps_v)
             st.commit = tuple(Expression(e, st.points)
                               for e in (eps_v, p, ufl.sqrt(1.5 * ufl.inner(s, s))))
         store_at_points((st.eps_v, st.p, st.q), st.commit)

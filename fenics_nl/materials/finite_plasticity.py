@@ -221,15 +221,6 @@ class FiniteJ2Plasticity(QuadratureStateOutputs, Isotropic, FiniteStrain):
 
     # the step's return and energy
 
-    def bind(self, mesh, degree: int) -> None:
-        """Create the virgin state at the quadrature points of `degree` on `mesh`.
-
-        Args:
-            mesh: the mesh.
-            degree: the quadrature degree (the residual's rule).
-        """
-        self.state.bind(mesh, degree)
-
     def _bound(self) -> FiniteStrainState:
         if self.state.metric is None:
             raise ValueError("FiniteJ2Plasticity has no state: call bind(mesh, quadrature "

@@ -124,12 +124,34 @@ def quadrature_spaces(mesh, degree: int):
         cell, value_shape=shape, scheme="default", degree=degree)) for shape in ((3, 3), ()))
 
 
-class StressAtPoints:
-    """σ_eq per cell of a law whose state lives at the quadrature points.
+class StateAtPoints:
+    """A law whose state lives at the quadrature points: bound, committed, read there.
 
-    J2 and the viscous laws: evaluated there, where the state is, and averaged over each
+    J2 (small and finite strain) and the viscous laws: `bind` creates the law's `state` on
+    a mesh; a small-strain law's `commit` stores the state of ε(u) by its `commit_strain`;
+    σ_eq per cell is evaluated at the points, where the state is, and averaged over each
     cell.
     """
+
+    def bind(self, mesh, degree: int) -> None:
+        """Create the state (zero) at the quadrature points of `degree` on `mesh`.
+
+        Args:
+            mesh: the mesh.
+            degree: the quadrature degree (the residual's rule).
+        """
+        self.state.bind(mesh, degree)
+
+    def commit(self, u, model: str = "3d") -> None:
+        """Store the step's state of the displacement `u` (a converged step).
+
+        The update is compiled for the first `u` given: one displacement per bound material.
+
+        Args:
+            u: the displacement.
+            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
+        """
+        self.commit_strain(kinematics.small_strain(u, model))
 
     def quadrature_space(self):
         """The law's scalar quadrature space (where its state is)."""
@@ -170,7 +192,7 @@ class StressAtPoints:
         return self.cell_mean(self.von_mises_expression(u, model), "von_mises")
 
 
-class QuadratureStateOutputs(StressAtPoints):
+class QuadratureStateOutputs(StateAtPoints):
     """Per-cell outputs of a law whose state lives at the quadrature points.
 
     J2 at small and finite strain: the law has `cumulated_plastic_strain`, a quadrature
@@ -238,15 +260,6 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
             value = float(getattr(self, name))
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be >= 0 and finite, got {getattr(self, name)!r}")
-
-    def bind(self, mesh, degree: int) -> None:
-        """Create the state (zero) at the quadrature points of `degree` on `mesh`.
-
-        Args:
-            mesh: the mesh.
-            degree: the quadrature degree (the residual's rule).
-        """
-        self.state.bind(mesh, degree)
 
     def modified_newton_tangent(self, u, model: str, dx):
         """The course's choice for plasticity: Hooke's tangent (E, ν), factorized once.
@@ -437,17 +450,6 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         rest = (self.mu * ufl.inner(d, d) + 0.5 * self.H * p**2
                 + self.C / 3.0 * ufl.inner(eps_p, eps_p) + self.sigma0 * dp)
         return rest, ufl.tr(eps), self.kappa
-
-    def commit(self, u, model: str = "3d") -> None:
-        """Store the return-mapped state of the displacement `u` (a converged step).
-
-        The update is compiled for the first `u` given: one displacement per bound material.
-
-        Args:
-            u: the displacement.
-            model: the kinematic model ("3d", "plane_strain" or "axisymmetric").
-        """
-        self.commit_strain(kinematics.small_strain(u, model))
 
     def commit_strain(self, strain) -> None:
         """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
