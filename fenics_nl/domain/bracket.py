@@ -23,7 +23,7 @@ from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 from fenics_nl.domain.mesh_check import check_cells
-from fenics_nl.domain.meshes import start_model
+from fenics_nl.domain.meshes import distributed, start_model
 
 __all__ = ["THICK", "bracket_mesh", "build"]
 
@@ -102,10 +102,7 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
     else:
         if comm.rank == 0:
             build(size)
-        data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-        if comm.rank == 0:
-            gmsh.model.remove()
-        data.mesh.geometry.x[:] *= length_scale
+        data = distributed(comm, length_scale, 3)
     missing = [g for g in GROUPS if g not in data.physical_groups]
     if missing:
         raise ValueError(f"the mesh has no physical group {', '.join(missing)} "

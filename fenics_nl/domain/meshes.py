@@ -6,8 +6,8 @@ import gmsh
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-__all__ = ["PUNCH_GROWTH", "graded_block", "punch_block", "punch_block_size", "quarter_annulus",
-           "start_model"]
+__all__ = ["PUNCH_GROWTH", "distributed", "graded_block", "punch_block", "punch_block_size",
+           "quarter_annulus", "size_by_field", "start_model", "threshold_field"]
 
 
 def start_model(name: str) -> None:
@@ -23,20 +23,70 @@ def start_model(name: str) -> None:
     gmsh.model.add(name)
 
 
-def _graded_size_field(h_fine: float, fine_radius: float, h_coarse: float, far: float):
-    """Element size h_fine within `fine_radius` of the origin, growing linearly to h_coarse."""
-    f_dist = gmsh.model.mesh.field.add("Distance")
-    origin = gmsh.model.getEntitiesInBoundingBox(-1e-9, -1e-9, -1e-9, 1e-9, 1e-9, 1e-9, 0)
-    gmsh.model.mesh.field.setNumbers(f_dist, "PointsList", [tag for _, tag in origin])
-    f_thr = gmsh.model.mesh.field.add("Threshold")
-    gmsh.model.mesh.field.setNumber(f_thr, "InField", f_dist)
-    gmsh.model.mesh.field.setNumber(f_thr, "SizeMin", h_fine)
-    gmsh.model.mesh.field.setNumber(f_thr, "SizeMax", h_coarse)
-    gmsh.model.mesh.field.setNumber(f_thr, "DistMin", fine_radius)
-    gmsh.model.mesh.field.setNumber(f_thr, "DistMax", far)
-    gmsh.model.mesh.field.setAsBackgroundMesh(f_thr)
+def threshold_field(h_fine: float, fine_radius: float, h_coarse: float, far: float, *,
+                    points=(), curves=(), sampling: int = 400) -> int:
+    """A gmsh size field: h_fine near points or curves, growing linearly to h_coarse.
+
+    gmsh's Distance and Threshold: h_fine within `fine_radius`, h_coarse from `far` on.
+
+    Args:
+        h_fine: the size near them.
+        fine_radius: the distance within which it is h_fine.
+        h_coarse: the size from `far` on.
+        far: the distance from which it is h_coarse.
+        points: the gmsh points (tags) the distance is measured from.
+        curves: the gmsh curves (tags) the distance is measured from.
+        sampling: the points per curve the distance is measured at.
+
+    Returns:
+        The field's tag.
+    """
+    field = gmsh.model.mesh.field
+    dist = field.add("Distance")
+    if points:
+        field.setNumbers(dist, "PointsList", list(points))
+    if curves:
+        field.setNumbers(dist, "CurvesList", list(curves))
+        field.setNumber(dist, "Sampling", sampling)
+    thr = field.add("Threshold")
+    field.setNumber(thr, "InField", dist)
+    field.setNumber(thr, "SizeMin", h_fine)
+    field.setNumber(thr, "SizeMax", h_coarse)
+    field.setNumber(thr, "DistMin", fine_radius)
+    field.setNumber(thr, "DistMax", far)
+    return thr
+
+
+def size_by_field(tag: int) -> None:
+    """Mesh by the size field `tag` alone (not the points' sizes, boundary's, curvature's)."""
+    gmsh.model.mesh.field.setAsBackgroundMesh(tag)
     for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
         gmsh.option.setNumber(f"Mesh.{opt}", 0)
+
+
+def distributed(comm: MPI.Comm, unit: float, dim: int = 2) -> gmshio.MeshData:
+    """The model meshed on rank 0, distributed, removed from gmsh, scaled back by `unit`.
+
+    Args:
+        comm: the communicator.
+        unit: the length gmsh worked in (its tolerances are absolute).
+        dim: the geometric dimension.
+
+    Returns:
+        DOLFINx's mesh with its tags.
+    """
+    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    data.mesh.geometry.x[:] *= unit
+    return data
+
+
+def _graded_size_field(h_fine: float, fine_radius: float, h_coarse: float, far: float):
+    """Element size h_fine within `fine_radius` of the origin, growing linearly to h_coarse."""
+    origin = gmsh.model.getEntitiesInBoundingBox(-1e-9, -1e-9, -1e-9, 1e-9, 1e-9, 1e-9, 0)
+    size_by_field(threshold_field(h_fine, fine_radius, h_coarse, far,
+                                  points=[tag for _, tag in origin]))
 
 
 def graded_block(comm: MPI.Comm, dim: int, width: float, depth: float, h_fine: float,
@@ -178,8 +228,4 @@ def quarter_annulus(comm: MPI.Comm, a: float, b: float, size: float, order: int 
         gmsh.model.addPhysicalGroup(2, [surface], 1, name="body")
         gmsh.option.setNumber("Mesh.ElementOrder", order)
         gmsh.model.mesh.generate(2)
-    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    if comm.rank == 0:
-        gmsh.model.remove()
-    data.mesh.geometry.x[:] *= a
-    return data
+    return distributed(comm, a)

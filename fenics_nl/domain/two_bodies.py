@@ -26,7 +26,13 @@ import gmsh
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-from fenics_nl.domain.meshes import _graded_size_field, start_model
+from fenics_nl.domain.meshes import (
+    _graded_size_field,
+    distributed,
+    size_by_field,
+    start_model,
+    threshold_field,
+)
 
 __all__ = ["BEARING_TAGS", "PIN_TAGS", "TWO_BODY_TAGS", "pin_on_flat", "shaft_in_bearing",
            "sphere_on_body"]
@@ -97,11 +103,7 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
         far = max(width, depth, r1, r2 or 0.0)
         _graded_size_field(a / fine / unit, 1.5, a / fine / unit + growth * far, far)
         gmsh.model.mesh.generate(2)
-    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    if comm.rank == 0:
-        gmsh.model.remove()
-    data.mesh.geometry.x[:] *= unit
-    return data
+    return distributed(comm, unit)
 
 
 BEARING_TAGS = ("shaft_surface", "shaft_symmetry", "hub", "bore", "housing_outer",
@@ -163,33 +165,15 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
         gmsh.model.addPhysicalGroup(2, [shaft[0][1]], 1, name="shaft")
         gmsh.model.addPhysicalGroup(2, [housing[0][1]], 2, name="housing")
         field = gmsh.model.mesh.field
-        fields = []
-        for curves, size in ((groups["shaft_surface"], hh), (groups["bore"], hh)):
-            dist = field.add("Distance")
-            field.setNumbers(dist, "CurvesList", curves)
-            field.setNumber(dist, "Sampling", 400)
-            thr = field.add("Threshold")
-            field.setNumber(thr, "InField", dist)
-            field.setNumber(thr, "SizeMin", size)
-            field.setNumber(thr, "SizeMax", size + growth * r3)
-            field.setNumber(thr, "DistMin", 2 * hh)
-            field.setNumber(thr, "DistMax", r3)
-            fields.append(thr)
-        nearest = field.add("Min")
-        field.setNumbers(nearest, "FieldsList", fields)
-        lower = field.add("MathEval")  # fine on the lower halves only
+        near = threshold_field(hh, 2 * hh, hh + growth * r3, r3,
+                               curves=groups["shaft_surface"] + groups["bore"])
+        lower = field.add("MathEval")  # fine within 60° of the lowest points only
         field.setString(lower, "F", f"{hh} + {growth} * max(y + 0.5, 0)")
         coarser = field.add("Max")
-        field.setNumbers(coarser, "FieldsList", [nearest, lower])
-        field.setAsBackgroundMesh(coarser)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        field.setNumbers(coarser, "FieldsList", [near, lower])
+        size_by_field(coarser)
         gmsh.model.mesh.generate(2)
-    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    if comm.rank == 0:
-        gmsh.model.remove()
-    data.mesh.geometry.x[:] *= unit
-    return data
+    return distributed(comm, unit)
 
 
 PIN_TAGS = ("pin_face", "pin_top", "pin_sides", "flat_top", "flat_bottom", "flat_sides")
@@ -235,22 +219,7 @@ def pin_on_flat(comm: MPI.Comm, width: float, height: float, h: float,
             gmsh.model.addPhysicalGroup(1, tags, i, name=name)
         gmsh.model.addPhysicalGroup(2, [pin], 1, name="pin")
         gmsh.model.addPhysicalGroup(2, [base], 2, name="flat")
-        field = gmsh.model.mesh.field
-        dist = field.add("Distance")
-        field.setNumbers(dist, "CurvesList", groups["pin_face"])
-        field.setNumber(dist, "Sampling", 200)
-        thr = field.add("Threshold")
-        field.setNumber(thr, "InField", dist)
-        field.setNumber(thr, "SizeMin", hh)
-        field.setNumber(thr, "SizeMax", hh + growth * L)
-        field.setNumber(thr, "DistMin", 0.05)
-        field.setNumber(thr, "DistMax", L)
-        field.setAsBackgroundMesh(thr)
-        for opt in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
-            gmsh.option.setNumber(f"Mesh.{opt}", 0)
+        size_by_field(threshold_field(hh, 0.05, hh + growth * L, L,
+                                      curves=groups["pin_face"], sampling=200))
         gmsh.model.mesh.generate(2)
-    data = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    if comm.rank == 0:
-        gmsh.model.remove()
-    data.mesh.geometry.x[:] *= unit
-    return data
+    return distributed(comm, unit)
