@@ -72,7 +72,11 @@ class ContactPair:
         self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
         self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
         self.B = self.rows(np.arange(len(self.slave)))
+        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
         self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
+        # the bodies' size: what a gap is small against (round-off)
+        self.length = self.comm.allreduce(float(np.ptp(msh.geometry.x, axis=0).max()),
+                                          op=MPI.MAX)
 
     @property
     def size(self) -> int:
@@ -110,8 +114,6 @@ class ContactPair:
 
     def tangential(self, u: fem.Function) -> np.ndarray:
         """The relative tangential displacement (u_s − u_m)·t at this rank's slave nodes."""
-        if not hasattr(self, "Bt"):
-            self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
         g = self.Bt.createVecLeft()
         self.Bt.mult(u.x.petsc_vec, g)
         return g.array.copy()
@@ -244,7 +246,7 @@ class PairContact:
         self.J = fem.form(ufl.derivative(residual, u))
         self.atol, self.scale = atol * force_scale, force_scale
         self.max_it, self.max_iterations = max_it, max_iterations
-        self.active = pair.gamma <= 1e-12 * self._length()  # touching at the start
+        self.active = pair.gamma <= 1e-12 * self.pair.length  # touching at the start
         self.lam = np.zeros(len(pair.slave))
         dofs = np.concatenate([bc.dof_indices()[0] for bc in self.bcs]) if self.bcs else \
             np.zeros(0, dtype=np.int32)
@@ -270,7 +272,7 @@ class PairContact:
             its += self.equilibrium(self.active, work)
             g = self.pair.gaps(self.u)
             leave = self.active & (self.lam < 0)
-            join = ~self.active & (g < -1e-12 * self._length())
+            join = ~self.active & (g < -1e-12 * self.pair.length)
             changes = self.pair.comm.allreduce(int(leave.sum() + join.sum()))
             history.append({"iteration": k, "active": self.pair.comm.allreduce(
                 int(self.active.sum())), "leave": self.pair.comm.allreduce(int(leave.sum())),
@@ -288,10 +290,6 @@ class PairContact:
             seen.add(key)
             self.active = new
         raise SolveError(f"the active set did not settle in {self.max_iterations} iterations")
-
-    def _length(self) -> float:
-        x = self.pair.mesh.geometry.x
-        return self.pair.comm.allreduce(float(np.ptp(x, axis=0).max()), op=MPI.MAX)
 
     def state(self) -> PairState:
         """Statuses, forces and pressures at this rank's owned slave nodes."""
@@ -355,7 +353,7 @@ class PairContact:
             B.mult(u.x.petsc_vec, g)
             g.array[:] += offset
             norm = R.norm()
-            closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self._length()
+            closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self.pair.length
             if norm <= self.atol and closed and it > 1:
                 self._iterations = it - 1
                 return (lam,)
@@ -487,7 +485,7 @@ class FrictionalPair(PairContact):
             dg = self.pair.tangential(self.u) - self.committed
             stick = self.active & ~self.slip
             opening = self.active & (self.lam < 0)
-            closing = ~self.active & (g < -1e-12 * self._length())
+            closing = ~self.active & (g < -1e-12 * self.pair.length)
             sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9))
             holding = self.active & self.slip & (dg * self.s > 0)
             scale = comm.allreduce(float(np.abs(self.lam).max(initial=0.0)), op=MPI.MAX)
