@@ -97,8 +97,8 @@ class Bearing(Parameters):
                          "the last step", unit="length", above=0)
     steps: int = number(6, "load steps, the push growing geometrically from push/100",
                         at_least=2)
-    size: float = number(0.025, "element size along the lower halves of the shaft's surface "
-                         "and the bore", unit="length", above=0)
+    size: float = number(0.025, "element size along the shaft's surface and the bore within "
+                         "60° of their lowest points", unit="length", above=0)
 
     def check(self):
         if not self.outer_radius > self.radius + self.clearance:
@@ -114,7 +114,7 @@ R1, c = args.radius, args.clearance
 # The half $x \ge 0$ of both bodies (the load is along the symmetry line), from gmsh
 # (`shaft_in_bearing`): cell tags `shaft` and `housing`, facet tags `shaft_surface` (the
 # slave), `bore` (the master), `hub`, `housing_outer`, and the symmetry lines; triangles
-# of `--size` along the lower halves of both surfaces, where the arc grows.
+# of `--size` along both surfaces within 60° of their lowest points, where the arc grows.
 
 # +
 mesh_data = shaft_in_bearing(comm, R1, c, args.outer_radius, args.size)

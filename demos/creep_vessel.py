@@ -393,11 +393,13 @@ def plot():
 
 
 def picture():
-    """The cumulated viscous strain on the deformed quarter."""
-    plasticity_pictures.creep_vessel_picture(
-        displacement_now(), material.output_fields()[0], args.png,
-        f"{shape}, n = {args.n:g}: time {times[-1]:.4g} = {times[-1] / tau:.3g} relaxation "
-        f"times, hoop stress at the bore {bore_hoop[-1] / p:.3f} p")
+    """The cumulated viscous strain (each cell's largest) on the deformed quarter."""
+    from fenics_nl.plots.deformed import deformed_picture
+
+    deformed_picture(displacement_now(), material.output_fields()[0], args.png,
+                     f"{shape}, n = {args.n:g}: time {times[-1]:.4g} = {times[-1] / tau:.3g} "
+                     f"relaxation times, hoop stress at the bore {bore_hoop[-1] / p:.3f} p",
+                     label="cumulated viscous strain", axes=("x (length)", "y (length)"))
     say(f"wrote {args.png}")
 
 

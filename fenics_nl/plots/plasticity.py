@@ -9,8 +9,7 @@ the die's force against the height reduction with the homogeneous compression an
 method (`upsetting_force_curve`). `demos/pressure_vessel.py` and `demos/upsetting.py` draw
 them. And the vessel creeping under a held pressure (`demos/creep_vessel.py`): its stress
 profiles at several times against Lamé's and the stationary closed form, the bore's stresses
-and displacement against time (`creep_vessel_figure`), the cumulated viscous strain on the
-deformed quarter (`creep_vessel_picture`).
+and displacement against time (`creep_vessel_figure`).
 """
 
 from __future__ import annotations
@@ -24,8 +23,8 @@ from mpi4py import MPI
 from fenics_nl.plots import deformed, figures
 from fenics_nl.theory import vessels
 
-__all__ = ["VesselRun", "billet_picture", "creep_vessel_figure", "creep_vessel_picture",
-           "upsetting_force_curve", "vessel_plastic_zone", "vessel_pressure_curve"]
+__all__ = ["VesselRun", "billet_picture", "creep_vessel_figure", "upsetting_force_curve",
+           "vessel_plastic_zone", "vessel_pressure_curve"]
 
 
 @dataclass
@@ -276,20 +275,3 @@ def creep_vessel_figure(shape: str, a: float, b: float, p: float, n: float, tau:
                  f"(bore σ_θθ {bore_hoop[-1] / p:.3f} p, stationary {final[1][0] / p:.3f} p)",
                  fontsize=11)
     figures.save_figure(fig, path)
-
-
-def creep_vessel_picture(displacement: fem.Function, viscous_strain_per_cell: fem.Function,
-                         path: str, title: str) -> None:
-    """The deformed quarter coloured by each cell's largest cumulated viscous strain.
-
-    Collective; rank 0 writes `path`.
-
-    Args:
-        displacement: u (a Function of its own space).
-        viscous_strain_per_cell: p, each cell's largest (DG0).
-        path: the PNG.
-        title: the picture's title.
-    """
-    deformed.deformed_picture(displacement, viscous_strain_per_cell, path, title,
-                              label="cumulated viscous strain",
-                              axes=("x (length)", "y (length)"))

@@ -159,7 +159,6 @@ class _Steps:
     def __init__(self, solver, law):
         self.x = solver.u.x.petsc_vec
         self.saved = self.x.copy()
-        self.law = law
         self.functions = [*law.state_functions().values(), law.equivalent_stress]
         self.eps_v, self.q = law.viscous_strain, law.equivalent_stress
         self.owned = self.eps_v.function_space.dofmap.index_map.size_local
