@@ -234,7 +234,8 @@ solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 # ### Against Hertz
 #
 # The lightest step against Hertz for its force (a and $p_0$ fitted to the computed
-# pressures: $p^2 = p_0^2(1 - s^2/a^2)$ over the nodes in contact but the outermost), and
+# pressures: $p^2 = p_0^2(1 - s^2/a^2)$ over the nodes in contact within 85 % of the
+# outermost's arc length), and
 # how far the heaviest has left it. The nodal pressures jump by 10 to 20 % where the two
 # surfaces' nodes come in and out of line (every ~2.2 of arc here): node-to-segment
 # contact with the same element size on both; the light loads' arcs are shorter than that
