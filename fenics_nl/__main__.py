@@ -89,7 +89,7 @@ def main(argv=None) -> int:
     built = time.perf_counter() - t0  # the mesh, the spaces, the forms' UFL
     n, ranks = len(case.factors), MPI.COMM_WORLD.size
     say(f"{case.path.name}: {case.model}, P{case.degree}, {problem.dofs} unknowns, "
-        f"{case.law}, " + (f"arc-length to load factor {case.arc['target']:g}" if case.arc
+        f"{case.law_name}, " + (f"arc-length to load factor {case.arc['target']:g}" if case.arc
                             else f"in time to {case.time['end']:g}"
                             + (", steps sized by their error" if case.time["adaptive"]
                                else f", {case.time['steps']} equal steps")
@@ -102,7 +102,7 @@ def main(argv=None) -> int:
     def solve():
         from fenics_nl.case.run import solve_case, write_outputs
 
-        cli.known(case=str(case.path), model=case.model, law=case.law, dofs=problem.dofs)
+        cli.known(case=str(case.path), model=case.model, law=case.law_name, dofs=problem.dofs)
         # a run that fails still draws its converged steps (the last converged state)
         cli.on_failure(lambda failed: write_outputs(problem, failed, args.png, args.plot))
         out = solve_case(problem, checkpoint=args.checkpoint,

@@ -865,12 +865,17 @@ def rewound(folder):
     return steps[-2]
 
 
-@pytest.mark.parametrize("case", ["contact", "plane-stress j2"])
+@pytest.mark.parametrize("case", ["contact", "frictional pair", "plane-stress j2"])
 def test_a_restart_with_contact_or_a_mixed_unknown_is_the_same_path(tmp_path, demo, case):
-    # the Hertz punch (the active set and its warm start) and the plane-stress J2 plate (a
-    # mixed unknown with ε_zz; adaptive steps grown by the driver) restarted one step short
+    # the Hertz punch (the active set and its warm start), the ball on the block with
+    # friction (a pair's statuses, forces and committed slip) and the plane-stress J2 plate
+    # (a mixed unknown with ε_zz; adaptive steps grown by the driver) restarted a step short
     if case == "contact":
         path = CASES / "hertz_punch.toml"
+    elif case == "frictional pair":
+        write(tmp_path, "ball_on_block.geo", (CASES / "ball_on_block.geo").read_text())
+        path = write(tmp_path, "ball.toml", (CASES / "ball_on_block.toml").read_text().replace(
+            "friction = 0.0", "friction = 0.3"))
     else:
         write(tmp_path, "plate.geo", PLATE_GEO)
         path = write(tmp_path, "plate.toml", PLATE.replace("steps = 4", "steps = 3"))

@@ -13,6 +13,7 @@ O(h)).
 
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -247,3 +248,68 @@ def test_a_pin_wears_to_the_uniform_pressure_and_the_worn_volume_is_k_f_s():
     assert volume == pytest.approx(kFs, rel=1e-10)
     (_, _), (x_fine, p_fine) = worn_pin(80)[0]
     assert np.array_equal(x, x_fine) and np.abs(p - p_fine).max() < 0.01
+
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+
+def test_a_case_file_of_two_bodies_is_hertz(demo):
+    # cases/ball_on_block.toml: the sphere on the block above, as a case file ([[material]]
+    # per cell group, a [[contact]] pair), its mesh h = a/20 at the contact. For the force
+    # the pair reports: the largest radius in contact −0.0043 (0.9 h) from Hertz's a, the
+    # largest nodal pressure (on the axis) −1.2 % from p0: bounded by one node spacing and
+    # 2 % (the nodal values, not the fitted ellipse of the tests above); the multipliers'
+    # force is the push's reaction and the block's support's (1e-8)
+    d = demo.case(CASES / "ball_on_block.toml")
+    pair = d["contact_pairs"][0]
+    assert (pair["slave"], pair["master"]) == ("ball_surface", "block_top")
+    force = pair["force"][1]
+    assert -d["reactions"]["ball_equator"][1] == pytest.approx(force, rel=1e-8)
+    assert d["reactions"]["block_bottom"][1] == pytest.approx(force, rel=1e-8)
+    ref = hertz.sphere_from_force(hertz.pair_modulus(3.0, 0.2, 1.0, 0.35), 0.0, 1.0, force)
+    assert abs(pair["contact_radius"] - ref["contact_radius"]) < 0.1 / 20
+    assert pair["max_pressure"] == pytest.approx(ref["max_pressure"], rel=0.02)
+    assert pair["nodes_in_contact"] >= 15
+    assert all(s["active_set_iterations"] <= 8 for s in d["steps"])
+
+
+def test_a_case_of_two_bodies_says_what_it_cannot_take(tmp_path, demo):
+    text = (CASES / "ball_on_block.toml").read_text()
+    (tmp_path / "ball_on_block.geo").write_text((CASES / "ball_on_block.geo").read_text())
+
+    def said(name, changed):
+        (tmp_path / name).write_text(changed)
+        proc = demo.run(["-m fenics_nl", "check", tmp_path / name], check=False)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr
+        return [line.removeprefix("error: ") for line in proc.stderr.strip().splitlines()]
+
+    lines = said("file.toml", text.replace("degree = 1", "degree = 2").replace(
+        'law = "linear-elastic"\nE = 1.0', 'law = "j2"\nsigma0 = 1.0\nE = 1.0').replace(
+        "friction = 0.0", "friction = -0.1\nwear = 1e-3"))
+    assert [line.split(": ")[0] for line in lines] == [
+        "material[2].law", "contact[1].wear", "contact[1].friction", "mesh.degree"], lines
+    lines = said("mesh.toml", text.replace('group = "ball"\n', 'group = "balls"\n').replace(
+        'master = "block_top"', 'master = "block_side"'))
+    assert lines[0].startswith("contact[1].master: 'block_side' is not a boundary group")
+    assert lines[1].startswith("material[1].group: 'balls' is not a cell group of the mesh "
+                               "(it has: ball, block)")
+    start = text.index('[[material]]\ngroup = "block"')
+    lines = said("bare.toml", text[:start] + text[text.index("[[boundary]]"):])
+    assert len(lines) == 1 and lines[0].endswith(
+        "cells are in no [[material]] group (cell groups without one: block)"), lines
+
+
+@pytest.mark.mpi
+def test_a_case_of_two_bodies_on_two_ranks_gives_the_serial_answer(demo):
+    # the ball on the block: the same iterations, and each pair's force, nodes in contact,
+    # radius and pressure (gathered from both ranks' slave nodes) as one rank's
+    s = demo.case(CASES / "ball_on_block.toml")
+    p = demo.case(CASES / "ball_on_block.toml", ranks=2)
+    assert p["ranks"] == 2
+    for key in ("newton_iterations", "active_set_iterations"):
+        assert [x[key] for x in p["steps"]] == [x[key] for x in s["steps"]], key
+    sp, pp = s["contact_pairs"][0], p["contact_pairs"][0]
+    assert pp["nodes_in_contact"] == sp["nodes_in_contact"]
+    for key in ("contact_radius", "max_pressure"):
+        assert pp[key] == pytest.approx(sp[key], rel=1e-9), key
+    assert pp["force"] == pytest.approx(sp["force"], rel=1e-9, abs=1e-12)

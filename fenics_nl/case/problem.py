@@ -21,19 +21,21 @@ from fenics_nl.case.damage import DamageSteps
 from fenics_nl.case.mesh import load_mesh
 from fenics_nl.case.spec import COMPONENTS, Case, CaseError, Condition
 from fenics_nl.contact.active_set import ActiveSetContact
+from fenics_nl.contact.pair import ContactPair, FrictionalPair, PairContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
-from fenics_nl.materials import kinematics, plane_stress
+from fenics_nl.materials import kinematics, laws, plane_stress
 from fenics_nl.materials import mixed as mixed_form
 from fenics_nl.materials.gradient_damage import DamagedElastic, GradientDamage
 from fenics_nl.materials.laws import von_mises_of
 from fenics_nl.materials.mixed import unknowns
+from fenics_nl.materials.piecewise import ByGroup
 from fenics_nl.solvers.newton import NewtonSolver
 from fenics_nl.solvers.result import SolveResult
 from fenics_nl.solvers.snes import SnesSolver
 
-__all__ = ["CaseProblem", "ContactSteps"]
+__all__ = ["CaseProblem", "ContactSteps", "PairSteps"]
 
 PREFIX = "case_"
 FLOAT_RANGE = 1e150  # a load beyond it has no square in double precision (max ~1.8e308)
@@ -49,9 +51,9 @@ class CaseProblem:
         self.model = case.model
         self.facets, problems = self._groups(data)
         self.probes, outside = self._locate_probes()
-        if problems + outside:
-            raise CaseError(problems + outside)
-        self.material = case.material()
+        self.material, unset = self._material(data)
+        if problems + outside + unset:
+            raise CaseError(problems + outside + unset)
         if isinstance(self.material, GradientDamage):  # its damage field: a state
             self.material = DamagedElastic(self.material)
         # 2 × degree: exact for the linear part of every law on affine cells (bracket's table)
@@ -99,18 +101,48 @@ class CaseProblem:
         exterior = dmesh.exterior_facet_indices(msh.topology)
         have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == fdim}
         problems, out = [], {}
-        for c in self.case.conditions:
-            where = c.key.rsplit(".", 1)[0] + ".group"
-            if c.group not in have:
-                problems.append(f"{where}: {c.group!r} is not a boundary group of the mesh "
+        named = [(c.group, c.key.rsplit(".", 1)[0] + ".group") for c in self.case.conditions]
+        named += [(p[side], f"{p['key']}.{side}") for p in self.case.pairs
+                  for side in ("slave", "master")]
+        for group, where in named:
+            if group not in have:
+                problems.append(f"{where}: {group!r} is not a boundary group of the mesh "
                                 f"(it has: {', '.join(sorted(have)) or 'none'})")
                 continue
-            out[c.group] = facets = data.facet_tags.find(have[c.group])
+            out[group] = facets = data.facet_tags.find(have[group])
             inside = msh.comm.allreduce(int(np.isin(facets, exterior, invert=True).sum()))
             if inside:
-                problems.append(f"{where}: {inside} facet(s) of {c.group!r} are inside the "
+                problems.append(f"{where}: {inside} facet(s) of {group!r} are inside the "
                                 f"body; conditions act on its boundary")
         return out, problems
+
+    def _material(self, data) -> tuple[laws.Material, list[str]]:
+        """The case's material ([[material]]: `ByGroup` on the cell groups), and what is wrong.
+
+        Every named group must be a cell group of the mesh, and every cell in one of them.
+        """
+        if self.case.groups is None:
+            return self.case.material(), []
+        msh = data.mesh
+        tdim = msh.topology.dim
+        have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == tdim}
+        problems, by_tag = [], {}
+        for i, (group, law) in enumerate(self.case.laws(), start=1):
+            if group not in have:
+                problems.append(f"material[{i}].group: {group!r} is not a cell group of the "
+                                f"mesh (it has: {', '.join(sorted(have)) or 'none'})")
+            else:
+                by_tag[have[group]] = law
+        if problems:
+            return None, problems
+        material = ByGroup(by_tag, data.cell_tags)
+        n = msh.topology.index_map(tdim).size_local
+        bare = msh.comm.allreduce(len(material.cells_without(n)))
+        if bare:
+            named = [g for g, t in have.items() if t not in by_tag]
+            problems.append(f"material: {bare} cells are in no [[material]] group (cell groups "
+                            f"without one: {', '.join(sorted(named)) or 'none'})")
+        return material, problems
 
     def _residual(self, data) -> ufl.Form:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""
@@ -126,6 +158,8 @@ class CaseProblem:
             elif c.kind == "pressure":
                 loads += self.t * c.value * ufl.dot(self._pressure_direction(c), v) * w * ds
         self._loads = loads
+        if isinstance(self.material, ByGroup):  # each law on its cells
+            return self.material.work(self.u, v, self.model, self.dx) + loads
         return self.fields.internal_work(self.material, self.model) * self.dx + loads
 
     def load_potential(self):
@@ -366,6 +400,8 @@ class CaseProblem:
         if method in ("modified", "bfgs"):  # J2: the course's elastic tangent, once
             opts["constant_tangent"] = self.fields.constant_tangent(self.material, self.model,
                                                                     self.dx)
+        if case.pairs:
+            return PairSteps(self)
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(
@@ -474,3 +510,44 @@ class ContactSteps:
         c.set_gap(self.problem.gap(float(self.problem.t.value)))
         c.add_penetrating()
         return c.solve()
+
+
+class PairSteps:
+    """The active set on the case's contact pairs as a load-step solver (`contact.pair`).
+
+    Each [[contact]] table is a `ContactPair` (its slave nodes projected once on its master
+    facets: small sliding); one active set runs over them all, frictionless or, when a pair
+    has friction, with Coulomb's statuses (committed at each converged step).
+    """
+
+    def __init__(self, problem: CaseProblem):
+        self.problem, self.u = problem, problem.unknown
+        pairs = [ContactPair(problem.V, problem.facets[p["slave"]],
+                             problem.facets[p["master"]], weight=problem.weight)
+                 for p in problem.case.pairs]
+        options = {"atol": problem.case.tolerance, "force_scale": problem.force_scale,
+                   "max_it": problem.case.max_it}
+        joined = ContactPair.joined(pairs)
+        friction = [p["friction"] for p in problem.case.pairs]
+        if any(friction):
+            self.contact = FrictionalPair(problem.residual, problem.unknown, problem.bcs, joined,
+                                          friction, **options)
+        else:
+            self.contact = PairContact(problem.residual, problem.unknown, problem.bcs, joined,
+                                       **options)
+
+    def solve(self) -> SolveResult:
+        """The pairs' contact at the current load factor, from the last statuses."""
+        return self.contact.solve()
+
+    def commit(self) -> None:
+        """A converged step: the next step's slip is measured from here (friction)."""
+        if isinstance(self.contact, FrictionalPair):
+            self.contact.commit()
+
+    def summaries(self) -> list[dict]:
+        """Each pair's force, nodes in contact, contact radius and largest pressure."""
+        axisymmetric = self.problem.model == "axisymmetric"
+        return [{"slave": p["slave"], "master": p["master"]}
+                | self.contact.summary(k, axisymmetric)
+                for k, p in enumerate(self.problem.case.pairs)]

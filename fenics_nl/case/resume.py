@@ -2,9 +2,10 @@
 
 The state is the unknown (with the pressure of the mixed form), the internal variables at
 the quadrature points (J2's plastic strain and cumulated plastic strain), the contact's
-active set and Newton's force reference; the identity is the case file's content (its hash,
-not its name: a copy elsewhere restarts, an edit does not) and the unknowns. The phases of
-the path are the case's load segments (0 for equal steps).
+active set (a pair's: its statuses, forces and committed slip) and Newton's force
+reference; the identity is the case file's content (its hash, not its name: a copy
+elsewhere restarts, an edit does not) and the unknowns. The phases of the path are the
+case's load segments (0 for equal steps).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ def case_checkpoints(problem, folder: str, every: int = 1) -> PathCheckpoints:
     if problem.material.path_dependent:
         functions.update(problem.material.state_functions())
     solver = problem.solver
-    contact = solver.contact if problem.contact is not None else None
-    newton = contact.newton if contact is not None else solver
+    contact = solver.contact if problem.contact is not None or problem.case.pairs else None
+    newton = contact.newton if problem.contact is not None else solver
     return PathCheckpoints(folder, identity, functions, every=every, contact=contact,
                            newton=newton if hasattr(newton, "force_reference") else None)

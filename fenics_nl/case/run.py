@@ -102,6 +102,8 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     if problem.material.path_dependent:  # committed when a step converges
         def commit():
             problem.commit()
+    elif problem.case.pairs:  # friction's slip is from the last converged step
+        commit = solver.commit
 
     def show(message):  # step cuts; the converged steps are reported by step_record
         if not message.startswith("step "):
@@ -157,7 +159,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
             work.add(path.work)
             previous = target
     last = steps[-1]
-    out = {"case": str(case.path), "model": case.model, "law": case.law,
+    out = {"case": str(case.path), "model": case.model, "law": case.law_name,
            "dofs": problem.dofs, "ranks": problem.mesh.comm.size, "steps": steps,
            "load_factor": last["load_factor"],
            "newton_iterations": sum(s["newton_iterations"] for s in steps),
@@ -178,9 +180,12 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
                 f"{passed[0]['load_factor']:.4g}) and stayed on its branch (the case runner "
                 "does not switch): its states with negative_eigenvalues > 0 are unstable, "
                 "the structure would leave them for another branch")
-    if problem.contact is not None:
+    if problem.contact is not None or problem.case.pairs:
         out["active_set_iterations"] = sum(s["active_set_iterations"] for s in steps)
+    if problem.contact is not None:
         out["contact_force"] = last["contact_force"]
+    if problem.case.pairs:
+        out["contact_pairs"] = last["contact_pairs"]
     return out
 
 
@@ -280,8 +285,11 @@ def step_record(problem: CaseProblem, t: float, result, at: float | None = None)
         rec["active_set_iterations"] = result.active_set_iterations
         rec["contact_force"] = c.force
         rec["nodes_in_contact"] = c.surface.count(c.active)
+    if problem.case.pairs:
+        rec["active_set_iterations"] = result.active_set_iterations
+        rec["contact_pairs"] = problem.solver.summaries()
     extra = (f", {result.active_set_iterations} active-set iterations"
-             if problem.contact is not None else "")
+             if problem.contact is not None or problem.case.pairs else "")
     if problem.damage:
         extra = (f" in {rec['alternate_iterations']} alternate iterations, largest damage "
                  f"{rec['largest_damage']:.3g}")
@@ -300,7 +308,7 @@ def warnings(problem: CaseProblem) -> list[str]:
     u_max = global_max(comm, np.linalg.norm(u.reshape(-1, problem.case.dim), axis=1))
     if not problem.material.finite_strain and u_max > 0.05 * size:
         notes.append(f"the largest displacement is {100 * u_max / size:.0f} % of the body's "
-                     f"size: a small-strain law ({problem.case.law}) is not valid there")
+                     f"size: a small-strain law ({problem.case.law_name}) is not valid there")
     if problem.damage:
         law = problem.material.law
         h = comm.allreduce(float(cell_sizes(problem.mesh).max(initial=0.0)), op=MPI.MAX)
@@ -401,7 +409,7 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
                           for p in problem.case.probes}
             when = (f"time {out['time']:.4g}" if "time" in out else f"load factor {t:.3g}")
             title = (f"{problem.case.path.name}: {when}, "
-                     f"{problem.case.law}, {problem.case.model}")
+                     f"{problem.case.law_name}, {problem.case.model}")
             focus = obstacle = None
             if problem.contact is not None:
                 c, S = problem.solver.contact, problem.solver.contact.surface

@@ -61,6 +61,16 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # not plane stress, no contact, no arc-length, newton = "full"; the JSON adds per step the
 # dissipated energy and the largest damage
 
+# or bodies of different materials: one [[material]] table per cell group (a physical
+# group of the mesh's cells; every cell in one), laws without internal variables
+# (linear-elastic, power-law, saint-venant-kirchhoff, neo-hookean), all small or all finite
+# strain:
+# [[material]]
+# group = "ball"
+# law = "linear-elastic"
+# E = 3.0
+# nu = 0.2
+
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
 displacement = [0.0, 0.0]     # a component may be "free"; values scale with the load factor
@@ -81,6 +91,13 @@ contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
 # or { obstacle = "sphere", center = [0.0, 2.0], radius = 1.0, displacement = [0.0, -0.01] }:
 # inside the braces, displacement moves the obstacle (scaled by the load factor). In the
 # axisymmetric model a sphere is centred on the axis and a plane is normal to it.
+
+# [[contact]]            # contact between two bodies (plane strain or axisymmetric, degree 1,
+# slave = "ball_surface" # displacement formulation): the slave group's nodes against the
+# master = "block_top"   # master group's facets (facet groups of the two bodies), small
+# friction = 0.0         # sliding; optional Coulomb coefficient (default 0). One table per
+#                        # pair; the JSON reports each pair's force, nodes in contact,
+#                        # contact radius and largest pressure every step
 
 [loading]
 steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
@@ -144,6 +161,9 @@ KEYS = [
     ("material", "law", "`linear-elastic`, `power-law`, `saint-venant-kirchhoff`, "
      "`neo-hookean`, `j2`, `j2-finite`, `at1`, `at2`, `norton` or `perzyna`", "required",
      "—"),
+    ("material", "group", "[[material]] only: the cell group (a physical group of the mesh's "
+     "cells) this law holds on; one table per group, every cell in one", "required there",
+     "—"),
     ("material", "E", "Young's modulus, > 0", "required", "stress"),
     ("material", "nu", "Poisson's ratio, −1 < ν ≤ 0.5 (0.5: the mixed formulation)",
      "required", "—"),
@@ -182,6 +202,11 @@ KEYS = [
     ("boundary", "contact", "one rigid frictionless obstacle: `{ obstacle = \"plane\", point, "
      "normal }` or `{ obstacle = \"sphere\", center, radius }`, and a `displacement` "
      "scaled by the load factor", "—", "length"),
+    ("contact", "slave", "[[contact]]: the facet group whose nodes are kept out of the "
+     "master's facets (the finer surface)", "required", "—"),
+    ("contact", "master", "[[contact]]: the facet group of the other body", "required", "—"),
+    ("contact", "friction", "[[contact]]: Coulomb's coefficient f (stick and slip, as on a "
+     "rigid obstacle)", "0", "—"),
     ("loading", "steps", "load control: n equal steps to the load factor 1, or a list of "
      "load factors to visit", "required there", "—"),
     ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
@@ -224,7 +249,7 @@ def key_table() -> str:
     """The format's keys as a Markdown table (the documentation's case page)."""
     lines = ["| key | meaning | default | unit |", "|---|---|---|---|"]
     for table, key, meaning, default, unit in KEYS:
-        name = f"[[{table}]]" if table in ("boundary", "probe") else f"[{table}]"
+        name = f"[[{table}]]" if table in ("boundary", "probe", "contact") else f"[{table}]"
         lines.append(f"| `{name}` `{key}` | {meaning} | {default} | {unit} |")
     return "\n".join(lines) + "\n"
 
@@ -249,6 +274,7 @@ VISCOUS = ("norton", "perzyna")  # rate-dependent: driven in time ([loading] tim
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
+STATE_FREE = ("linear-elastic", "power-law", "saint-venant-kirchhoff", "neo-hookean")
 WORDS = {"split": SPLITS}  # parameters that are words, and their choices
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "bfgs", "snes")
@@ -311,6 +337,21 @@ class Case:
     refine_near: dict | None = None  # .geo: groups, size, distance (`case.mesh`)
     time: dict | None = None  # a viscous law's time axis: end, steps, adaptive, tolerance,
     # stationary, and factor (the load factor against time, [[t, f], ...])
+    groups: list[tuple[str, str, dict]] | None = None  # [[material]]: (group, law, parameters)
+    pairs: list[dict] = field(default_factory=list)  # [[contact]]: slave, master, friction, key
+
+    @property
+    def law_name(self) -> str:
+        """The law, or each group's: "linear-elastic (ball), neo-hookean (block)"."""
+        if self.groups is None:
+            return self.law
+        return ", ".join(f"{law} ({group})" for group, law, _ in self.groups)
+
+    def laws(self) -> list[tuple[str | None, laws.Material]]:
+        """(cell group, law) of each [[material]]; [(None, the material)] for [material]."""
+        if self.groups is None:
+            return [(None, self.material())]
+        return [(g, LAWS[law](**parameters)) for g, law, parameters in self.groups]
 
     @property
     def dim(self) -> int:
@@ -419,7 +460,8 @@ def read_case(path: str | Path) -> Case:
     except tomllib.TOMLDecodeError as err:
         raise CaseError([f"{path}: not valid TOML: {err}"]) from None
     r = _Reader()
-    r.unknown(data, "case", ("mesh", "material", "boundary", "loading", "solver", "probe"))
+    r.unknown(data, "case", ("mesh", "material", "boundary", "contact", "loading", "solver",
+                             "probe"))
 
     m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation",
                                "refine_near"))
@@ -451,13 +493,14 @@ def read_case(path: str | Path) -> Case:
         r.fail("mesh.formulation", '"mixed" has no plane-stress form (no volume constraint)')
     dim = 3 if model == "3d" else 2
 
-    law, parameters = _material(r, data, model)
+    law, parameters, groups = _material(r, data, model)
     if (law in ("j2", *VISCOUS) and model == "plane_stress" and degree is not None
             and degree > 2):
         # ε_zz needs one function per quadrature point (materials.plane_stress): P3's rule
         # on a triangle has 12 points, and no discontinuous space has 12 functions
         r.fail("mesh.degree", f"{law} in plane stress takes degree 1 or 2, got {degree}")
-    if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"):
+    if (parameters.get("nu") == 0.5 and formulation != "mixed" and model != "plane_stress"
+            and groups is None):
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
@@ -487,6 +530,9 @@ def read_case(path: str | Path) -> Case:
             r.fail(key, message)
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
+    pairs = _pairs(r, data)
+    if pairs:
+        _pair_limits(r, model, degree, formulation, law, newton, linear, conditions, arc)
     probes = _probes(r, data, dim)
     if arc is not None and arc["stop"] is not None and model is not None:
         tables = data.get("probe", [])
@@ -498,7 +544,7 @@ def read_case(path: str | Path) -> Case:
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
-                refine_near, time_axis)
+                refine_near, time_axis, groups, pairs)
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
@@ -520,6 +566,60 @@ def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
         out.append(("loading.control", f"{law}: the damage is irreversible and the load "
                                        "driven step by step: no arc-length control"))
     return out
+
+
+def _pairs(r: _Reader, data: dict) -> list[dict]:
+    """The [[contact]] pairs: slave and master facet groups, Coulomb's f."""
+    tables = data.get("contact", [])
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        r.fail("contact", "must be [[contact]] tables, one per pair")
+        return []
+    out = []
+    for i, t in enumerate(tables, start=1):
+        where = f"contact[{i}]"
+        if "wear" in t:  # the issue's optional key: said, not taken
+            r.fail(f"{where}.wear", "not a case key: Archard's wear needs each step's sliding "
+                                    "distance, which a case's load factor does not give "
+                                    "(use contact.pair.ArchardWear in a script)")
+        r.unknown({k: v for k, v in t.items() if k != "wear"}, where,
+                  ("slave", "master", "friction"))
+        slave = r.get(t, "slave", where, str, required=True)
+        master = r.get(t, "master", where, str, required=True)
+        f = r.get(t, "friction", where, float, default=0.0, minimum=0.0)
+        if slave is not None and slave == master:
+            r.fail(f"{where}.master", f"{master!r} is the slave group too: a pair is two "
+                                      "surfaces")
+        if slave is not None and master is not None and f is not None:
+            out.append({"slave": slave, "master": master, "friction": f, "key": where})
+    return out
+
+
+def _pair_limits(r: _Reader, model, degree, formulation, law, newton, linear, conditions,
+                 arc) -> None:
+    """What a case with [[contact]] pairs cannot take, each said (`contact.pair`'s reach)."""
+    if model == "3d":
+        r.fail("contact", "pairs are 2D (plane strain, plane stress, axisymmetric): the "
+                          "projection on master facets is on segments")
+    if degree is not None and degree != 1:
+        r.fail("mesh.degree", f"contact pairs take degree 1 (node-to-segment), got {degree}")
+    if formulation == "mixed":
+        r.fail("mesh.formulation", "contact pairs take the displacement formulation")
+    if law is not None and law not in STATE_FREE:
+        r.fail("material.law", f"{law}: contact pairs take laws without internal variables "
+                               f"({', '.join(STATE_FREE)})")
+    if newton not in (None, "full"):
+        r.fail("solver.newton", "contact pairs run their own Newton on the saddle point "
+                                '(full): remove newton or set "full"')
+    if linear not in (None, "lu"):
+        r.fail("solver.linear_solver", 'contact pairs solve their saddle point by "lu" '
+                                       "(MUMPS)")
+    for c in conditions:
+        if c.kind == "contact":
+            r.fail(c.key, "a rigid obstacle and [[contact]] pairs in one case: not yet (one "
+                          "active set of either kind)")
+    if arc is not None:
+        r.fail("loading.control", "arc-length control scales loads only: contact pairs "
+                                  "cannot take part")
 
 
 def _require_mesh_fits(mesh_file: Path, model: str) -> None:
@@ -554,23 +654,64 @@ def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, con
 
 
 def _material(r: _Reader, data: dict, model: str | None):
+    """(law, parameters, groups): one [material], or [[material]] tables by cell group.
+
+    With groups, `law` and `parameters` are the first group's (what the checks of a single
+    law read: every group's law is state-free, so those checks pass for all alike) and
+    `groups` lists (group, law, parameters); else `groups` is None.
+    """
     m = data.get("material")
+    if isinstance(m, list) and m and all(isinstance(t, dict) for t in m):
+        return _materials_by_group(r, m, model)
     if not isinstance(m, dict):
-        r.fail("material", "missing table" if m is None else "must be a table [material]")
-        return None, {}
-    law = r.get(m, "law", "material", str, required=True, choices=tuple(LAWS))
+        r.fail("material", "missing table" if m is None else
+               "must be a table [material] or [[material]] tables, one per cell group")
+        return None, {}, None
+    return (*_one_material(r, m, "material", model), None)
+
+
+def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
+    groups, seen = [], {}
+    for i, t in enumerate(tables, start=1):
+        where = f"material[{i}]"
+        group = r.get(t, "group", where, str, required=True)
+        law, parameters = _one_material(r, {k: v for k, v in t.items() if k != "group"},
+                                        where, model)
+        if law is not None and law not in STATE_FREE:
+            r.fail(f"{where}.law", f"{law} keeps internal variables on every quadrature point "
+                                   f"of the mesh: [[material]] groups take "
+                                   f"{', '.join(STATE_FREE)}; or one [material] for all")
+        if parameters.get("nu") == 0.5:
+            r.fail(f"{where}.nu", "0.5 needs the mixed formulation, which [[material]] groups "
+                                  "do not take")
+        if group is not None and group in seen:
+            r.fail(f"{where}.group", f"{group!r} has its material in {seen[group]} already")
+        elif group is not None:
+            seen[group] = where
+        if group is not None and law is not None:
+            groups.append((group, law, parameters))
+    if len({LAWS[law].finite_strain for _, law, _ in groups}) > 1:
+        r.fail("material", "all groups small strain or all finite strain (one kinematics "
+                           "for the bodies)")
+    if not groups:
+        return None, {}, None
+    return groups[0][1], groups[0][2], groups
+
+
+def _one_material(r: _Reader, m: dict, where: str, model: str | None):
+    law = r.get(m, "law", where, str, required=True, choices=tuple(LAWS))
     if law is None:  # still name a misspelt key (lawe = ...) beside the missing law
         every = {f.name for cls in LAWS.values() for f in fields(cls) if f.init}
-        r.unknown(m, "material", ("law", *sorted(every)))
+        r.unknown(m, where, ("law", *sorted(every)))
         return None, {}
     params = [f for f in fields(LAWS[law]) if f.init]  # the parameters, not the state
     accepted = tuple(f.name for f in params)
-    r.unknown(m, "material", ("law", *accepted))
+    r.unknown(m, where, ("law", *accepted))
     parameters = {}
     defaults = OPTIONAL.get(law, {})
     for f in params:  # every parameter but a documented optional one: say it
         kind = str if f.name in WORDS else float
-        value = r.get(m, f.name, "material", kind, required=f.name not in defaults,
+        value = r.get(m, f.name, where, kind, required=f.name not in defaults,
                       default=defaults.get(f.name), choices=WORDS.get(f.name))
         if value is not None:
             parameters[f.name] = value
@@ -579,9 +720,9 @@ def _material(r: _Reader, data: dict, model: str | None):
             LAWS[law](**parameters)
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
-            r.fail(f"material.{name}" if name in parameters else "material", rest or name)
+            r.fail(f"{where}.{name}" if name in parameters else where, rest or name)
     if law in ("neo-hookean", "power-law", "j2-finite") and model == "plane_stress":
-        r.fail("material.law", f"{law} has no plane-stress form: use mesh.model = "
+        r.fail(f"{where}.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters
 

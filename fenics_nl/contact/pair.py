@@ -74,9 +74,36 @@ class ContactPair:
         self.B = self.rows(np.arange(len(self.slave)))
         self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
         self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
+        self.part = np.zeros(len(self.slave), dtype=np.int64)  # which pair (`joined`)
         # the bodies' size: what a gap is small against (round-off)
         self.length = self.comm.allreduce(float(np.ptp(msh.geometry.x, axis=0).max()),
                                           op=MPI.MAX)
+
+    @classmethod
+    def joined(cls, pairs: list[ContactPair]) -> ContactPair:
+        """Several pairs as one: their slave nodes one after the other, `part` says whose.
+
+        One active set then runs over every pair (a node may be the slave of two pairs: it
+        has a row in each).
+        """
+        if len(pairs) == 1:
+            return pairs[0]
+        out = object.__new__(cls)
+        first = pairs[0]
+        out.V, out.mesh, out.comm, out.bs = first.V, first.mesh, first.comm, first.bs
+        for name in ("slave", "x", "slave_global", "xi", "normal", "gamma", "master_nodes",
+                     "areas"):
+            setattr(out, name, np.concatenate([getattr(p, name) for p in pairs]))
+        out.part = np.concatenate([np.full(len(p.slave), k) for k, p in enumerate(pairs)])
+        out.length = max(p.length for p in pairs)
+        out.B = out.rows(np.arange(len(out.slave)))
+        out.Bt = out.rows(np.arange(len(out.slave)), tangential=True)
+        return out
+
+    def keys(self, which: np.ndarray) -> tuple:
+        """The nodes `which` of every rank as one sorted tuple (a set's identity)."""
+        ids = self.slave_global[which] * (int(self.part.max(initial=0)) + 1) + self.part[which]
+        return tuple(np.sort(np.concatenate(self.comm.allgather(ids))))
 
     @property
     def size(self) -> int:
@@ -233,7 +260,8 @@ class PairContact:
         pair: the contact pair.
         atol: Newton's tolerance on ‖R‖ (times `force_scale`); the gaps of the active
             nodes to 1e-12 of the bodies' size.
-        force_scale: the scale of the forces (the load).
+        force_scale: the scale of the forces (the load); None: each solve's first residual
+            and contact forces set it (displacements drive the bodies).
         max_it: Newton iterations per active-set iteration.
         max_iterations: active-set iterations before giving up.
     """
@@ -244,7 +272,7 @@ class PairContact:
         self.u, self.bcs, self.pair = u, list(bcs), pair
         self.F = fem.form(residual)
         self.J = fem.form(ufl.derivative(residual, u))
-        self.atol, self.scale = atol * force_scale, force_scale
+        self.rel, self.scale = atol, force_scale
         self.max_it, self.max_iterations = max_it, max_iterations
         self.active = pair.gamma <= 1e-12 * self.pair.length  # touching at the start
         self.lam = np.zeros(len(pair.slave))
@@ -283,22 +311,66 @@ class PairContact:
                                    time.perf_counter() - t0, active_set_iterations=k,
                                    history=history)
             new = (self.active & ~leave) | join
-            key = tuple(np.sort(np.concatenate(self.pair.comm.allgather(  # every rank's
-                self.pair.slave_global[new]))))
+            key = self.pair.keys(new)
             if key in seen:
                 raise SolveError(f"the active set cycles (iteration {k})")
             seen.add(key)
             self.active = new
         raise SolveError(f"the active set did not settle in {self.max_iterations} iterations")
 
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """What a restart needs after a converged step: the set and the forces (this rank's).
+
+        Returns:
+            The arrays, for `restore_arrays`.
+        """
+        return {"active": self.active.astype(np.uint8), "lam": self.lam.copy()}
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The state of `checkpoint_arrays` back (the next solve starts from it)."""
+        self.active = arrays["active"].astype(bool)
+        self.lam = arrays["lam"].copy()
+
+    def summary(self, part: int = 0, axisymmetric: bool = False) -> dict:
+        """One pair's (`ContactPair.part`) force, nodes in contact, radius, largest pressure.
+
+        The force: the master's on the slave body (every rank's; axisymmetric: its axial
+        resultant over the revolution, the radial one 0); `contact_radius`: the
+        largest x (the radius, axisymmetric) of a node in contact, or in plane strain half
+        the largest distance between two nodes in contact (the half-width); 0 when none.
+        """
+        mine = self.pair.part == part
+        st = self.state()
+        on = mine & st.active
+        comm = self.pair.comm
+        x = np.vstack(comm.allgather(self.pair.x[on]))
+        p = comm.allreduce(float(st.pressure[on].max(initial=0.0)), op=MPI.MAX)
+        if len(x) == 0:
+            radius = 0.0
+        elif axisymmetric:
+            radius = float(x[:, 0].max())
+        else:
+            radius = 0.5 * float(np.max(np.linalg.norm(x[:, None] - x[None], axis=2)))
+        force = self.force(mine)
+        if axisymmetric:  # the radial resultant vanishes over the revolution (as reactions)
+            force[0] = 0.0
+        return {"force": force.tolist(), "nodes_in_contact": len(x),
+                "contact_radius": radius, "max_pressure": p}
+
     def state(self) -> PairState:
         """Statuses, forces and pressures at this rank's owned slave nodes."""
         areas = np.where(self.pair.areas > 0, self.pair.areas, 1.0)
         return PairState(self.active.copy(), self.lam.copy(), self.lam / areas)
 
-    def force(self) -> np.ndarray:
-        """The force the master exerts on the slave body, Σ λ_s n_s (every rank's)."""
-        return np.array([self.pair.total(self.lam * self.pair.normal[:, k]) for k in (0, 1)])
+    def force(self, which: np.ndarray | None = None) -> np.ndarray:
+        """The force the master exerts on the slave body, Σ λ_s n_s (every rank's).
+
+        Args:
+            which: flags of the slave nodes to sum over (one pair's); None: all.
+        """
+        keep = np.ones(len(self.lam), bool) if which is None else which
+        return np.array([self.pair.total((self.lam * self.pair.normal[:, k])[keep])
+                         for k in (0, 1)])
 
     def profile(self) -> tuple[np.ndarray, np.ndarray]:
         """(x, pressure) of the active slave nodes, gathered on every rank (x: n × 2)."""
@@ -354,7 +426,9 @@ class PairContact:
             g.array[:] += offset
             norm = R.norm()
             closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self.pair.length
-            if norm <= self.atol and closed and it > 1:
+            if it == 1:
+                reference = self.scale if self.scale is not None else norm
+            if norm <= self.rel * reference and closed and it > 1:
                 self._iterations = it - 1
                 return (lam,)
             K = petsc.assemble_matrix(self.J, self.bcs)
@@ -364,7 +438,9 @@ class PairContact:
             u.x.petsc_vec.axpy(-1.0, du)
             u.x.scatter_forward()
             lam -= dlam
-            if norm <= self.atol and closed:
+            if it == 1 and self.scale is None:  # the contact forces found: a scale too
+                reference = max(reference, _vec(B, lam).norm())
+            if norm <= self.rel * reference and closed:
                 self._iterations = it
                 return (lam,)
         raise SolveError(f"contact pair: Newton did not converge in {self.max_it} iterations "
@@ -393,7 +469,7 @@ def _saddle_solve(K, B, R, g, held, work: WorkCounts):
     Bn = B.copy()
     Bn.scale(-1.0)
     Bt.zeroRows(held, diag=0.0)  # the prescribed dofs keep their value: no multiplier there
-    nest = PETSc.Mat().createNest([[K, Bt], [Bn, None]], comm=K.comm)
+    nest = PETSc.Mat().createNest([[K, Bt], [Bn, _unconstrained(Bt)]], comm=K.comm)
     A = nest.convert("aij")
     rhs = A.createVecRight()
     n_u = R.getLocalSize()
@@ -419,6 +495,25 @@ def _saddle_solve(K, B, R, g, held, work: WorkCounts):
     return du, dlam
 
 
+def _unconstrained(Bt: PETSc.Mat) -> PETSc.Mat | None:
+    """1 on the diagonal of the rows of B that bind prescribed dofs only, else None.
+
+    Such a row (the tangential row of a node on the axis, where both bodies' u_r are held)
+    constrains nothing the solve can change: its multiplier is left out (dλ = −g, 0 for a
+    condition the supports already meet) instead of making the saddle point singular.
+    """
+    B = Bt.transpose(PETSc.Mat())
+    start, n = B.getOwnershipRange()[0], B.getLocalSize()[0]
+    empty = [start + i for i in range(n) if not np.any(B.getRow(start + i)[1])]
+    if not B.comm.tompi4py().allreduce(len(empty)):
+        return None
+    D = PETSc.Mat().createAIJ((B.getSizes()[0], B.getSizes()[0]), nnz=(1, 0), comm=B.comm)
+    for row in empty:
+        D.setValue(row, row, 1.0)
+    D.assemble()
+    return D
+
+
 class FrictionalPair(PairContact):
     """The active set on a pair with Coulomb friction (2D): open, stuck or slipping nodes.
 
@@ -442,15 +537,17 @@ class FrictionalPair(PairContact):
         u: the displacement (P1, 2D).
         bcs: the Dirichlet conditions.
         pair: the contact pair.
-        friction: Coulomb's coefficient f.
+        friction: Coulomb's coefficient f, or one per pair (`ContactPair.part`).
         **options: `PairContact`'s (tolerances, iteration limits).
     """
 
     def __init__(self, residual, u, bcs, pair: ContactPair, friction: float, **options):
         super().__init__(residual, u, bcs, pair, **options)
-        if not friction >= 0:
+        f = np.asarray(friction, dtype=float)
+        if not np.all(f >= 0):
             raise ValueError(f"the friction coefficient must be >= 0, got {friction}")
-        self.f = friction
+        # one per pair (`ContactPair.joined`), as one per slave node
+        self.f = f[pair.part] if f.ndim else np.full(len(pair.slave), float(f))
         n = len(pair.slave)
         self.slip, self.s = np.zeros(n, dtype=bool), np.zeros(n)
         self.lam_t = np.zeros(n)
@@ -460,12 +557,30 @@ class FrictionalPair(PairContact):
         """The converged step's tangential displacement: the next step's slip is from it."""
         self.committed = self.pair.tangential(self.u)
 
-    def force(self) -> np.ndarray:
-        """The force the master exerts on the slave body, Σ λ_n n + λ_t t (every rank's)."""
+    def force(self, which: np.ndarray | None = None) -> np.ndarray:
+        """The force the master exerts on the slave body, Σ λ_n n + λ_t t (every rank's).
+
+        Args:
+            which: flags of the slave nodes to sum over (one pair's); None: all.
+        """
+        keep = np.ones(len(self.lam), bool) if which is None else which
         n = self.pair.normal
         t = np.c_[-n[:, 1], n[:, 0]]
-        return np.array([self.pair.total(self.lam * n[:, k] + self.lam_t * t[:, k])
+        return np.array([self.pair.total((self.lam * n[:, k] + self.lam_t * t[:, k])[keep])
                          for k in (0, 1)])
+
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """The set, the slip statuses and directions, the forces and the committed slip."""
+        return super().checkpoint_arrays() | {
+            "slip": self.slip.astype(np.uint8), "s": self.s.copy(),
+            "lam_t": self.lam_t.copy(), "committed": self.committed.copy()}
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The state of `checkpoint_arrays` back."""
+        super().restore_arrays(arrays)
+        self.slip = arrays["slip"].astype(bool)
+        self.s, self.lam_t = arrays["s"].copy(), arrays["lam_t"].copy()
+        self.committed = arrays["committed"].copy()
 
     def solve(self) -> SolveResult:
         """The active-set loop with friction, from the current statuses (warm start).
@@ -518,13 +633,13 @@ class FrictionalPair(PairContact):
         if self.pair.comm.allreduce(len(sliding)):
             Bs = pair.rows(sliding, tangential=True)
             forces = Bs.createVecRight()
-            Bs.multTranspose(_vec(Bs, self.f * lam_n[sliding] * self.s[sliding]), forces)
+            Bs.multTranspose(_vec(Bs, (self.f * lam_n * self.s)[sliding]), forces)
         lam = self._saddle(B, offset, forces, work)[0]
         self.lam[:] = 0.0
         self.lam_t[:] = 0.0
         self.lam[closed] = lam[: len(closed)]
         self.lam_t[stick] = lam[len(closed):]
-        self.lam_t[sliding] = self.f * lam_n[sliding] * self.s[sliding]
+        self.lam_t[sliding] = (self.f * lam_n * self.s)[sliding]
         return self._iterations
 
 
