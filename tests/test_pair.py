@@ -26,12 +26,15 @@ from fenics_nl.domain import boundary
 from fenics_nl.domain.two_bodies import sphere_on_body
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import LinearElastic
+from fenics_nl.solvers.result import WorkCounts
 from fenics_nl.theory import hertz
 
 
-def pressed(model, R1, R2, upper, lower, delta, a, fine=20.0, comm=MPI.COMM_WORLD):
+def pressed(model, R1, R2, upper, lower, delta, a, fine=20.0, comm=MPI.COMM_WORLD,
+            steps=1, linear=False):
     """The upper body pushed down by δ at its equator onto the lower one (held at its
-    bottom): Hertz's a and p0 for the force, and the fitted ones; the loop's counts."""
+    bottom), in `steps` equal steps: Hertz's a and p0 for the force, and the fitted ones;
+    the loop's counts (the last step's, and the work of all)."""
     d = sphere_on_body(comm, R1, a, R2=R2, fine=fine)
     msh = d.mesh
 
@@ -46,13 +49,17 @@ def pressed(model, R1, R2, upper, lower, delta, a, fine=20.0, comm=MPI.COMM_WORL
     residual = sum(ufl.inner(LinearElastic(*m).stress(eps), eps_v) * weight * dx(i)
                    for i, m in ((1, upper), (2, lower)))
     top = boundary.component(V, 1, tag("upper_top"))
-    top.g.x.array[:] = -delta
     bcs = [top, boundary.component(V, 0, np.concatenate([tag("upper_axis"),
                                                          tag("lower_axis")])),
            boundary.component(V, 1, tag("lower_bottom"))]
     pair = ContactPair(V, tag("upper_contact"), tag("lower_contact"), weight=weight)
-    contact = PairContact(residual, u, bcs, pair, force_scale=upper[0] * a * a)
-    result = contact.solve()
+    contact = PairContact(residual, u, bcs, pair, force_scale=upper[0] * a * a, linear=linear)
+    work, ever = WorkCounts(), np.zeros(len(pair.slave), dtype=bool)
+    for k in range(1, steps + 1):
+        top.g.x.array[:] = -delta * k / steps
+        result = contact.solve()
+        work.add(result.work)
+        ever |= contact.active
     half = 2.0 if model == "plane_strain" else 1.0  # the model is half the contact
     force = contact.force()[1] * half
     # the push's reaction: the force the top holds, against the multipliers' sum
@@ -68,7 +75,8 @@ def pressed(model, R1, R2, upper, lower, delta, a, fine=20.0, comm=MPI.COMM_WORL
             "contact_radius_hertz": ref["contact_radius"], "max_pressure_hertz":
             ref["max_pressure"], "iterations": result.active_set_iterations,
             "newton": result.iterations, "nodes": len(r), "h": a / fine,
-            "outermost": r.max()}
+            "outermost": r.max(), "work": work, "ever_active": pair.total(ever),
+            "u": u.x.array.copy()}
 
 
 @pytest.mark.parametrize("model,R2", [("axisymmetric", None), ("plane_strain", 2.0)])
@@ -83,6 +91,25 @@ def test_two_bodies_of_two_materials_are_hertz(model, R2):
         assert run[key] == pytest.approx(run[f"{key}_hertz"], rel=0.015), (key, run)
     assert run["force"] == pytest.approx(run["reaction"], rel=1e-8)
     assert run["newton"] == run["iterations"] <= 8 and run["nodes"] >= 10
+
+
+def test_a_linear_pair_on_one_factorization_is_the_saddle_points_answer():
+    # the sphere on the block in 4 steps: K factorized once, each set solved by the
+    # Schur complement of its active rows (contact.condensed), against the saddle point
+    # factorized at every active-set iteration: the same sets, forces and displacements
+    # (measured 6e-15); one factorization for the run, one back-substitution a step, and
+    # one column per node ever in a set (24: the 23 in contact at the steps' ends, and one
+    # that joined and left within a step)
+    args = ("axisymmetric", 1.0, None, (3.0, 0.2), (1.0, 0.35), 0.012, 0.1)
+    saddle, condensed = pressed(*args, steps=4), pressed(*args, steps=4, linear=True)
+    assert condensed["iterations"] == saddle["iterations"]
+    assert condensed["force"] == pytest.approx(saddle["force"], rel=1e-12)
+    u0, u1 = saddle["u"], condensed["u"]
+    assert np.abs(u1 - u0).max() <= 1e-12 * np.abs(u0).max()
+    w, w0 = condensed["work"], saddle["work"]
+    assert (w.factorizations, w.linear_solves) == (1, 4)
+    assert condensed["ever_active"] <= w.update_columns <= condensed["ever_active"] + 2
+    assert w0.factorizations == w0.linear_solves >= 8
 
 
 def test_code_aster_ssnv104_two_hemispheres():

@@ -532,9 +532,9 @@ class PairSteps:
         if any(friction):
             self.contact = FrictionalPair(problem.residual, problem.unknown, problem.bcs, joined,
                                           friction, **options)
-        else:
+        else:  # a linear law: K factorized once for the run (`contact.condensed`)
             self.contact = PairContact(problem.residual, problem.unknown, problem.bcs, joined,
-                                       **options)
+                                       linear=problem.material.is_linear, **options)
 
     def solve(self) -> SolveResult:
         """The pairs' contact at the current load factor, from the last statuses."""

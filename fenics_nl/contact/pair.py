@@ -28,6 +28,7 @@ PETSc matrices in the unknowns' global numbering, solved by MUMPS.
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass
 
@@ -38,10 +39,13 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from fenics_nl.contact.condensed import CondensedSaddle, every_rank
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 __all__ = ["ArchardWear", "ContactPair", "FrictionalPair", "PairContact", "PairState"]
+
+log = logging.getLogger(__name__)
 
 
 class ContactPair:
@@ -264,11 +268,14 @@ class PairContact:
             and contact forces set it (displacements drive the bodies).
         max_it: Newton iterations per active-set iteration.
         max_iterations: active-set iterations before giving up.
+        linear: the residual is linear in u: K is factorized once for the whole run and
+            each set solved by its Schur complement on the active rows
+            (`contact.condensed`), instead of a saddle point factorized at every iteration.
     """
 
     def __init__(self, residual, u, bcs, pair: ContactPair, *,
                  atol: float = 1e-10, force_scale: float = 1.0, max_it: int = 20,
-                 max_iterations: int = 50):
+                 max_iterations: int = 50, linear: bool = False):
         self.u, self.bcs, self.pair = u, list(bcs), pair
         self.F = fem.form(residual)
         self.J = fem.form(ufl.derivative(residual, u))
@@ -284,6 +291,8 @@ class PairContact:
         self.held = PETSc.IS().createGeneral((owned + start).astype(np.int32),
                                              comm=pair.comm)
         self.history: list[dict] = []
+        self.condensed = CondensedSaddle(self.J, self.bcs, pair.B, self.held) if linear \
+            else None
 
     def solve(self) -> SolveResult:
         """The active-set loop from the current set (warm start) to a set that repeats.
@@ -395,11 +404,75 @@ class PairContact:
         """
         work = work if work is not None else WorkCounts()
         self.active = np.asarray(active, dtype=bool).copy()  # what `state` reports
+        if self.condensed is not None:
+            saved = self.u.x.array.copy(), self.lam.copy()
+            try:
+                return self._condensed_equilibrium(work)
+            except SolveError as err:  # K singular: a body held by the contact alone
+                self.u.x.array[:], self.lam[:] = saved
+                log.warning("contact pair: %s: each set is solved as a saddle point", err)
+                self.condensed = None
         which = np.flatnonzero(self.active)
         lam = self._saddle(self.pair.rows(which), self.pair.gamma[which], None, work)[0]
         self.lam[:] = 0.0
         self.lam[which] = lam
         return self._iterations
+
+    def _condensed_equilibrium(self, work: WorkCounts) -> int:
+        """The set's equilibrium of a linear residual on the kept factorization.
+
+        First the equilibrium with the last forces λ (a back-substitution, only if the
+        loads moved since: R(u) − Bᵀλ ≠ 0), then the new forces of the set from the
+        active rows' flexibility, u moved by their columns. Checked: R(u) − Bᵀλ = 0 and
+        the active gaps closed, as the Newton solve checks them.
+        """
+        pair, c, comm = self.pair, self.condensed, self.pair.comm
+        r = self._out_of_balance(work)
+        reference = self.scale if self.scale is not None else max(
+            r.norm(), float(np.linalg.norm(every_rank(comm, self.lam))))
+        if r.norm() > self.rel * reference:  # the loads moved: the new u_0 (+ W λ)
+            self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
+            self.u.x.scatter_forward()
+            work.linear_solves += 1
+        lam = every_rank(comm, self.lam)
+        now = np.flatnonzero(every_rank(comm, self.active))  # global slave rows
+        was = np.flatnonzero(lam)
+        c.columns(now, work)
+        g = every_rank(comm, pair.gaps(self.u))
+        new = np.linalg.solve(c.flexibility(now, now),
+                              -g[now] + c.flexibility(now, was) @ lam[was]) if len(now) \
+            else np.zeros(0)
+        c.add(self.u.x.petsc_vec, now, new)
+        c.add(self.u.x.petsc_vec, was, -lam[was])
+        self.u.x.scatter_forward()
+        lam[:] = 0.0
+        lam[now] = new
+        start = c.start
+        self.lam[:] = lam[start:start + len(self.lam)]
+        norm = self._out_of_balance(work).norm()
+        if self.scale is None:
+            reference = max(reference, float(np.linalg.norm(new)))
+        gaps = np.abs(pair.gaps(self.u)[self.active]).max(initial=0.0)
+        closed = comm.allreduce(float(gaps), op=MPI.MAX) <= 1e-12 * pair.length
+        if not (norm <= self.rel * reference and closed):
+            raise SolveError(f"the condensed solve left |R| = {norm:.2e} or gaps open (K "
+                             "singular, a body held by the contact alone; or a residual not "
+                             "linear in u)")
+        return 1
+
+    def _out_of_balance(self, work: WorkCounts) -> PETSc.Vec:
+        """R(u) − Bᵀλ with the supports' values set in u (their rows zeroed)."""
+        for bc in self.bcs:
+            bc.set(self.u.x.array)
+        self.u.x.scatter_forward()
+        R = petsc.assemble_vector(self.F)
+        R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        work.residual_assemblies += 1
+        Bt_lam = self.pair.B.createVecRight()
+        self.pair.B.multTranspose(_vec(self.pair.B, self.lam), Bt_lam)
+        R.axpy(-1.0, Bt_lam)
+        _zero(R, self.held)
+        return R
 
     def _saddle(self, B, offset, forces, work):
         """Newton on R(u) − Bᵀλ − forces = 0, B u + offset = 0: (λ, ) and the iterations.
