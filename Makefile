@@ -98,7 +98,7 @@ test-mpi: $(VENV)/.installed
 # `make bench QUICK=1`: small meshes, a smoke run that writes nothing (about 1 min);
 # `make bench-large`: the bracket at 234k, 300k (1 vs 2 ranks) and ~1M unknowns (about 75 min),
 # and every capability on the iterative path at ~1M (about an hour more)
-BENCHMARKS := newton contact buckling bracket iterative arch_iterative plasticity sphere_ranks \
+BENCHMARKS := newton contact contact_pair buckling bracket iterative arch_iterative plasticity sphere_ranks \
 	plasticity_peer mixed secant \
 	friction continuation newtonal damage damage_peer identification forming creep
 bench: $(VENV)/.bench-installed
