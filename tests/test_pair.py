@@ -159,10 +159,10 @@ def test_the_bearing_demo_is_hertz_at_light_load_then_leaves_it(demo):
     assert max(s["iterations"] for s in d["steps"]) <= 10
 
 
-def pulled_sideways(comm=MPI.COMM_WORLD):
+def pulled_sideways(comm=MPI.COMM_WORLD, linear=False):
     """Two identical cylinders (R = 1, E = 1, ν = 0.3), f = 0.3, pressed then pulled
     sideways by their top in three steps: each step's (Q, P, the stick zone's half-width),
-    the fitted a and the largest node spacing in the contact."""
+    the fitted a, the largest node spacing in the contact, and the work of the loop."""
     from fenics_nl.contact.pair import FrictionalPair
 
     R, a, E, nu, f, delta = 1.0, 0.1, 1.0, 0.3, 0.3, 0.012
@@ -178,9 +178,10 @@ def pulled_sideways(comm=MPI.COMM_WORLD):
     down, sideways = (boundary.component(V, k, tag("upper_top")) for k in (1, 0))
     bcs = [down, sideways, *(boundary.component(V, k, tag("lower_bottom")) for k in (0, 1))]
     pair = ContactPair(V, tag("upper_contact"), tag("lower_contact"))
-    contact = FrictionalPair(residual, u, bcs, pair, f, force_scale=E * a * a)
+    contact = FrictionalPair(residual, u, bcs, pair, f, force_scale=E * a * a, linear=linear)
     down.g.x.array[:] = -delta
-    contact.solve()
+    work = WorkCounts()
+    work.add(contact.solve().work)
     contact.commit()
     x, p = contact.profile()
     r = np.abs(x[:, 0])
@@ -189,12 +190,13 @@ def pulled_sideways(comm=MPI.COMM_WORLD):
     steps = []
     for shift in (0.002, 0.004, 0.005):
         sideways.g.x.array[:] = shift
-        contact.solve()
+        result = contact.solve()
+        work.add(result.work)
         contact.commit()
         Q, P = contact.force()
         stuck = np.concatenate(comm.allgather(pair.x[contact.active & ~contact.slip, 0]))
-        steps.append((Q, P, 0.5 * (stuck.max() - stuck.min())))
-    return steps, a_fit, spacing, f
+        steps.append((Q, P, 0.5 * (stuck.max() - stuck.min()), result.active_set_iterations))
+    return steps, a_fit, spacing, f, work
 
 
 def test_cattaneo_mindlin_between_two_identical_cylinders():
@@ -206,19 +208,34 @@ def test_cattaneo_mindlin_between_two_identical_cylinders():
     # −0.0074 (−0.0062 at h/2), the same at every load: the top is held, and the couple Q·R
     # of the contact force and the top's reaction tilts the pressure (half-spaces have no
     # such couple)
-    steps, a_fit, spacing, f = pulled_sideways()
-    for Q, P, width in steps:
+    steps, a_fit, spacing, f, _ = pulled_sideways()
+    for Q, P, width, _ in steps:
         assert 0 < -Q < f * P
         assert width == pytest.approx(a_fit * np.sqrt(1 - abs(Q) / (f * P)), abs=spacing)
-    widths = [w for _, _, w in steps]
+    widths = [w for _, _, w, _ in steps]
     assert widths[0] > widths[1] > widths[2]
 
 
+def test_friction_on_one_factorization_is_the_saddle_points_answer():
+    # the same Cattaneo–Mindlin run with K factorized once (contact.condensed: the stuck
+    # nodes' slips are rows too, the slipping nodes' f λ_n known forces): the same statuses
+    # at every iteration (the counts), the same forces and stick zones (measured 1e-13);
+    # one factorization and one back-substitution a step, against one factorization per
+    # status iteration
+    saddle, condensed = pulled_sideways()[0], pulled_sideways(linear=True)
+    for a, b in zip(saddle, condensed[0], strict=True):
+        assert a == pytest.approx(b, rel=1e-10, abs=1e-14)
+    work = condensed[-1]
+    assert (work.factorizations, work.linear_solves) == (1, 4)
+
+
 @pytest.mark.mpi
-def test_friction_on_a_pair_on_two_ranks_gives_the_serial_answer():
+@pytest.mark.parametrize("linear", [False, True], ids=["saddle point", "one factorization"])
+def test_friction_on_a_pair_on_two_ranks_gives_the_serial_answer(linear):
     # the statuses are each rank's own slave nodes': the same forces and stick zones
     assert MPI.COMM_WORLD.size > 1
-    parallel, serial = pulled_sideways()[0], pulled_sideways(MPI.COMM_SELF)[0]
+    parallel = pulled_sideways(linear=linear)[0]
+    serial = pulled_sideways(MPI.COMM_SELF, linear=linear)[0]
     for a, b in zip(parallel, serial, strict=True):
         assert a == pytest.approx(b, rel=1e-8, abs=1e-12)
 

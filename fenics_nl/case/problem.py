@@ -517,7 +517,8 @@ class PairSteps:
 
     Each [[contact]] table is a `ContactPair` (its slave nodes projected once on its master
     facets: small sliding); one active set runs over them all, frictionless or, when a pair
-    has friction, with Coulomb's statuses (committed at each converged step).
+    has friction, with Coulomb's statuses (committed at each converged step). A linear law
+    keeps one factorization of K for the run (`contact.condensed`).
     """
 
     def __init__(self, problem: CaseProblem):
@@ -526,15 +527,16 @@ class PairSteps:
                              problem.facets[p["master"]], weight=problem.weight)
                  for p in problem.case.pairs]
         options = {"atol": problem.case.tolerance, "force_scale": problem.force_scale,
-                   "max_it": problem.case.max_it}
+                   "max_it": problem.case.max_it,  # linear laws: K factorized once
+                   "linear": problem.material.is_linear}
         joined = ContactPair.joined(pairs)
         friction = [p["friction"] for p in problem.case.pairs]
         if any(friction):
             self.contact = FrictionalPair(problem.residual, problem.unknown, problem.bcs, joined,
                                           friction, **options)
-        else:  # a linear law: K factorized once for the run (`contact.condensed`)
+        else:
             self.contact = PairContact(problem.residual, problem.unknown, problem.bcs, joined,
-                                       linear=problem.material.is_linear, **options)
+                                       **options)
 
     def solve(self) -> SolveResult:
         """The pairs' contact at the current load factor, from the last statuses."""

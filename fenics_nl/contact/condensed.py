@@ -15,6 +15,11 @@ column w_j is solved the first time node j becomes active and kept (with B w_j, 
 S); an active-set iteration is then a small dense solve and vector updates, and a load step
 costs one back-substitution (the new u_0) besides the new columns. The rigid obstacle's row
 update (`solvers.row_update`) does the same with Dirichlet rows.
+
+The rows come in blocks (the normal gaps B; with friction also the tangential slips B_t):
+a force on a row of any block, unknown (an active gap, a stuck node's slip) or known (a
+slipping node's f λ_n), moves u by its column. `solve` takes the forces of every row
+before and the rows whose force is unknown, and returns the new forces.
 """
 
 from __future__ import annotations
@@ -33,23 +38,26 @@ __all__ = ["CondensedSaddle"]
 
 
 class CondensedSaddle:
-    """K factorized once and the columns w_j = K⁻¹ b_j of the nodes ever active.
+    """K factorized once and the columns w = K⁻¹ b of the rows ever loaded.
+
+    A row is (block, j): the j-th global row of the block's matrix.
 
     Args:
         J: the tangent form (constant: the residual is linear).
         bcs: the Dirichlet conditions (identity rows of K).
-        B: the gap rows of every slave node (global columns).
+        blocks: the row blocks (PETSc matrices of the same layout, global columns).
         held: the prescribed dofs (global indices, this rank's).
     """
 
-    def __init__(self, J, bcs, B: PETSc.Mat, held: PETSc.IS):
-        self.J, self.bcs, self.B, self.held = J, bcs, B, held
+    def __init__(self, J, bcs, blocks: list[PETSc.Mat], held: PETSc.IS):
+        self.J, self.bcs, self.blocks, self.held = J, bcs, blocks, held
+        B = blocks[0]
         self.comm = B.comm.tompi4py()
-        self.start = B.getOwnershipRange()[0]
-        self.n = B.getSize()[0]
+        self.start, self.local = B.getOwnershipRange()[0], B.getLocalSize()[0]
+        self.n = B.getSize()[0]  # rows per block (every rank's)
         self.ksp = None
-        self.w: dict[int, PETSc.Vec] = {}  # global slave row -> w_j
-        self.S: dict[int, np.ndarray] = {}  # global slave row -> B w_j (every slave row)
+        self.w: dict[int, PETSc.Vec] = {}  # row (block * n + j) -> w
+        self.S: dict[int, np.ndarray] = {}  # row -> [B w; B_t w; ...] (every row)
 
     def factorize(self, work: WorkCounts) -> None:
         """K assembled with its supports and factorized by MUMPS (once)."""
@@ -80,47 +88,78 @@ class CondensedSaddle:
         return x
 
     def columns(self, rows: np.ndarray, work: WorkCounts) -> None:
-        """w_j and B w_j for the global slave rows `rows` not yet kept (collective).
+        """w and [B w; ...] for the rows (block * n + j) not yet kept (collective).
 
         The new columns in one block: MUMPS solves many right-hand sides at once faster
         than one after the other.
         """
-        new = [int(j) for j in rows if int(j) not in self.w]
+        new = [int(k) for k in rows if int(k) not in self.w]
         if not new:
             return
         if self.ksp is None:
             self.factorize(work)
-        E = PETSc.Mat().createDense((self.B.getSizes()[0], (None, len(new))), comm=self.B.comm)
-        E.setUp()
-        for k, j in enumerate(new):
-            if self.start <= j < self.start + self.B.getLocalSize()[0]:
-                E.setValue(j, k, 1.0)
-        E.assemble()
-        b = self.B.transposeMatMult(E)  # the rows of B, as columns
-        b.zeroRows(self.held, diag=0.0)  # the supports take no multiplier
+        b = None
+        for block, M in enumerate(self.blocks):  # each block's rows, as columns
+            E = PETSc.Mat().createDense((M.getSizes()[0], (None, len(new))), comm=M.comm)
+            E.setUp()
+            for col, k in enumerate(new):
+                j = k - block * self.n
+                if k // self.n == block and self.start <= j < self.start + self.local:
+                    E.setValue(j, col, 1.0)
+            E.assemble()
+            part = M.transposeMatMult(E)
+            if b is None:
+                b = part
+            else:
+                b.axpy(1.0, part, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        b.zeroRows(self.held, diag=0.0)  # the supports take no force
         b = b.convert("dense")
         x = b.duplicate()
         t0 = time.perf_counter()
         self.ksp.matSolve(b, x)
         work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
         work.update_columns += len(new)
-        Bx = self.B.matMult(x)
-        local = Bx.getDenseArray()
-        every = np.vstack(self.comm.allgather(np.asarray(local)))
-        for k, j in enumerate(new):
-            self.w[j] = x.getColumnVector(k)
-            self.S[j] = every[:, k].copy()
+        every = np.vstack([np.vstack(self.comm.allgather(np.asarray(
+            M.matMult(x).getDenseArray()))) for M in self.blocks])
+        for col, k in enumerate(new):
+            self.w[k] = x.getColumnVector(col)
+            self.S[k] = every[:, col].copy()
+
+    def solve(self, before: np.ndarray, unknown: np.ndarray, known: np.ndarray,
+              residual: np.ndarray, work: WorkCounts) -> np.ndarray:
+        """The rows' new forces, and u moved by their columns (`move` applies it).
+
+        Args:
+            before: every row's force now (u is in equilibrium with them).
+            unknown: the rows whose force makes their `residual` (a gap, a slip) zero.
+            known: every row's force where it is given (slipping nodes), else 0.
+            residual: every row's condition at u now (gaps, slips since the last step).
+            work: the counts.
+
+        Returns:
+            Every row's new force (0 outside `unknown` and the given ones).
+        """
+        after = known.copy()
+        loaded = np.flatnonzero(before)
+        self.columns(np.union1d(unknown, np.flatnonzero(known)), work)
+        free = np.array([k for k in unknown if abs(self.S[int(k)][int(k)]) > 0], dtype=int)
+        if len(free):  # a row on held dofs only (S_kk = 0) takes no force
+            rhs = -residual[free] + self.flexibility(free, loaded) @ before[loaded]
+            given = np.flatnonzero(known)
+            rhs -= self.flexibility(free, given) @ known[given]
+            after[free] = np.linalg.solve(self.flexibility(free, free), rhs)
+        return after
 
     def flexibility(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """S[rows, cols] (dense, the same on every rank)."""
         if len(cols) == 0:
             return np.zeros((len(rows), 0))
-        return np.column_stack([self.S[int(j)][rows] for j in cols])
+        return np.column_stack([self.S[int(k)][rows] for k in cols])
 
-    def add(self, u: PETSc.Vec, rows: np.ndarray, values: np.ndarray) -> None:
-        """u += Σ_j w_j values_j."""
-        for j, value in zip(rows, values, strict=True):
-            u.axpy(float(value), self.w[int(j)])
+    def move(self, u: PETSc.Vec, before: np.ndarray, after: np.ndarray) -> None:
+        """u += Σ_k w_k (after_k − before_k)."""
+        for k in np.flatnonzero(after - before):
+            u.axpy(float(after[k] - before[k]), self.w[int(k)])
 
 
 def every_rank(comm: MPI.Comm, values: np.ndarray) -> np.ndarray:

@@ -291,7 +291,7 @@ class PairContact:
         self.held = PETSc.IS().createGeneral((owned + start).astype(np.int32),
                                              comm=pair.comm)
         self.history: list[dict] = []
-        self.condensed = CondensedSaddle(self.J, self.bcs, pair.B, self.held) if linear \
+        self.condensed = CondensedSaddle(self.J, self.bcs, [pair.B], self.held) if linear \
             else None
 
     def solve(self) -> SolveResult:
@@ -404,73 +404,84 @@ class PairContact:
         """
         work = work if work is not None else WorkCounts()
         self.active = np.asarray(active, dtype=bool).copy()  # what `state` reports
-        if self.condensed is not None:
-            saved = self.u.x.array.copy(), self.lam.copy()
-            try:
-                return self._condensed_equilibrium(work)
-            except SolveError as err:  # K singular: a body held by the contact alone
-                self.u.x.array[:], self.lam[:] = saved
-                log.warning("contact pair: %s: each set is solved as a saddle point", err)
-                self.condensed = None
+        if self.condensed is not None and self._condensed(
+                np.flatnonzero(every_rank(self.pair.comm, self.active)),
+                np.zeros(self.condensed.n), lambda: every_rank(self.pair.comm,
+                                                             self.pair.gaps(self.u)), work):
+            return 1
         which = np.flatnonzero(self.active)
         lam = self._saddle(self.pair.rows(which), self.pair.gamma[which], None, work)[0]
         self.lam[:] = 0.0
         self.lam[which] = lam
         return self._iterations
 
-    def _condensed_equilibrium(self, work: WorkCounts) -> int:
-        """The set's equilibrium of a linear residual on the kept factorization.
+    # -- a linear residual: one factorization for the run (`contact.condensed`) ----------
 
-        First the equilibrium with the last forces λ (a back-substitution, only if the
-        loads moved since: R(u) − Bᵀλ ≠ 0), then the new forces of the set from the
-        active rows' flexibility, u moved by their columns. Checked: R(u) − Bᵀλ = 0 and
-        the active gaps closed, as the Newton solve checks them.
+    def _rows(self) -> np.ndarray:
+        """Every row's force (every rank's): the normal ones."""
+        return every_rank(self.pair.comm, self.lam)
+
+    def _set_rows(self, forces: np.ndarray) -> None:
+        start = self.condensed.start
+        self.lam[:] = forces[start:start + len(self.lam)]
+
+    def _contact_forces(self) -> PETSc.Vec:
+        """Bᵀλ: the contact forces on the nodes (u's layout)."""
+        out = self.pair.B.createVecRight()
+        self.pair.B.multTranspose(_vec(self.pair.B, self.lam), out)
+        return out
+
+    def _condensed(self, unknown, known, conditions, work: WorkCounts) -> bool:
+        """The statuses' equilibrium on the kept factorization; False if it cannot be.
+
+        First the equilibrium with the forces now (a back-substitution, only if the loads
+        moved since: R(u) − Bᵀλ ≠ 0), then the forces of the `unknown` rows that zero their
+        `conditions()` (gaps, slips) with the `known` ones given, u moved by their columns.
+        Checked, as a Newton solve checks its answer: R(u) − Bᵀλ = 0 and the conditions met
+        to 1e-12 of the bodies' size. K singular (a body held by the contact alone) or a
+        residual not linear in u fails the check: the state is put back, said, and from
+        then on each set is a saddle point factorized (False).
         """
-        pair, c, comm = self.pair, self.condensed, self.pair.comm
-        r = self._out_of_balance(work)
-        reference = self.scale if self.scale is not None else max(
-            r.norm(), float(np.linalg.norm(every_rank(comm, self.lam))))
-        if r.norm() > self.rel * reference:  # the loads moved: the new u_0 (+ W λ)
-            self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
+        c = self.condensed
+        saved = self.u.x.array.copy(), self._rows()
+        try:
+            r = self._out_of_balance(work)
+            before = saved[1]
+            reference = self.scale if self.scale is not None else max(
+                r.norm(), float(np.linalg.norm(before)))
+            if r.norm() > self.rel * reference:  # the loads moved: the new u_0 (+ W λ)
+                self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
+                self.u.x.scatter_forward()
+                work.linear_solves += 1
+            after = c.solve(before, unknown, known, conditions(), work)
+            c.move(self.u.x.petsc_vec, before, after)
             self.u.x.scatter_forward()
-            work.linear_solves += 1
-        lam = every_rank(comm, self.lam)
-        now = np.flatnonzero(every_rank(comm, self.active))  # global slave rows
-        was = np.flatnonzero(lam)
-        c.columns(now, work)
-        g = every_rank(comm, pair.gaps(self.u))
-        new = np.linalg.solve(c.flexibility(now, now),
-                              -g[now] + c.flexibility(now, was) @ lam[was]) if len(now) \
-            else np.zeros(0)
-        c.add(self.u.x.petsc_vec, now, new)
-        c.add(self.u.x.petsc_vec, was, -lam[was])
-        self.u.x.scatter_forward()
-        lam[:] = 0.0
-        lam[now] = new
-        start = c.start
-        self.lam[:] = lam[start:start + len(self.lam)]
-        norm = self._out_of_balance(work).norm()
-        if self.scale is None:
-            reference = max(reference, float(np.linalg.norm(new)))
-        gaps = np.abs(pair.gaps(self.u)[self.active]).max(initial=0.0)
-        closed = comm.allreduce(float(gaps), op=MPI.MAX) <= 1e-12 * pair.length
-        if not (norm <= self.rel * reference and closed):
-            raise SolveError(f"the condensed solve left |R| = {norm:.2e} or gaps open (K "
-                             "singular, a body held by the contact alone; or a residual not "
-                             "linear in u)")
-        return 1
+            self._set_rows(after)
+            norm = self._out_of_balance(work).norm()
+            if self.scale is None:
+                reference = max(reference, float(np.linalg.norm(after)))
+            left = np.abs(conditions()[unknown]).max(initial=0.0)
+            if not (norm <= self.rel * reference and left <= 1e-12 * self.pair.length):
+                raise SolveError(f"the condensed solve left |R| = {norm:.2e} and conditions "
+                                 f"{left:.2e} (K singular, a body held by the contact "
+                                 "alone; or a residual not linear in u)")
+            return True
+        except SolveError as err:
+            self.u.x.array[:] = saved[0]
+            self._set_rows(saved[1])
+            log.warning("contact pair: %s: each set is solved as a saddle point", err)
+            self.condensed = None
+            return False
 
     def _out_of_balance(self, work: WorkCounts) -> PETSc.Vec:
-        """R(u) − Bᵀλ with the supports' values set in u (their rows zeroed)."""
+        """R(u) − (the contact forces) with the supports' values set in u (their rows 0)."""
         for bc in self.bcs:
             bc.set(self.u.x.array)
         self.u.x.scatter_forward()
         R = petsc.assemble_vector(self.F)
         R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
         work.residual_assemblies += 1
-        Bt_lam = self.pair.B.createVecRight()
-        self.pair.B.multTranspose(_vec(self.pair.B, self.lam), Bt_lam)
-        R.axpy(-1.0, Bt_lam)
+        R.axpy(-1.0, self._contact_forces())
         _zero(R, self.held)
         return R
 
@@ -625,6 +636,8 @@ class FrictionalPair(PairContact):
         self.slip, self.s = np.zeros(n, dtype=bool), np.zeros(n)
         self.lam_t = np.zeros(n)
         self.committed = pair.tangential(u)
+        if self.condensed is not None:  # the stuck nodes' slips are rows too
+            self.condensed = CondensedSaddle(self.J, self.bcs, [pair.B, pair.Bt], self.held)
 
     def commit(self) -> None:
         """The converged step's tangential displacement: the next step's slip is from it."""
@@ -694,8 +707,44 @@ class FrictionalPair(PairContact):
         raise SolveError(f"the frictional statuses did not settle in {self.max_iterations} "
                          "iterations")
 
+    def _rows(self) -> np.ndarray:
+        """Every row's force (every rank's): the normal ones, then the tangential ones."""
+        comm = self.pair.comm
+        return np.concatenate([every_rank(comm, self.lam), every_rank(comm, self.lam_t)])
+
+    def _set_rows(self, forces: np.ndarray) -> None:
+        n, start, local = self.condensed.n, self.condensed.start, len(self.lam)
+        self.lam[:] = forces[start:start + local]
+        self.lam_t[:] = forces[n + start:n + start + local]
+
+    def _contact_forces(self) -> PETSc.Vec:
+        """Bᵀλ_n + B_tᵀλ_t."""
+        out = super()._contact_forces()
+        tangential = self.pair.Bt.createVecRight()
+        self.pair.Bt.multTranspose(_vec(self.pair.Bt, self.lam_t), tangential)
+        out.axpy(1.0, tangential)
+        return out
+
+    def _condensed_statuses(self, lam_n: np.ndarray, work: WorkCounts) -> bool:
+        """The statuses' equilibrium on the kept factorization (False: it cannot be)."""
+        comm, n = self.pair.comm, self.condensed.n
+        closed = every_rank(comm, self.active)
+        slipping = closed & every_rank(comm, self.slip)
+        unknown = np.concatenate([np.flatnonzero(closed),
+                                  n + np.flatnonzero(closed & ~slipping)])
+        known = np.zeros(2 * n)
+        known[n:][slipping] = every_rank(comm, self.f * lam_n * self.s)[slipping]
+
+        def conditions():  # the gaps, and the slips since the last committed state
+            return np.concatenate([every_rank(comm, self.pair.gaps(self.u)), every_rank(
+                comm, self.pair.tangential(self.u) - self.committed)])
+
+        return self._condensed(unknown, known, conditions, work)
+
     def _equilibrium(self, lam_n: np.ndarray, work: WorkCounts) -> int:
-        """One saddle-point solve for the current statuses; the slip forces from `lam_n`."""
+        """One solve for the current statuses; the slip forces from `lam_n`."""
+        if self.condensed is not None and self._condensed_statuses(lam_n, work):
+            return 1
         pair = self.pair
         stick = np.flatnonzero(self.active & ~self.slip)
         closed = np.flatnonzero(self.active)
