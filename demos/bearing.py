@@ -7,7 +7,9 @@
 # writes its loop out. At light load the contact is Hertz's between two cylinders, one in
 # the other; as the load grows the arc spreads over a good part of the circumference, where
 # Hertz's half-spaces no longer describe either body: the computed arc stays narrower than
-# Hertz's, its pressure higher.
+# Hertz's, its pressure higher. Then, with Coulomb friction between them, the shaft is
+# turned by its hub: the torque the contact holds grows while part of the arc sticks, and
+# stays at the Coulomb limit once all of it slips.
 #
 # ## Problem definition
 #
@@ -47,7 +49,7 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from fenics_nl.contact.pair import ContactPair, PairContact
+from fenics_nl.contact.pair import ContactPair, FrictionalPair, PairContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.two_bodies import shaft_in_bearing
 from fenics_nl.errors import SolveError
@@ -99,6 +101,11 @@ class Bearing(Parameters):
                         at_least=2)
     size: float = number(0.025, "element size along the shaft's surface and the bore within "
                          "60° of their lowest points", unit="length", above=0)
+    friction: float = number(0.2, "Coulomb's coefficient between shaft and bore, for the "
+                             "torque (0: no torque part)", unit="-", at_least=0)
+    turn: float = number(0.01, "the hub's last rotation, in radians, under the last push",
+                         unit="rad", above=0)
+    turn_steps: int = number(5, "steps of the rotation", at_least=1)
 
     def check(self):
         if not self.outer_radius > self.radius + self.clearance:
@@ -152,10 +159,9 @@ bcs = [push, boundary.component(V, 0, tagged("hub")),
 
 # +
 dx = ufl.Measure("dx", msh, subdomain_data=mesh_data.cell_tags)
-materials = {mesh_data.physical_groups["shaft"].tag: LinearElastic(args.E_shaft,
-                                                                   args.nu_shaft),
-             mesh_data.physical_groups["housing"].tag: LinearElastic(args.E_housing,
-                                                                     args.nu_housing)}
+shaft_tag, housing_tag = (mesh_data.physical_groups[n].tag for n in ("shaft", "housing"))
+materials = {shaft_tag: LinearElastic(args.E_shaft, args.nu_shaft),
+             housing_tag: LinearElastic(args.E_housing, args.nu_housing)}
 eps, eps_v = (kinematics.small_strain(w, "plane_strain") for w in (u, v))
 residual = sum(ufl.inner(law.stress(eps), eps_v) * dx(group)
                for group, law in materials.items())
@@ -259,6 +265,83 @@ say(f"lightest step: a {100 * errors['contact_radius']:+.2f} %, p0 "
     f"±{heavy['arc_degrees']:.1f}°")
 # -
 
+# ## Turning the shaft: the friction torque
+#
+# With Coulomb friction $f$ between the bodies (`--friction`), a torque on the shaft is
+# held by the contact until every node in contact slips. A turn is not symmetric about the
+# load's line: the whole shaft and housing now, pushed as above, then the hub turned by
+# small angles $\theta$ ($u = \theta\, e_z \times x$ plus the push on the hub; small
+# sliding: $R_1 \theta$ stays a few elements). A node in contact is stuck (no relative
+# tangential displacement since the last step, $|\lambda_t| \le f \lambda_n$) or slipping
+# ($\lambda_t = f \lambda_n$ against its slip): the course's statuses on the pair
+# (`FrictionalPair`, on one factorization as above, the stuck nodes' slips rows of their
+# own). The torque of the bore on the shaft, $T = \sum_s x_s \times (\lambda_n n +
+# \lambda_t t)$, grows with $\theta$ while a stick zone remains, then stays at the Coulomb
+# limit $T = f R_1 \sum_s \lambda_{n,s}$: more than $f R_1 P$, since around a conforming
+# arc the normal forces add up to more than their resultant $P$ (the arc's "friction
+# factor" $\sum \lambda_n / P$; $4/\pi$ for a cosine pressure over a half circle).
+
+# +
+torque = None
+if args.friction > 0:
+    whole = shaft_in_bearing(comm, R1, c, args.outer_radius, args.size, full=True)
+
+    def on_whole(name):
+        """The facets of the whole model's physical group `name`."""
+        return whole.facet_tags.find(whole.physical_groups[name].tag)
+
+    W = fem.functionspace(whole.mesh, ("Lagrange", 1, (2,)))
+    w, w_v = fem.Function(W, name="displacement"), ufl.TestFunction(W)
+    hub = [boundary.component(W, k, on_whole("hub")) for k in (0, 1)]
+    hub_x = hub[0].g.function_space.tabulate_dof_coordinates()  # the hub's rigid motion
+    bcs_whole = [*hub, *(boundary.component(W, k, on_whole("housing_outer")) for k in (0, 1))]
+    dxw = ufl.Measure("dx", whole.mesh, subdomain_data=whole.cell_tags)
+    e, e_v = (kinematics.small_strain(x, "plane_strain") for x in (w, w_v))
+    residual_whole = sum(ufl.inner(law.stress(e), e_v) * dxw(whole.physical_groups[name].tag)
+                         for name, law in (("shaft", materials[shaft_tag]),
+                                           ("housing", materials[housing_tag])))
+    ring = ContactPair(W, on_whole("shaft_surface"), on_whole("bore"))
+    turning = FrictionalPair(residual_whole, w, bcs_whole, ring, args.friction,
+                             force_scale=args.E_housing * c, linear=True)
+
+    def move_hub(drop, theta):
+        """The hub pushed down by `drop` and turned by `theta` (counter-clockwise)."""
+        hub[0].g.x.array[:] = -theta * hub_x[:, 1]
+        hub[1].g.x.array[:] = -drop + theta * hub_x[:, 0]
+
+    def resisting_torque():
+        """−Σ x × (λ_n n + λ_t t): the bore's torque against the turn (every rank's)."""
+        n = ring.normal
+        F = turning.lam[:, None] * n + turning.lam_t[:, None] * np.c_[-n[:, 1], n[:, 0]]
+        return -ring.total(ring.x[:, 0] * F[:, 1] - ring.x[:, 1] * F[:, 0])
+
+    torque = {"rotation": [], "torque": [], "limit": [], "slipping": [], "in_contact": []}
+    for delta in args.push * np.geomspace(1e-2, 1.0, args.steps):  # the same pushes
+        move_hub(c + delta, 0.0)
+        turning.solve()
+        turning.commit()
+    for theta in np.linspace(0.0, args.turn, args.turn_steps + 1)[1:]:
+        move_hub(c + args.push, theta)
+        result = turning.solve()
+        turning.commit()
+        closed = turning.active
+        torque["rotation"].append(theta)
+        torque["torque"].append(resisting_torque())
+        torque["limit"].append(args.friction * R1 * ring.total(turning.lam[closed]))
+        torque["slipping"].append(comm.allreduce(int((closed & turning.slip).sum())))
+        torque["in_contact"].append(comm.allreduce(int(closed.sum())))
+        say(f"  turned by {theta:.4g} rad: T = {torque['torque'][-1]:.5g}, "
+            f"f R1 Σλ_n = {torque['limit'][-1]:.5g}, {torque['slipping'][-1]} of "
+            f"{torque['in_contact'][-1]} nodes slipping, {result.active_set_iterations} "
+            "status iterations")
+    torque["friction_factor"] = torque["limit"][-1] / (args.friction * R1
+                                                       * turning.force()[1])
+    torque["saturation"] = torque["torque"][-1] / torque["limit"][-1]
+    say(f"the friction torque saturates at {torque['saturation']:.6f} of f R1 Σλ_n (the "
+        f"chords' normals are not quite radial); the arc's friction factor Σλ_n/P = "
+        f"{torque['friction_factor']:.4f}")
+# -
+
 # ## Outputs
 
 
@@ -270,7 +353,7 @@ def summary():
            "active_set_iterations": sum(h["iterations"] for h in history),
            "factorizations": work.factorizations, "linear_solves": work.linear_solves,
            "update_columns": work.update_columns, "dofs": output.dofs(V), "ranks": comm.size,
-           "solve_time_s": solve_time, "warnings": []}
+           "solve_time_s": solve_time, "torque": torque, "warnings": []}
     if light["nodes"] < 10:
         out["warnings"].append(f"{light['nodes']} nodes in contact at the lightest step: "
                                "a and p0 are coarse there (refine --size)")
@@ -278,11 +361,12 @@ def summary():
 
 
 def plot():
-    """a and p0 against P, and the pressure around the arc, with Hertz's."""
+    """a and p0 against P, the pressure around the arc, with Hertz's; the torque."""
     indentation_pictures.pair_curves(
         history, f"a shaft (R1 = {R1:g}) in a bore with a clearance of {c:g}: Hertz at "
         f"light load (a {100 * errors['contact_radius']:+.1f} %, p0 "
-        f"{100 * errors['max_pressure']:+.1f} %), then departing from it", args.plot)
+        f"{100 * errors['max_pressure']:+.1f} %), then departing from it", args.plot,
+        torque=torque)
 
 
 def picture():

@@ -11,9 +11,10 @@ the supports take no multiplier). The gaps of the active nodes close when
     S_AA λ_A = −(B_A u_0 + γ_A),     S = B W  (the contact surface's flexibility),
 
 a dense system of the active nodes only. So K is factorized once for the whole run; a
-column w_j is solved the first time node j becomes active and kept (with B w_j, a column of
-S); an active-set iteration is then a small dense solve and vector updates, and a load step
-costs one back-substitution (the new u_0) besides the new columns. The rigid obstacle's row
+column w_j is solved the first time node j becomes active (in one block with the others
+new at that iteration) and B w_j, a column of S, kept; an active-set iteration is then a
+small dense solve and one back-substitution (u moved by Σ w_j Δλ_j), and a load step one
+more (the new u_0). The rigid obstacle's row
 update (`solvers.row_update`) does the same with Dirichlet rows.
 
 The rows come in blocks (the normal gaps B; with friction also the tangential slips B_t):
@@ -56,8 +57,17 @@ class CondensedSaddle:
         self.start, self.local = B.getOwnershipRange()[0], B.getLocalSize()[0]
         self.n = B.getSize()[0]  # rows per block (every rank's)
         self.ksp = None
-        self.w: dict[int, PETSc.Vec] = {}  # row (block * n + j) -> w
-        self.S: dict[int, np.ndarray] = {}  # row -> [B w; B_t w; ...] (every row)
+        self.column: dict[int, int] = {}  # row (block * n + j) -> its column of S
+        # S's columns [B w; B_t w; ...] (every row), in an array with room for twice
+        # the columns (grown by doubling, not copied at every new column); the w
+        # themselves are not kept (rows of u × columns: too many), u moves by a
+        # back-substitution instead (`move`)
+        self._S = np.zeros((len(blocks) * self.n, 0))
+
+    @property
+    def S(self) -> np.ndarray:
+        """The flexibility's kept columns, [B w; B_t w; ...] (every row, dense)."""
+        return self._S[:, :len(self.column)]
 
     def factorize(self, work: WorkCounts) -> None:
         """K assembled with its supports and factorized by MUMPS (once)."""
@@ -93,16 +103,38 @@ class CondensedSaddle:
         The new columns in one block: MUMPS solves many right-hand sides at once faster
         than one after the other.
         """
-        new = [int(k) for k in rows if int(k) not in self.w]
+        new = [int(k) for k in rows if int(k) not in self.column]
         if not new:
             return
         if self.ksp is None:
             self.factorize(work)
+        b = self._unit_loads(new)
+        x = b.duplicate()
+        t0 = time.perf_counter()
+        self.ksp.matSolve(b, x)
+        work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
+        work.update_columns += len(new)
+        every = np.vstack([np.vstack(self.comm.allgather(np.asarray(
+            M.matMult(x).getDenseArray()))) for M in self.blocks])
+        first, last = len(self.column), len(self.column) + len(new)
+        if last > self._S.shape[1]:  # more room: twice what is needed
+            grown = np.zeros((self._S.shape[0], 2 * last))
+            grown[:, :first] = self.S
+            self._S = grown
+        self._S[:, first:last] = every
+        self.column.update({k: first + col for col, k in enumerate(new)})
+
+    def _unit_loads(self, rows: list[int]) -> PETSc.Mat:
+        """b_k for the rows k, as the columns of a dense matrix (u's rows).
+
+        b_k: the row k of its block, transposed, the supports' dofs zeroed (they take no
+        force).
+        """
         b = None
-        for block, M in enumerate(self.blocks):  # each block's rows, as columns
-            E = PETSc.Mat().createDense((M.getSizes()[0], (None, len(new))), comm=M.comm)
+        for block, M in enumerate(self.blocks):
+            E = PETSc.Mat().createDense((M.getSizes()[0], (None, len(rows))), comm=M.comm)
             E.setUp()
-            for col, k in enumerate(new):
+            for col, k in enumerate(rows):
                 j = k - block * self.n
                 if k // self.n == block and self.start <= j < self.start + self.local:
                     E.setValue(j, col, 1.0)
@@ -112,18 +144,21 @@ class CondensedSaddle:
                 b = part
             else:
                 b.axpy(1.0, part, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        b.zeroRows(self.held, diag=0.0)  # the supports take no force
-        b = b.convert("dense")
-        x = b.duplicate()
-        t0 = time.perf_counter()
-        self.ksp.matSolve(b, x)
-        work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
-        work.update_columns += len(new)
-        every = np.vstack([np.vstack(self.comm.allgather(np.asarray(
-            M.matMult(x).getDenseArray()))) for M in self.blocks])
-        for col, k in enumerate(new):
-            self.w[k] = x.getColumnVector(col)
-            self.S[k] = every[:, col].copy()
+        b.zeroRows(self.held, diag=0.0)
+        return b.convert("dense")
+
+    def _load(self, forces: np.ndarray) -> PETSc.Vec:
+        """Σ_k b_k forces_k (every row's force; u's layout, the supports' dofs zeroed)."""
+        out = None
+        for block, M in enumerate(self.blocks):
+            v = M.createVecLeft()
+            first = block * self.n + self.start
+            v.array[:] = forces[first:first + self.local]
+            part = M.createVecRight()
+            M.multTranspose(v, part)
+            out = part if out is None else out + part
+        out.array[self.held.indices - out.getOwnershipRange()[0]] = 0.0
+        return out
 
     def solve(self, before: np.ndarray, unknown: np.ndarray, known: np.ndarray,
               residual: np.ndarray, work: WorkCounts) -> np.ndarray:
@@ -142,7 +177,8 @@ class CondensedSaddle:
         after = known.copy()
         loaded = np.flatnonzero(before)
         self.columns(np.union1d(unknown, np.flatnonzero(known)), work)
-        free = np.array([k for k in unknown if abs(self.S[int(k)][int(k)]) > 0], dtype=int)
+        free = np.array([k for k in unknown if abs(self.S[int(k), self.column[int(k)]]) > 0],
+                        dtype=int)
         if len(free):  # a row on held dofs only (S_kk = 0) takes no force
             rhs = -residual[free] + self.flexibility(free, loaded) @ before[loaded]
             given = np.flatnonzero(known)
@@ -152,14 +188,15 @@ class CondensedSaddle:
 
     def flexibility(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """S[rows, cols] (dense, the same on every rank)."""
-        if len(cols) == 0:
-            return np.zeros((len(rows), 0))
-        return np.column_stack([self.S[int(k)][rows] for k in cols])
+        where = [self.column[int(k)] for k in cols]
+        return self.S[np.ix_(np.asarray(rows, dtype=int), where)]
 
-    def move(self, u: PETSc.Vec, before: np.ndarray, after: np.ndarray) -> None:
-        """u += Σ_k w_k (after_k − before_k)."""
-        for k in np.flatnonzero(after - before):
-            u.axpy(float(after[k] - before[k]), self.w[int(k)])
+    def move(self, u: PETSc.Vec, before: np.ndarray, after: np.ndarray,
+             work: WorkCounts) -> None:
+        """u += K⁻¹ Σ_k b_k (after_k − before_k): one back-substitution."""
+        if np.any(after != before):
+            u.axpy(1.0, self.back_solve(self._load(after - before), work))
+            work.linear_solves += 1
 
 
 def every_rank(comm: MPI.Comm, values: np.ndarray) -> np.ndarray:

@@ -454,7 +454,7 @@ class PairContact:
                 self.u.x.scatter_forward()
                 work.linear_solves += 1
             after = c.solve(before, unknown, known, conditions(), work)
-            c.move(self.u.x.petsc_vec, before, after)
+            c.move(self.u.x.petsc_vec, before, after, work)
             self.u.x.scatter_forward()
             self._set_rows(after)
             norm = self._out_of_balance(work).norm()
@@ -610,9 +610,12 @@ class FrictionalPair(PairContact):
     * slipping nodes: g_n = 0 and the tangential force f λ_n s on the slave (its opposite,
       by the shape functions, on the master), λ_n from the last iteration;
 
-    then updates the statuses: a closed node in tension opens, an open node that penetrates
-    closes (stuck); a stuck node whose |λ_t| exceeds f λ_n slips, s = sign(λ_t); a slipping
-    node whose slip goes along its friction force (Δg_t s > 0) sticks. The loop ends when no
+    then updates the statuses: a closed node in tension opens; an open node that penetrates
+    closes, slipping without friction (it cannot stick where it was at the step's start:
+    it touched down within the step), until its slip gives the friction's sense, s =
+    −sign(Δg_t), or sticks if it has not slipped; a stuck node whose |λ_t| exceeds f λ_n
+    slips, s = sign(λ_t); a slipping node whose slip goes along its friction force
+    (Δg_t s > 0) sticks. (As on a rigid obstacle, `contact.friction`.) The loop ends when no
     status changes and the friction forces agree with the normal forces of the same solve
     (to 1e-9 of the largest).
 
@@ -689,10 +692,14 @@ class FrictionalPair(PairContact):
             closing = ~self.active & (g < -1e-12 * self.pair.length)
             sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9))
             holding = self.active & self.slip & (dg * self.s > 0)
+            landed = self.active & self.slip & (self.s == 0)  # touched down, no sense yet
+            sensing = landed & (np.abs(dg) > 1e-12 * self.pair.length)
+            resting = landed & ~sensing  # it has not slipped since it landed: it sticks
             scale = comm.allreduce(float(np.abs(self.lam).max(initial=0.0)), op=MPI.MAX)
             drift = comm.allreduce(float(np.abs((self.lam - lam_n)[self.slip]).max(
                 initial=0.0)), op=MPI.MAX)
-            changes = comm.allreduce(int((opening | closing | sliding | holding).sum()))
+            changes = comm.allreduce(int((opening | closing | sliding | holding | landed
+                                          ).sum()))
             history.append({"iteration": k, "active": comm.allreduce(int(self.active.sum())),
                             "slip": comm.allreduce(int((self.active & self.slip).sum())),
                             "changes": changes})
@@ -701,7 +708,9 @@ class FrictionalPair(PairContact):
                 return SolveResult(True, "converged", its, [], work, time.perf_counter() - t0,
                                    active_set_iterations=k, history=history)
             self.s = np.where(sliding, np.sign(self.lam_t), self.s)
-            self.slip = (self.slip & ~holding | sliding) & ~opening & ~closing
+            self.s = np.where(sensing, -np.sign(dg), self.s)  # friction against the slip
+            self.s = np.where(closing, 0.0, self.s)
+            self.slip = (self.slip & ~holding & ~resting | sliding | closing) & ~opening
             self.active = (self.active & ~opening) | closing
             lam_n = self.lam.copy()
         raise SolveError(f"the frictional statuses did not settle in {self.max_iterations} "

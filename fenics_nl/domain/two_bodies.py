@@ -13,10 +13,10 @@ Cell tags ``upper``, ``lower``; facet tags ``upper_contact`` (the upper body's a
 lower arc or the block's top), ``lower_bottom`` (the equator or the block's bottom),
 ``lower_axis``, and ``lower_side`` (the block's).
 
-`shaft_in_bearing`: the half (x ≥ 0) of a shaft of radius R1 in a housing of bore R2 =
-R1 + clearance and outer radius R3, both centred at the origin (plane strain), a node at
-the shaft's centre (where it may be pushed): they do not touch; pushed down, the shaft's
-lowest point meets the bore's. Triangles of size h along the
+`shaft_in_bearing`: the half (x ≥ 0; or the whole) of a shaft of radius R1 around its hub
+(a rigid core of radius R1/5, where it is driven) in a housing of bore R2 = R1 + clearance
+and outer radius R3, all centred at the origin (plane strain): they do not touch; pushed
+down, the shaft's lowest point meets the bore's. Triangles of size h along the
 lower halves of both circles (where the contact arc grows), growing away from them.
 """
 
@@ -111,7 +111,7 @@ BEARING_TAGS = ("shaft_surface", "shaft_symmetry", "hub", "bore", "housing_outer
 
 
 def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: float,
-                     growth: float = 0.15) -> gmshio.MeshData:
+                     growth: float = 0.15, full: bool = False) -> gmshio.MeshData:
     """The half shaft (around its hub) in the half housing, refined along the lower arcs.
 
     Args:
@@ -121,10 +121,12 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
         R3: the housing's outer radius (> R1 + clearance).
         h: the element size along the lower halves of the shaft's surface and the bore.
         growth: the elements' growth per unit distance beyond.
+        full: the whole shaft and housing (no symmetry lines): a load that is not along
+            the symmetry line, a torque.
 
     Returns:
         The mesh with its cell tags (``shaft`` 1, ``housing`` 2) and facet tags
-        (`BEARING_TAGS`).
+        (`BEARING_TAGS`; without the symmetry lines if `full`).
     """
     if not (clearance > 0 and R3 > R1 + clearance):
         raise ValueError(f"need clearance > 0 and R3 > R1 + clearance, got clearance = "
@@ -135,13 +137,15 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
         start_model("bearing")
         occ = gmsh.model.occ
 
-        def half(disc_out, disc_in):
-            """The half x ≥ 0 of the annulus between two radii."""
+        def annulus(disc_out, disc_in):
+            """The annulus between two radii (its half x ≥ 0 unless `full`)."""
             ring = occ.cut([(2, occ.addDisk(0, 0, 0, disc_out, disc_out))],
                            [(2, occ.addDisk(0, 0, 0, disc_in, disc_in))])[0]
+            if full:
+                return ring
             return occ.intersect(ring, [(2, occ.addRectangle(0, -r3, 0, r3, 2 * r3))])[0]
 
-        shaft, housing = half(r1, hub), half(r3, r2)
+        shaft, housing = annulus(r1, hub), annulus(r3, r2)
         occ.synchronize()
         tol = 1e-6
         groups = {name: [] for name in BEARING_TAGS}
@@ -149,7 +153,7 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
             _, curves = gmsh.model.getAdjacencies(dim, surface)
             for c in curves:
                 x, _, _ = occ.getCenterOfMass(1, c)
-                if abs(x) < tol:
+                if abs(x) < tol and not full:
                     groups[f"{body}_symmetry"].append(c)
                     continue
                 lo, hi = gmsh.model.getParametrizationBounds(1, c)

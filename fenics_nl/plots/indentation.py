@@ -375,7 +375,7 @@ def _title(out: dict) -> str:
 
 
 def pair_curves(steps: list[dict], title: str, path: str,
-                comm: MPI.Comm = MPI.COMM_WORLD) -> None:
+                comm: MPI.Comm = MPI.COMM_WORLD, torque: dict | None = None) -> None:
     """a and p0 against the force (log–log) and p around the arc, with Hertz's.
 
     Args:
@@ -385,11 +385,14 @@ def pair_curves(steps: list[dict], title: str, path: str,
         title: the figure's title.
         path: the PNG, written by rank 0 of `comm`.
         comm: the run's communicator.
+        torque: a third panel, the friction torque against the rotation: `rotation`,
+            `torque`, its Coulomb `limit` (f R Σλ_n) and the nodes `slipping` of those
+            `in_contact`, per step.
     """
     if comm.rank != 0:
         return
     plt = figures.pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, axes = plt.subplots(1, 3 if torque else 2, figsize=(18 if torque else 12, 4.8))
     P = np.array([s["force"] for s in steps])
     ax = axes[0]
     for key, name, colour in (("contact_radius", "half-width a", "C0"),
@@ -418,5 +421,20 @@ def pair_curves(steps: list[dict], title: str, path: str,
     ax.set_title("pressure around the arc (lines: Hertz for the same P)", fontsize=9)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
+    if torque:
+        ax = axes[2]
+        theta = [0.0, *torque["rotation"]]
+        ax.plot(theta, [0.0, *torque["torque"]], "o-", color="C0", label="FE: torque T")
+        ax.plot(torque["rotation"], torque["limit"], "--", color="C3",
+                label="Coulomb limit f R Σλ_n")
+        for th, t, k, m in zip(torque["rotation"], torque["torque"], torque["slipping"],
+                               torque["in_contact"], strict=True):
+            ax.annotate(f"{k}/{m}", (th, t), textcoords="offset points", xytext=(4, -12),
+                        fontsize=7)
+        ax.set_xlabel("rotation of the hub θ [rad]")
+        ax.set_ylabel("torque resisting the turn [force·length/length]")
+        ax.set_title("the friction torque (labels: nodes slipping / in contact)", fontsize=9)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
     fig.suptitle(title, fontsize=11)
     figures.save_figure(fig, path)
