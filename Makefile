@@ -45,7 +45,15 @@ $(VENV)/.docs-installed: $(VENV)/.installed
 # the benchmarks' extra and the peers, with --no-deps (see pyproject.toml's bench extra):
 # the J2 peer and the phase-field peer (it declares nothing; it needs pandas, in the extra)
 PEER := dolfinx-external-operator==0.11.0 phasefieldx==0.4.1
-$(VENV)/.bench-installed: $(VENV)/.installed
+# the two-body contact peer (benchmarks/ngsolve_pair.py) in a venv of its own: NGSolve
+# brings its own OpenBLAS and OpenCASCADE, kept apart from PETSc's and gmsh's; it runs in
+# its own process anyway (benchmarks/contact_pair.py finds it by NGSOLVE_PYTHON)
+NGSOLVE := .venv-ngsolve/bin/python
+$(NGSOLVE):
+	$(PY) -m venv .venv-ngsolve
+	.venv-ngsolve/bin/python -m pip install --quiet ngsolve==6.2.2608
+
+$(VENV)/.bench-installed: $(VENV)/.installed $(NGSOLVE)
 	$(call install,-e ".[bench]")
 	$(call install,--no-deps $(PEER))
 	@touch $@
@@ -103,7 +111,8 @@ BENCHMARKS := newton contact contact_pair buckling bracket iterative arch_iterat
 	friction continuation newtonal damage damage_peer identification forming creep
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
-	  $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) || exit 1; done
+	  NGSOLVE_PYTHON=$(NGSOLVE) $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) \
+	  || exit 1; done
 	$(if $(QUICK),,$(PY) benchmarks/reading.py --update-docs)
 
 bench-large: $(VENV)/.installed
@@ -128,4 +137,4 @@ lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 
 clean:
-	rm -rf $(VENV) *.egg-info results docs/_build docs/demos docs/screenshots
+	rm -rf $(VENV) .venv-ngsolve *.egg-info results docs/_build docs/demos docs/screenshots
