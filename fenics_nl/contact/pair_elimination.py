@@ -146,22 +146,21 @@ class EliminatedPair(PairContact):
         """T: the identity on the free dofs, the constraint's row on each eliminated one.
 
         The increments' transform: the held dofs' columns are left out (their increment is
-        0), so that Tᵀ K T keeps their identity rows.
+        0), so that Tᵀ K T keeps their identity rows. Built row by row as CSR arrays.
         """
         start, n_owned, N = self.n_dofs
-        T = PETSc.Mat().createAIJ(((n_owned, N), (n_owned, N)), nnz=(7, 7),
-                                  comm=self.pair.comm)
-        T.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        rows = self._rows(which)
-        eliminated = {dof for dof, _ in rows}
-        for dof in range(start, start + n_owned):
-            if dof not in eliminated:
-                T.setValue(dof, dof, 1.0)
         held = set(every_rank(self.pair.comm, self.held.indices).tolist())
-        for dof, terms in rows:
-            for col, c in terms:
-                if col not in held:
-                    T.setValue(dof, col, c, addv=PETSc.InsertMode.ADD_VALUES)
+        rows = {dof - start: [(col, c) for col, c in terms if col not in held]
+                for dof, terms in self._rows(which)}
+        indptr, indices, values = [0], [], []
+        for r in range(n_owned):
+            entries = sorted(rows.get(r, [(start + r, 1.0)]))
+            indices += [col for col, _ in entries]
+            values += [c for _, c in entries]
+            indptr.append(len(indices))
+        T = PETSc.Mat().createAIJ(((n_owned, N), (n_owned, N)), csr=(
+            np.array(indptr, dtype=PETSc.IntType), np.array(indices, dtype=PETSc.IntType),
+            np.array(values)), comm=self.pair.comm)
         T.assemble()
         return T
 
