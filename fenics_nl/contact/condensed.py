@@ -161,15 +161,19 @@ class CondensedSaddle:
         return out
 
     def solve(self, before: np.ndarray, unknown: np.ndarray, known: np.ndarray,
-              residual: np.ndarray, work: WorkCounts) -> np.ndarray:
+              residual: np.ndarray, work: WorkCounts,
+              compliance: np.ndarray | None = None) -> np.ndarray:
         """The rows' new forces, and u moved by their columns (`move` applies it).
 
         Args:
             before: every row's force now (u is in equilibrium with them).
             unknown: the rows whose force makes their `residual` (a gap, a slip) zero.
             known: every row's force where it is given (slipping nodes), else 0.
-            residual: every row's condition at u now (gaps, slips since the last step).
+            residual: every row's condition at u now (gaps, slips since the last step),
+                with its compliance's term c λ if any.
             work: the counts.
+            compliance: c, one per row (of the first block) or None: each unknown row's
+                condition is then residual + S Δλ + c Δλ = 0 (wear in the gap).
 
         Returns:
             Every row's new force (0 outside `unknown` and the given ones).
@@ -183,7 +187,13 @@ class CondensedSaddle:
             rhs = -residual[free] + self.flexibility(free, loaded) @ before[loaded]
             given = np.flatnonzero(known)
             rhs -= self.flexibility(free, given) @ known[given]
-            after[free] = np.linalg.solve(self.flexibility(free, free), rhs)
+            S = self.flexibility(free, free)
+            if compliance is not None:  # c (λ_new − λ_before) joins the residual's c λ_before
+                c = np.zeros(len(before))
+                c[:len(compliance)] = compliance
+                S = S + np.diag(c[free])
+                rhs += c[free] * before[free]
+            after[free] = np.linalg.solve(S, rhs)
         return after
 
     def flexibility(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:

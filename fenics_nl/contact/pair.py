@@ -293,6 +293,9 @@ class PairContact:
         self.history: list[dict] = []
         self.condensed = CondensedSaddle(self.J, self.bcs, [pair.B], self.held) if linear \
             else None
+        # a compliance in the gap of each owned slave node (g + c λ = 0 where active):
+        # the wear of a step (`ArchardWear`); None: none
+        self.compliance: np.ndarray | None = None
 
     def solve(self) -> SolveResult:
         """The active-set loop from the current set (warm start) to a set that repeats.
@@ -404,13 +407,16 @@ class PairContact:
         """
         work = work if work is not None else WorkCounts()
         self.active = np.asarray(active, dtype=bool).copy()  # what `state` reports
+        c = np.zeros(len(self.lam)) if self.compliance is None else self.compliance
+        comm = self.pair.comm
         if self.condensed is not None and self._condensed(
-                np.flatnonzero(every_rank(self.pair.comm, self.active)),
-                np.zeros(self.condensed.n), lambda: every_rank(self.pair.comm,
-                                                             self.pair.gaps(self.u)), work):
+                np.flatnonzero(every_rank(comm, self.active)), np.zeros(self.condensed.n),
+                lambda: every_rank(comm, self.pair.gaps(self.u) + c * self.lam), work,
+                every_rank(comm, c)):
             return 1
         which = np.flatnonzero(self.active)
-        lam = self._saddle(self.pair.rows(which), self.pair.gamma[which], None, work)[0]
+        lam = self._saddle(self.pair.rows(which), self.pair.gamma[which], None, work,
+                           None if self.compliance is None else c[which])[0]
         self.lam[:] = 0.0
         self.lam[which] = lam
         return self._iterations
@@ -431,7 +437,8 @@ class PairContact:
         self.pair.B.multTranspose(_vec(self.pair.B, self.lam), out)
         return out
 
-    def _condensed(self, unknown, known, conditions, work: WorkCounts) -> bool:
+    def _condensed(self, unknown, known, conditions, work: WorkCounts,
+                   compliance=None) -> bool:
         """The statuses' equilibrium on the kept factorization; False if it cannot be.
 
         First the equilibrium with the forces now (a back-substitution, only if the loads
@@ -453,7 +460,7 @@ class PairContact:
                 self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
                 self.u.x.scatter_forward()
                 work.linear_solves += 1
-            after = c.solve(before, unknown, known, conditions(), work)
+            after = c.solve(before, unknown, known, conditions(), work, compliance)
             c.move(self.u.x.petsc_vec, before, after, work)
             self.u.x.scatter_forward()
             self._set_rows(after)
@@ -485,10 +492,11 @@ class PairContact:
         _zero(R, self.held)
         return R
 
-    def _saddle(self, B, offset, forces, work):
-        """Newton on R(u) − Bᵀλ − forces = 0, B u + offset = 0: (λ, ) and the iterations.
+    def _saddle(self, B, offset, forces, work, compliance=None):
+        """Newton on R(u) − Bᵀλ − forces = 0, B u + offset + c λ = 0: (λ, ).
 
-        `forces`: known contact forces (a PETSc Vec in u's layout: friction), or None.
+        `forces`: known contact forces (a PETSc Vec in u's layout: friction), or None;
+        `compliance`: c, one per row of B (wear: the step's wear in the gap), or None.
         """
         u = self.u
         lam = np.zeros(B.getLocalSize()[0])
@@ -507,7 +515,7 @@ class PairContact:
             _zero(R, self.held)  # the prescribed dofs: no equation
             g = B.createVecLeft()
             B.mult(u.x.petsc_vec, g)
-            g.array[:] += offset
+            g.array[:] += offset + (0.0 if compliance is None else compliance * lam)
             norm = R.norm()
             closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self.pair.length
             if it == 1:
@@ -518,7 +526,7 @@ class PairContact:
             K = petsc.assemble_matrix(self.J, self.bcs)
             K.assemble()
             work.tangent_assemblies += 1
-            du, dlam = _saddle_solve(K, B, R, g, self.held, work)
+            du, dlam = _saddle_solve(K, B, R, g, self.held, work, compliance)
             u.x.petsc_vec.axpy(-1.0, du)
             u.x.scatter_forward()
             lam -= dlam
@@ -542,18 +550,19 @@ def _zero(R: PETSc.Vec, rows: PETSc.IS) -> None:
     R.array[rows.indices - start] = 0.0
 
 
-def _saddle_solve(K, B, R, g, held, work: WorkCounts):
-    """[K −Bᵀ; −B 0] [du; dλ] = [R; −g] by MUMPS LU: (du, dλ), a Vec and an array.
+def _saddle_solve(K, B, R, g, held, work: WorkCounts, compliance=None):
+    """[K −Bᵀ; −B −C] [du; dλ] = [R; −g] by MUMPS LU: (du, dλ), a Vec and an array.
 
     The prescribed dofs (`held`, identity rows of K) take no multiplier: their rows of Bᵀ
-    are zero, so du = 0 there.
+    are zero, so du = 0 there. C = diag(`compliance`), or 0.
     """
     Bt = B.transpose(PETSc.Mat())  # a new matrix (without `out`, B itself is transposed)
     Bt.scale(-1.0)
     Bn = B.copy()
     Bn.scale(-1.0)
     Bt.zeroRows(held, diag=0.0)  # the prescribed dofs keep their value: no multiplier there
-    nest = PETSc.Mat().createNest([[K, Bt], [Bn, _unconstrained(Bt)]], comm=K.comm)
+    nest = PETSc.Mat().createNest([[K, Bt], [Bn, _multiplier_block(Bt, compliance)]],
+                                  comm=K.comm)
     A = nest.convert("aij")
     rhs = A.createVecRight()
     n_u = R.getLocalSize()
@@ -579,21 +588,26 @@ def _saddle_solve(K, B, R, g, held, work: WorkCounts):
     return du, dlam
 
 
-def _unconstrained(Bt: PETSc.Mat) -> PETSc.Mat | None:
-    """1 on the diagonal of the rows of B that bind prescribed dofs only, else None.
+def _multiplier_block(Bt: PETSc.Mat, compliance=None) -> PETSc.Mat | None:
+    """The saddle point's lower right block: −C, and 1 on a row binding held dofs only.
 
-    Such a row (the tangential row of a node on the axis, where both bodies' u_r are held)
-    constrains nothing the solve can change: its multiplier is left out (dλ = −g, 0 for a
-    condition the supports already meet) instead of making the saddle point singular.
+    C = diag(`compliance`) (wear: the step's wear k Δs/A per unit force, in the gap). A row
+    of B on prescribed dofs only (the tangential row of a node on the axis, where both
+    bodies' u_r are held) constrains nothing the solve can change: its multiplier is left
+    out (dλ = −g, 0 for a condition the supports already meet) instead of making the
+    saddle point singular. None if the block is 0.
     """
     B = Bt.transpose(PETSc.Mat())
     start, n = B.getOwnershipRange()[0], B.getLocalSize()[0]
-    empty = [start + i for i in range(n) if not np.any(B.getRow(start + i)[1])]
-    if not B.comm.tompi4py().allreduce(len(empty)):
+    diagonal = np.zeros(n) if compliance is None else -np.asarray(compliance, dtype=float)
+    for i in range(n):
+        if not np.any(B.getRow(start + i)[1]):
+            diagonal[i] = 1.0
+    if not B.comm.tompi4py().allreduce(int(np.count_nonzero(diagonal))):
         return None
     D = PETSc.Mat().createAIJ((B.getSizes()[0], B.getSizes()[0]), nnz=(1, 0), comm=B.comm)
-    for row in empty:
-        D.setValue(row, row, 1.0)
+    for i in np.flatnonzero(diagonal):
+        D.setValue(start + i, start + i, diagonal[i])
     D.assemble()
     return D
 
@@ -795,10 +809,14 @@ class ArchardWear:
 
     The wear depth grows as dh = k p ds (k the wear coefficient over the hardness, p the
     contact pressure, s the sliding distance), and moves the worn surface away: the gap of
-    each slave node grows by its wear, so that the pressure redistributes. Each step of
-    sliding Δs solves the contact at the current wear, then adds Δh_s = k λ_s Δs / A_s
-    (λ_s the node's normal force, A_s its area): the worn volume Σ Δh_s A_s is then
-    k Δs Σ λ_s = k F_n Δs exactly, a discrete identity of the integration.
+    each slave node grows by its wear, so that the pressure redistributes. Backward Euler
+    over a step of sliding Δs: the wear of the step is that of the pressure at its end,
+    Δh_s = k λ_s Δs / A_s (λ_s the node's normal force, A_s its area), so the contact of
+    the step is solved with it in the gap, g_s + (k Δs / A_s) λ_s = 0 on the active nodes:
+    a compliance in series with the bodies, which makes the update stable whatever the
+    step (the explicit one, the wear of the step's start, oscillates with too few steps).
+    The worn volume Σ Δh_s A_s is k Δs Σ λ_s = k F_n Δs exactly, a discrete identity of
+    the integration.
 
     The sliding is its distance per step, not a motion of the mesh: a pin sliding on a
     long flat track meets the same flat everywhere (the track's own wear, spread over its
@@ -818,7 +836,7 @@ class ArchardWear:
         self.distance = 0.0
 
     def slide(self, ds: float) -> SolveResult:
-        """The contact at the current wear, then the wear of a sliding distance `ds`.
+        """The contact and the wear of a sliding distance `ds` (the step's end pressure).
 
         Args:
             ds: the sliding distance of the step.
@@ -826,10 +844,14 @@ class ArchardWear:
         Returns:
             The contact solve's result.
         """
-        result = self.contact.solve()
-        pair = self.contact.pair
+        contact, pair = self.contact, self.contact.pair
         areas = np.where(pair.areas > 0, pair.areas, np.inf)  # a node of no area: no wear
-        dh = self.k * np.clip(self.contact.lam, 0.0, None) * ds / areas
+        contact.compliance = self.k * ds / areas
+        try:
+            result = contact.solve()
+        finally:
+            c, contact.compliance = contact.compliance, None
+        dh = c * np.where(contact.active, contact.lam, 0.0)
         self.depth += dh
         pair.gamma += dh  # the worn slave surface moves away from the master
         self.volume += pair.total(dh * pair.areas)
