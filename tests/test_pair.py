@@ -151,6 +151,17 @@ def test_wear_on_one_factorization_is_the_saddle_points_answer():
     assert condensed["work"].factorizations == 1 < saddle["work"].factorizations
 
 
+def test_a_body_held_by_the_contact_alone_falls_back_to_the_saddle_point(caplog):
+    # the pin pressed by a traction (nothing else holds it vertically: K is singular):
+    # linear=True cannot keep one factorization; it says so once, puts the state back and
+    # solves each set as the saddle point: the same pressures as the saddle point's own
+    ((_, p_saddle), _), *_ = worn_pin(0)
+    with caplog.at_level("WARNING", logger="fenics_nl.contact.pair"):
+        ((_, p_linear), _), *_ = worn_pin(0, linear=True)
+    assert "each set is solved as a saddle point" in caplog.text
+    assert np.abs(p_linear - p_saddle).max() <= 1e-10 * np.abs(p_saddle).max()
+
+
 def test_code_aster_ssnv104_two_hemispheres():
     # two hemispheres R = 50 mm, E = 20 GPa, ν = 0.3, crushed by 4 mm between their
     # equators: Hertz (1/R = 2/50, E* = E/(2(1 − ν²))) gives a = 10 mm, p0 = 2798.3 MPa for an
@@ -205,6 +216,9 @@ def test_the_bearing_demo_is_hertz_at_light_load_then_holds_a_friction_torque(de
     # 8e-5 (the bore's chord normals are not radial, within h/2R of it: bounded 1e-3); the
     # conforming arc's normal forces add up to 1.058 P (above 1: bounded)
     t = d["torque"]
+    # the contact's torque (from λ and the normals) is the one the hub holds the shaft with
+    # (its reaction, the shaft's equilibrium): measured 7e-14
+    assert t["hub"] == pytest.approx(t["torque"], rel=1e-8)
     assert t["slipping"][0] < t["in_contact"][0] and t["slipping"][-1] == t["in_contact"][-1]
     sticking = sum(k < m for k, m in zip(t["slipping"], t["in_contact"], strict=True))
     assert all(b > a for a, b in itertools.pairwise(t["torque"][:sticking + 1]))
@@ -295,7 +309,7 @@ def test_friction_on_a_pair_on_two_ranks_gives_the_serial_answer(linear):
         assert a == pytest.approx(b, rel=1e-8, abs=1e-12)
 
 
-def worn_pin(steps, comm=MPI.COMM_WORLD):
+def worn_pin(steps, comm=MPI.COMM_WORLD, linear=False):
     """A flat pin (w = 1, E = 1, ν = 0.3) pressed on a flat by F = 0.01 (a traction on its
     top), slid a distance s = 1 in `steps` with Archard's k = 2 (a mean wear of 0.02, twice
     the pin's elastic approach): the pressures before and after, the worn volume."""
@@ -317,7 +331,7 @@ def worn_pin(steps, comm=MPI.COMM_WORLD):
     bcs = [boundary.component(V, 0, tag("pin_top")),
            *(boundary.component(V, c, tag("flat_bottom")) for c in (0, 1))]
     contact = PairContact(residual, u, bcs, ContactPair(V, tag("pin_face"), tag("flat_top")),
-                          force_scale=F)
+                          force_scale=F, linear=linear)
     wear = ArchardWear(contact, k)
 
     def profile():
@@ -416,6 +430,11 @@ def test_a_case_of_two_bodies_says_what_it_cannot_take(tmp_path, demo):
         "friction = 0.0", "friction = -0.1\nwear = 1e-3"))
     assert [line.split(": ")[0] for line in lines] == [
         "material[2].law", "contact[1].wear", "contact[1].friction", "mesh.degree"], lines
+    lines = said("twice.toml", text.replace("degree = 1", 'degree = 2\nformulation = "mixed"')
+                 + '\n[[contact]]\nslave = "ball_surface"\nmaster = "block_top"\n')
+    assert lines[:2] == ['mesh.formulation: "mixed" takes one [material]: [[material]] groups '
+                         "are the displacement formulation's", "contact[2]: the pair "
+                         "'ball_surface' on 'block_top' is given twice"], lines
     lines = said("mesh.toml", text.replace('group = "ball"\n', 'group = "balls"\n').replace(
         'master = "block_top"', 'master = "block_side"'))
     assert lines[0].startswith("contact[1].master: 'block_side' is not a boundary group")

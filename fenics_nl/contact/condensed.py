@@ -37,9 +37,11 @@ from fenics_nl.solvers.result import WorkCounts
 
 __all__ = ["CondensedSaddle"]
 
+CHUNK = 64  # new columns solved at once: MUMPS's multiple right-hand sides, memory bounded
+
 
 class CondensedSaddle:
-    """K factorized once and the columns w = K⁻¹ b of the rows ever loaded.
+    """K factorized once and the flexibility S = B K⁻¹ Bᵀ's columns of the rows ever loaded.
 
     A row is (block, j): the j-th global row of the block's matrix.
 
@@ -98,16 +100,18 @@ class CondensedSaddle:
         return x
 
     def columns(self, rows: np.ndarray, work: WorkCounts) -> None:
-        """w and [B w; ...] for the rows (block * n + j) not yet kept (collective).
+        """S's columns [B w; ...] (w = K⁻¹ b) of the rows (block * n + j) not yet kept.
 
-        The new columns in one block: MUMPS solves many right-hand sides at once faster
-        than one after the other.
+        The new columns in blocks of `CHUNK`: MUMPS solves many right-hand sides at once
+        faster than one after the other. Collective.
         """
         new = [int(k) for k in rows if int(k) not in self.column]
-        if not new:
-            return
-        if self.ksp is None:
+        if self.ksp is None and new:
             self.factorize(work)
+        for first in range(0, len(new), CHUNK):  # dense n × CHUNK blocks at most
+            self._new_columns(new[first:first + CHUNK], work)
+
+    def _new_columns(self, new: list[int], work: WorkCounts) -> None:
         b = self._unit_loads(new)
         x = b.duplicate()
         t0 = time.perf_counter()

@@ -61,8 +61,8 @@ class ContactPair:
     def __init__(self, V: fem.FunctionSpace, slave_facets, master_facets, weight=1.0):
         msh = V.mesh
         if msh.geometry.dim != 2 or V.element.basix_element.degree != 1:
-            raise ValueError("a contact pair takes P1 displacements in 2D (plane strain or "
-                             "axisymmetric)")
+            raise ValueError("a contact pair takes P1 displacements in 2D (plane strain, "
+                             "plane stress or axisymmetric)")
         self.V, self.mesh, self.comm = V, msh, msh.comm
         self.bs = V.dofmap.index_map_bs
         fdim = msh.topology.dim - 1
@@ -73,6 +73,10 @@ class ContactPair:
         self.x = x[self.slave, :2]
         self.slave_global = imap.local_to_global(self.slave)
         segments = _master_segments(V, np.asarray(master_facets, np.int32))
+        shared = self.comm.allreduce(int(np.isin(self.slave_global, segments["nodes"]).sum()))
+        if shared:
+            raise ValueError(f"{shared} slave nodes are master nodes too: a pair's surfaces "
+                             "are two bodies' (they share no node)")
         self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
         self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
         self.B = self.rows(np.arange(len(self.slave)))
@@ -106,7 +110,8 @@ class ContactPair:
 
     def keys(self, which: np.ndarray) -> tuple:
         """The nodes `which` of every rank as one sorted tuple (a set's identity)."""
-        ids = self.slave_global[which] * (int(self.part.max(initial=0)) + 1) + self.part[which]
+        parts = self.comm.allreduce(int(self.part.max(initial=0)), op=MPI.MAX) + 1
+        ids = self.slave_global[which] * parts + self.part[which]
         return tuple(np.sort(np.concatenate(self.comm.allgather(ids))))
 
     @property
@@ -274,7 +279,7 @@ class PairContact:
     """
 
     def __init__(self, residual, u, bcs, pair: ContactPair, *,
-                 atol: float = 1e-10, force_scale: float = 1.0, max_it: int = 20,
+                 atol: float = 1e-10, force_scale: float | None = None, max_it: int = 20,
                  max_iterations: int = 50, linear: bool = False):
         self.u, self.bcs, self.pair = u, list(bcs), pair
         self.F = fem.form(residual)
@@ -473,7 +478,7 @@ class PairContact:
                                  f"{left:.2e} (K singular, a body held by the contact "
                                  "alone; or a residual not linear in u)")
             return True
-        except SolveError as err:
+        except (SolveError, np.linalg.LinAlgError, PETSc.Error) as err:
             self.u.x.array[:] = saved[0]
             self._set_rows(saved[1])
             log.warning("contact pair: %s: each set is solved as a saddle point", err)
@@ -650,7 +655,7 @@ class FrictionalPair(PairContact):
         # one per pair (`ContactPair.joined`), as one per slave node
         self.f = f[pair.part] if f.ndim else np.full(len(pair.slave), float(f))
         n = len(pair.slave)
-        self.slip, self.s = np.zeros(n, dtype=bool), np.zeros(n)
+        self.slip, self.s = self.f == 0, np.zeros(n)  # no friction: slipping for good
         self.lam_t = np.zeros(n)
         self.committed = pair.tangential(u)
         if self.condensed is not None:  # the stuck nodes' slips are rows too
@@ -696,20 +701,23 @@ class FrictionalPair(PairContact):
         """
         t0, work, its, history = time.perf_counter(), WorkCounts(), 0, []
         comm = self.pair.comm
-        lam_n = self.lam.copy()
+        lam_n, seen = self.lam.copy(), set()
+        tol_u = 1e-12 * self.pair.length  # a slip of round-off
+        rubs = self.f > 0  # a pair without friction: its nodes slip freely, for good
         for k in range(1, self.max_iterations + 1):
             its += self._equilibrium(lam_n, work)
             g = self.pair.gaps(self.u)
             dg = self.pair.tangential(self.u) - self.committed
             stick = self.active & ~self.slip
-            opening = self.active & (self.lam < 0)
-            closing = ~self.active & (g < -1e-12 * self.pair.length)
-            sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9))
-            holding = self.active & self.slip & (dg * self.s > 0)
-            landed = self.active & self.slip & (self.s == 0)  # touched down, no sense yet
-            sensing = landed & (np.abs(dg) > 1e-12 * self.pair.length)
-            resting = landed & ~sensing  # it has not slipped since it landed: it sticks
             scale = comm.allreduce(float(np.abs(self.lam).max(initial=0.0)), op=MPI.MAX)
+            opening = self.active & (self.lam < 0)
+            closing = ~self.active & (g < -tol_u)
+            sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9)
+                               + 1e-12 * scale)
+            holding = self.active & self.slip & rubs & (dg * self.s > tol_u)
+            landed = self.active & self.slip & rubs & (self.s == 0)  # no sense yet
+            sensing = landed & (np.abs(dg) > tol_u)
+            resting = landed & ~sensing  # it has not slipped since it landed: it sticks
             drift = comm.allreduce(float(np.abs((self.lam - lam_n)[self.slip]).max(
                 initial=0.0)), op=MPI.MAX)
             changes = comm.allreduce(int((opening | closing | sliding | holding | landed
@@ -724,8 +732,16 @@ class FrictionalPair(PairContact):
             self.s = np.where(sliding, np.sign(self.lam_t), self.s)
             self.s = np.where(sensing, -np.sign(dg), self.s)  # friction against the slip
             self.s = np.where(closing, 0.0, self.s)
+            # a node that lands sticks, if it does, where it landed (not where it was at
+            # the step's start, when it was open)
+            self.committed = np.where(closing, self.pair.tangential(self.u), self.committed)
             self.slip = (self.slip & ~holding & ~resting | sliding | closing) & ~opening
             self.active = (self.active & ~opening) | closing
+            key = self.pair.keys(self.active) + self.pair.keys(self.active & self.slip) + \
+                tuple(np.concatenate(comm.allgather(self.s[self.active])))
+            if key in seen and changes:
+                raise SolveError(f"the frictional statuses cycle (iteration {k})")
+            seen.add(key)
             lam_n = self.lam.copy()
         raise SolveError(f"the frictional statuses did not settle in {self.max_iterations} "
                          "iterations")
