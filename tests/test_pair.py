@@ -460,3 +460,25 @@ def test_a_case_of_two_bodies_on_two_ranks_gives_the_serial_answer(demo):
     for key in ("contact_radius", "max_pressure"):
         assert pp[key] == pytest.approx(sp[key], rel=1e-9), key
     assert pp["force"] == pytest.approx(sp["force"], rel=1e-9, abs=1e-12)
+
+
+def test_a_case_of_two_pairs_one_dry_one_lubricated(demo):
+    # cases/two_rollers.toml: two rollers on one block, each its own [[contact]] pair, one
+    # active set over both (ContactPair.joined), the left frictionless, the right f = 0.3.
+    # Each pair's own record: the lubricated one has no tangential force at all, the dry
+    # one holds part of the slip of the dissimilar materials (1.2 % of its normal force);
+    # the normal forces agree to 0.1 % (the rollers are alike; bounded 1 %); each against
+    # Hertz for its own force: the half-width 0.4 h inside a (bounded h), the largest nodal
+    # pressure +0.02 %, +0.4 % (bounded 2 %); the pairs' forces are the supports' reactions
+    d = demo.case(CASES / "two_rollers.toml")
+    left, right = d["contact_pairs"]
+    assert (left["slave"], right["slave"]) == ("left_surface", "right_surface")
+    assert left["force"][0] == 0.0 and abs(right["force"][0]) > 1e-3 * right["force"][1]
+    assert right["force"][1] == pytest.approx(left["force"][1], rel=0.01)
+    Es = hertz.pair_modulus(3.0, 0.2, 1.0, 0.35)
+    for pair in (left, right):
+        ref = hertz.cylinder_from_force(Es, 0.0, 1.0, pair["force"][1])
+        assert abs(pair["contact_radius"] - ref["contact_radius"]) < 0.06 / 10
+        assert pair["max_pressure"] == pytest.approx(ref["max_pressure"], rel=0.02)
+    total = np.sum([p["force"] for p in (left, right)], axis=0)
+    assert -np.array(d["reactions"]["equators"]) == pytest.approx(total, rel=1e-8)
