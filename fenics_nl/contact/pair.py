@@ -2,7 +2,8 @@
 
 The *slave* surface's nodes are projected on the *master* surface's facets (2D: segments;
 the closest point, its parameter ξ and the master's outward normal n there; small
-sliding: the projection is made once, in the reference configuration). At a slave node s
+sliding: the projection is made once, in the reference configuration; finite sliding,
+frictionless: made again where the bodies are after every solve, `ContactPair.follow`). At a slave node s
 projected at ξ on the master facet with nodes m_j (shape functions N_j), the gap is
 
     g_s(u) = γ_s + (u_s − Σ_j N_j(ξ) u_{m_j}) · n ≥ 0,     γ_s = (x_s − x_m(ξ)) · n,
@@ -77,7 +78,9 @@ class ContactPair:
         if shared:
             raise ValueError(f"{shared} slave nodes are master nodes too: a pair's surfaces "
                              "are two bodies' (they share no node)")
+        self.segments = segments  # every rank's master facets, reference configuration
         self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
+        self.opened = np.zeros(len(self.slave))  # gap added to the geometry's (wear)
         self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
         self.B = self.rows(np.arange(len(self.slave)))
         self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
@@ -100,13 +103,56 @@ class ContactPair:
         first = pairs[0]
         out.V, out.mesh, out.comm, out.bs = first.V, first.mesh, first.comm, first.bs
         for name in ("slave", "x", "slave_global", "xi", "normal", "gamma", "master_nodes",
-                     "areas"):
+                     "areas", "opened"):
             setattr(out, name, np.concatenate([getattr(p, name) for p in pairs]))
         out.part = np.concatenate([np.full(len(p.slave), k) for k, p in enumerate(pairs)])
         out.length = max(p.length for p in pairs)
         out.B = out.rows(np.arange(len(out.slave)))
         out.Bt = out.rows(np.arange(len(out.slave)), tangential=True)
         return out
+
+    def open(self, depth: np.ndarray) -> None:
+        """Open the gap of each owned slave node by `depth` (wear: the surface worn away)."""
+        self.gamma += depth
+        self.opened += depth
+
+    def follow(self, u: fem.Function) -> int:
+        """The projection made again where the bodies are now (finite sliding).
+
+        Each slave node at x_s + u_s is projected on the master facets at x_m + u_m (their
+        normals turned with them, on the same side); B is rebuilt at the new points, and γ
+        set so that γ + B u is the gap there (plus what `open` added): the gap linearized
+        about the current state. Collective.
+
+        Returns:
+            The slave nodes (every rank's) whose master facet changed.
+        """
+        if not hasattr(self, "segments"):
+            raise ValueError("follow: a single pair's (not `joined`)")
+        seg, bs = self.segments, self.bs
+        ids = np.unique(seg["nodes"])
+        imap = self.V.dofmap.index_map
+        local = imap.global_to_local(ids)
+        mine = (local >= 0) & (local < imap.size_local)
+        values = u.x.array.reshape(-1, bs)[local[mine], :2]
+        every = np.vstack(self.comm.allgather(np.c_[ids[mine], values]))
+        moved = dict(zip(every[:, 0].astype(np.int64), every[:, 1:], strict=True))
+        p0 = seg["p0"] + np.array([moved[int(n)] for n in seg["nodes"][:, 0]])
+        p1 = seg["p1"] + np.array([moved[int(n)] for n in seg["nodes"][:, 1]])
+        t = p1 - p0
+        normal = np.c_[t[:, 1], -t[:, 0]] / np.linalg.norm(t, axis=1)[:, None]
+        normal *= np.sign(np.einsum("ij,ij->i", normal, seg["normal"]))[:, None]
+        now = {"p0": p0, "p1": p1, "normal": normal, "nodes": seg["nodes"]}
+        x = self.x + u.x.array.reshape(-1, bs)[self.slave, :2]
+        facet, self.xi, self.normal, gap = _project(x, now)
+        changed = self.comm.allreduce(int((facet != self.facet).sum()))
+        self.facet, self.master_nodes = facet, seg["nodes"][facet]
+        self.B = self.rows(np.arange(len(self.slave)))
+        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
+        Bu = self.B.createVecLeft()
+        self.B.mult(u.x.petsc_vec, Bu)
+        self.gamma = gap - Bu.array + self.opened
+        return changed
 
     def keys(self, which: np.ndarray) -> tuple:
         """The nodes `which` of every rank as one sorted tuple (a set's identity)."""
@@ -276,11 +322,18 @@ class PairContact:
         linear: the residual is linear in u: K is factorized once for the whole run and
             each set solved by its Schur complement on the active rows
             (`contact.condensed`), instead of a saddle point factorized at every iteration.
+        finite_sliding: the projection made again after every solve where the bodies are
+            (`ContactPair.follow`), the loop ending when the set repeats and the active
+            gaps so measured are closed; frictionless, each set a saddle point.
     """
 
     def __init__(self, residual, u, bcs, pair: ContactPair, *,
                  atol: float = 1e-10, force_scale: float | None = None, max_it: int = 20,
-                 max_iterations: int = 50, linear: bool = False):
+                 max_iterations: int = 50, linear: bool = False,
+                 finite_sliding: bool = False):
+        if finite_sliding and linear:
+            raise ValueError("finite sliding moves B: no one factorization (linear=False)")
+        self.finite_sliding = finite_sliding
         self.u, self.bcs, self.pair = u, list(bcs), pair
         self.F = fem.form(residual)
         self.J = fem.form(ufl.derivative(residual, u))
@@ -313,23 +366,31 @@ class PairContact:
             SolveError: the set did not settle within `max_iterations`.
         """
         t0, work, its, history, seen = time.perf_counter(), WorkCounts(), 0, [], set()
+        comm, length = self.pair.comm, self.pair.length
+        if self.finite_sliding:
+            self.pair.follow(self.u)
         for k in range(1, self.max_iterations + 1):
             its += self.equilibrium(self.active, work)
+            moved, open_gap = 0, 0.0
+            if self.finite_sliding:  # the gaps where the bodies are now
+                moved = self.pair.follow(self.u)
+                open_gap = comm.allreduce(float(np.abs(self.pair.gaps(self.u)[
+                    self.active]).max(initial=0.0)), op=MPI.MAX)
             g = self.pair.gaps(self.u)
             leave = self.active & (self.lam < 0)
-            join = ~self.active & (g < -1e-12 * self.pair.length)
-            changes = self.pair.comm.allreduce(int(leave.sum() + join.sum()))
-            history.append({"iteration": k, "active": self.pair.comm.allreduce(
-                int(self.active.sum())), "leave": self.pair.comm.allreduce(int(leave.sum())),
-                "join": self.pair.comm.allreduce(int(join.sum()))})
-            if changes == 0:
+            join = ~self.active & (g < -1e-12 * length)
+            changes = comm.allreduce(int(leave.sum() + join.sum()))
+            history.append({"iteration": k, "active": comm.allreduce(int(self.active.sum())),
+                            "leave": comm.allreduce(int(leave.sum())),
+                            "join": comm.allreduce(int(join.sum())), "moved": moved})
+            if changes == 0 and open_gap <= 1e-10 * length:
                 self.history = history
                 return SolveResult(True, "converged", its, [], work,
                                    time.perf_counter() - t0, active_set_iterations=k,
                                    history=history)
             new = (self.active & ~leave) | join
             key = self.pair.keys(new)
-            if key in seen:
+            if key in seen and changes and not moved:  # (the geometry may still settle)
                 raise SolveError(f"the active set cycles (iteration {k})")
             seen.add(key)
             self.active = new
@@ -648,6 +709,9 @@ class FrictionalPair(PairContact):
     """
 
     def __init__(self, residual, u, bcs, pair: ContactPair, friction: float, **options):
+        if options.get("finite_sliding"):
+            raise ValueError("friction on a pair is small sliding (its slip is measured on "
+                             "the projection it started from)")
         super().__init__(residual, u, bcs, pair, **options)
         f = np.asarray(friction, dtype=float)
         if not np.all(f >= 0):
@@ -869,7 +933,7 @@ class ArchardWear:
             c, contact.compliance = contact.compliance, None
         dh = c * np.where(contact.active, contact.lam, 0.0)
         self.depth += dh
-        pair.gamma += dh  # the worn slave surface moves away from the master
+        pair.open(dh)  # the worn slave surface moves away from the master
         self.volume += pair.total(dh * pair.areas)
         self.distance += ds
         return result
