@@ -1,15 +1,16 @@
 """Contact between two deformable bodies: the course's active set on a slave–master pair.
 
-The *slave* surface's nodes are projected on the *master* surface's facets (2D: segments;
-the closest point, its parameter ξ and the master's outward normal n there; small
-sliding: the projection is made once, in the reference configuration; finite sliding,
-frictionless: made again where the bodies are after every solve, `ContactPair.follow`). At a slave node s
-projected at ξ on the master facet with nodes m_j (shape functions N_j), the gap is
+The *slave* surface's nodes are projected on the *master* surface's facets (2D: segments,
+3D: triangles; the closest point, its shape functions N_j and the master's outward normal
+n there; small sliding: the projection is made once, in the reference configuration;
+finite sliding, 2D and frictionless: made again where the bodies are after every solve,
+`ContactPair.follow`). At a slave node s projected on the master facet with nodes m_j,
+the gap is
 
-    g_s(u) = γ_s + (u_s − Σ_j N_j(ξ) u_{m_j}) · n ≥ 0,     γ_s = (x_s − x_m(ξ)) · n,
+    g_s(u) = γ_s + (u_s − Σ_j N_j u_{m_j}) · n ≥ 0,     γ_s = (x_s − x_m) · n,
 
 a linear condition B_s u + γ_s ≥ 0: B has one row per slave node, +n on the slave node's
-components, −N_j(ξ) n on the master nodes'. Each active-set iteration solves the
+components, −N_j n on the master nodes'. Each active-set iteration solves the
 equilibrium with the relative normal displacement prescribed on the active nodes and no
 traction elsewhere, by Lagrange multipliers (the course's saddle point, with A coupling
 both bodies):
@@ -50,7 +51,10 @@ log = logging.getLogger(__name__)
 
 
 class ContactPair:
-    """Slave nodes on one body's facets against the master facets of the other (2D, P1).
+    """Slave nodes on one body's facets against the master facets of the other (P1).
+
+    2D: node to segment (plane strain, plane stress, axisymmetric); 3D: node to triangle
+    (frictionless: the tangential rows are 2D's).
 
     Args:
         V: the displacement space (vector, P1, 2D: plane strain or axisymmetric).
@@ -61,29 +65,32 @@ class ContactPair:
 
     def __init__(self, V: fem.FunctionSpace, slave_facets, master_facets, weight=1.0):
         msh = V.mesh
-        if msh.geometry.dim != 2 or V.element.basix_element.degree != 1:
-            raise ValueError("a contact pair takes P1 displacements in 2D (plane strain, "
-                             "plane stress or axisymmetric)")
+        if V.element.basix_element.degree != 1:
+            raise ValueError("a contact pair takes P1 displacements (node to segment or "
+                             "triangle)")
         self.V, self.mesh, self.comm = V, msh, msh.comm
+        self.gdim = msh.geometry.dim
         self.bs = V.dofmap.index_map_bs
         fdim = msh.topology.dim - 1
         imap = V.dofmap.index_map
         nodes = fem.locate_dofs_topological(V, fdim, np.asarray(slave_facets, np.int32))
         self.slave = nodes[nodes < imap.size_local]  # the owned slave nodes (V's blocks)
         x = V.tabulate_dof_coordinates()
-        self.x = x[self.slave, :2]
+        self.x = x[self.slave, :self.gdim]
         self.slave_global = imap.local_to_global(self.slave)
-        segments = _master_segments(V, np.asarray(master_facets, np.int32))
+        segments = _master_facets(V, np.asarray(master_facets, np.int32))
         shared = self.comm.allreduce(int(np.isin(self.slave_global, segments["nodes"]).sum()))
         if shared:
             raise ValueError(f"{shared} slave nodes are master nodes too: a pair's surfaces "
                              "are two bodies' (they share no node)")
         self.segments = segments  # every rank's master facets, reference configuration
-        self.facet, self.xi, self.normal, self.gamma = _project(self.x, segments)
+        self.facet, self.weights, self.normal, self.gamma = _project(self.x, segments)
         self.opened = np.zeros(len(self.slave))  # gap added to the geometry's (wear)
-        self.master_nodes = segments["nodes"][self.facet]  # (n, 2) global blocks
+        self.master_nodes = segments["nodes"][self.facet]  # (n, nodes) global blocks
         self.B = self.rows(np.arange(len(self.slave)))
-        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
+        # the tangential rows (friction): 2D only (3D's two tangents are not built)
+        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True) if \
+            self.gdim == 2 else None
         self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
         self.part = np.zeros(len(self.slave), dtype=np.int64)  # which pair (`joined`)
         # the bodies' size: what a gap is small against (round-off)
@@ -102,13 +109,15 @@ class ContactPair:
         out = object.__new__(cls)
         first = pairs[0]
         out.V, out.mesh, out.comm, out.bs = first.V, first.mesh, first.comm, first.bs
-        for name in ("slave", "x", "slave_global", "xi", "normal", "gamma", "master_nodes",
-                     "areas", "opened"):
+        out.gdim = first.gdim
+        for name in ("slave", "x", "slave_global", "weights", "normal", "gamma",
+                     "master_nodes", "areas", "opened"):
             setattr(out, name, np.concatenate([getattr(p, name) for p in pairs]))
         out.part = np.concatenate([np.full(len(p.slave), k) for k, p in enumerate(pairs)])
         out.length = max(p.length for p in pairs)
         out.B = out.rows(np.arange(len(out.slave)))
-        out.Bt = out.rows(np.arange(len(out.slave)), tangential=True)
+        out.Bt = out.rows(np.arange(len(out.slave)), tangential=True) if out.gdim == 2 \
+            else None
         return out
 
     def open(self, depth: np.ndarray) -> None:
@@ -129,6 +138,8 @@ class ContactPair:
         """
         if not hasattr(self, "segments"):
             raise ValueError("follow: a single pair's (not `joined`)")
+        if self.gdim != 2:
+            raise ValueError("follow: finite sliding is 2D (segments)")
         seg, bs = self.segments, self.bs
         ids = np.unique(seg["nodes"])
         imap = self.V.dofmap.index_map
@@ -137,14 +148,12 @@ class ContactPair:
         values = u.x.array.reshape(-1, bs)[local[mine], :2]
         every = np.vstack(self.comm.allgather(np.c_[ids[mine], values]))
         moved = dict(zip(every[:, 0].astype(np.int64), every[:, 1:], strict=True))
-        p0 = seg["p0"] + np.array([moved[int(n)] for n in seg["nodes"][:, 0]])
-        p1 = seg["p1"] + np.array([moved[int(n)] for n in seg["nodes"][:, 1]])
-        t = p1 - p0
-        normal = np.c_[t[:, 1], -t[:, 0]] / np.linalg.norm(t, axis=1)[:, None]
+        P = seg["points"] + np.array([[moved[int(n)] for n in row] for row in seg["nodes"]])
+        normal = _normal(P)
         normal *= np.sign(np.einsum("ij,ij->i", normal, seg["normal"]))[:, None]
-        now = {"p0": p0, "p1": p1, "normal": normal, "nodes": seg["nodes"]}
+        now = {"points": P, "normal": normal, "nodes": seg["nodes"]}
         x = self.x + u.x.array.reshape(-1, bs)[self.slave, :2]
-        facet, self.xi, self.normal, gap = _project(x, now)
+        facet, self.weights, self.normal, gap = _project(x, now)
         changed = self.comm.allreduce(int((facet != self.facet).sum()))
         self.facet, self.master_nodes = facet, seg["nodes"][facet]
         self.B = self.rows(np.arange(len(self.slave)))
@@ -176,26 +185,31 @@ class ContactPair:
         Returns:
             The matrix, one row per node of `which`.
         """
+        if tangential and self.gdim != 2:
+            raise ValueError("tangential rows: 2D only")
+        g = self.gdim
         n_local = len(which)
         N = self.V.dofmap.index_map.size_global * self.bs
         n_owned = self.V.dofmap.index_map.size_local * self.bs
-        B = PETSc.Mat().createAIJ(((n_local, None), (n_owned, N)), nnz=(6, 6), comm=self.comm)
+        nnz = g * (self.weights.shape[1] + 1)
+        B = PETSc.Mat().createAIJ(((n_local, None), (n_owned, N)), nnz=(nnz, nnz),
+                                  comm=self.comm)
         B.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         start = B.getOwnershipRange()[0]
         for row, i in enumerate(which):
             n = self.normal[i]
             d = np.array([-n[1], n[0]]) if tangential else n
-            cols = [self.bs * self.slave_global[i] + k for k in range(2)]
+            cols = [self.bs * self.slave_global[i] + k for k in range(g)]
             vals = list(d)
-            for j, w in ((0, 1 - self.xi[i]), (1, self.xi[i])):
-                cols += [self.bs * self.master_nodes[i, j] + k for k in range(2)]
+            for j, w in enumerate(self.weights[i]):
+                cols += [self.bs * self.master_nodes[i, j] + k for k in range(g)]
                 vals += list(-w * d)
             B.setValues(start + row, cols, vals, addv=PETSc.InsertMode.ADD_VALUES)
         B.assemble()
         return B
 
     def tangential(self, u: fem.Function) -> np.ndarray:
-        """The relative tangential displacement (u_s − u_m)·t at this rank's slave nodes."""
+        """The relative tangential displacement (u_s − u_m)·t at this rank's slave nodes (2D)."""
         g = self.Bt.createVecLeft()
         self.Bt.mult(u.x.petsc_vec, g)
         return g.array.copy()
@@ -211,20 +225,20 @@ class ContactPair:
         return self.comm.allreduce(float(np.sum(values)))
 
 
-def _master_segments(V, facets) -> dict:
-    """Every rank's master facets (2D segments), gathered on every rank.
+def _master_facets(V, facets) -> dict:
+    """Every rank's master facets (2D segments, 3D triangles), gathered on every rank.
 
-    Each: its two nodes' global blocks and coordinates, and the master body's outward
-    normal (pointing away from the cell the facet bounds).
+    Each: its nodes' global blocks and coordinates (`points`: facets × nodes × dim) and
+    the master body's outward normal (pointing away from the cell the facet bounds).
     """
     msh = V.mesh
-    fdim = msh.topology.dim - 1
+    g, fdim = msh.geometry.dim, msh.topology.dim - 1
     msh.topology.create_connectivity(fdim, fdim + 1)
     msh.topology.create_connectivity(fdim, 0)
     f2c, f2v = msh.topology.connectivity(fdim, fdim + 1), msh.topology.connectivity(fdim, 0)
     imap = V.dofmap.index_map
     nf = msh.topology.index_map(fdim).size_local
-    facets = facets[facets < nf]  # owned: each segment once
+    facets = facets[facets < nf]  # owned: each facet once
     x = V.tabulate_dof_coordinates()
     from fenics_nl.contact.surface import vertex_of_dof
 
@@ -236,44 +250,95 @@ def _master_segments(V, facets) -> dict:
     msh.topology.create_connectivity(fdim + 1, 0)
     c2v = msh.topology.connectivity(fdim + 1, 0)
     for f in facets:
-        v0, v1 = f2v.links(f)
-        d0, d1 = dof_of_vertex[v0], dof_of_vertex[v1]
-        p0, p1 = x[d0, :2], x[d1, :2]
-        t = p1 - p0
-        n = np.array([t[1], -t[0]]) / np.linalg.norm(t)
+        dofs = dof_of_vertex[f2v.links(f)]
+        P = x[dofs, :g]
+        n = _normal(P)
         cell = f2c.links(f)[0]  # its vertices' coordinates: P1 dofs (not geometry.x,
-        centre = x[dof_of_vertex[c2v.links(cell)], :2].mean(axis=0)  # numbered apart)
-        if np.dot(n, 0.5 * (p0 + p1) - centre) < 0:
+        centre = x[dof_of_vertex[c2v.links(cell)], :g].mean(axis=0)  # numbered apart)
+        if np.dot(n, P.mean(axis=0) - centre) < 0:
             n = -n
-        g0, g1 = imap.local_to_global(np.array([d0, d1], dtype=np.int32))
-        rows.append([*p0, *p1, *n, g0, g1])
-    local = np.array(rows, dtype=float).reshape(-1, 8)
+        rows.append([*P.ravel(), *n, *imap.local_to_global(dofs.astype(np.int32))])
+    k = g  # nodes per facet
+    local = np.array(rows, dtype=float).reshape(-1, k * g + g + k)
     every = np.vstack(msh.comm.allgather(local))
-    return {"p0": every[:, 0:2], "p1": every[:, 2:4], "normal": every[:, 4:6],
-            "nodes": every[:, 6:8].astype(np.int64)}
+    return {"points": every[:, :k * g].reshape(-1, k, g),
+            "normal": every[:, k * g:k * g + g],
+            "nodes": every[:, k * g + g:].astype(np.int64)}
 
 
-def _project(points: np.ndarray, segments: dict):
-    """Each point's closest master segment: (its index, ξ, the normal, the gap γ)."""
-    p0, p1, normals = segments["p0"], segments["p1"], segments["normal"]
-    nodes = np.sort(segments["nodes"], axis=1)
-    t = p1 - p0
-    length2 = np.einsum("ij,ij->i", t, t)
+def _normal(P: np.ndarray) -> np.ndarray:
+    """The unit normal of segments (2D: the tangent turned clockwise) or triangles.
+
+    3D: (p1 − p0) × (p2 − p0), normalized; its sense is the caller's to set.
+    """
+    if P.shape[-1] == 2:
+        t = P[..., 1, :] - P[..., 0, :]
+        n = np.stack([t[..., 1], -t[..., 0]], axis=-1)
+    else:
+        n = np.cross(P[..., 1, :] - P[..., 0, :], P[..., 2, :] - P[..., 0, :])
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def _closest(x: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The point of each facet P (facets × nodes × dim) closest to x, and its weights.
+
+    The weights are the facet's shape functions at that point.
+    """
+    if P.shape[1] == 2:  # segments
+        t = P[:, 1] - P[:, 0]
+        s = np.clip(np.einsum("ij,ij->i", x - P[:, 0], t) / np.einsum("ij,ij->i", t, t),
+                    0.0, 1.0)
+        return P[:, 0] + s[:, None] * t, np.c_[1 - s, s]
+    a, b, c = P[:, 0], P[:, 1], P[:, 2]  # triangles: the plane's foot if inside, else
+    v0, v1 = b - a, c - a               # the closest point of the three edges
+    n = np.cross(v0, v1)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    q = x - np.einsum("ij,ij->i", x - a, n)[:, None] * n
+    v2 = q - a
+    d00, d01, d11 = (np.einsum("ij,ij->i", p, r) for p, r in ((v0, v0), (v0, v1), (v1, v1)))
+    d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
+    den = d00 * d11 - d01 * d01
+    v, w = (d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den
+    weights = np.c_[1 - v - w, v, w]
+    closest = q.copy()
+    outside = np.any(weights < 0, axis=1)
+    if outside.any():
+        best = np.full(len(P), np.inf)
+        for i, j in ((0, 1), (1, 2), (2, 0)):
+            e0, e1 = P[outside, i], P[outside, j]
+            t = e1 - e0
+            s = np.clip(np.einsum("ij,ij->i", x - e0, t) / np.einsum("ij,ij->i", t, t),
+                        0.0, 1.0)
+            point = e0 + s[:, None] * t
+            d = np.linalg.norm(x - point, axis=1)
+            better = d < best[outside]
+            rows = np.flatnonzero(outside)[better]
+            best[rows] = d[better]
+            closest[rows] = point[better]
+            weights[rows] = 0.0
+            weights[rows, i], weights[rows, j] = 1 - s[better], s[better]
+    return closest, weights
+
+
+def _project(points: np.ndarray, facets: dict):
+    """Each point's closest master facet: (its index, its weights, the normal, the gap γ)."""
+    P, normals = facets["points"], facets["normal"]
+    nodes = np.sort(facets["nodes"], axis=1)
+    scale = float(np.linalg.norm(P[:, 1] - P[:, 0], axis=1).max(initial=0.0))
     facet = np.zeros(len(points), dtype=np.int64)
-    xi = np.zeros(len(points))
+    weights = np.zeros((len(points), P.shape[1]))
     for i, x in enumerate(points):
-        s = np.clip(np.einsum("ij,ij->i", x - p0, t) / length2, 0.0, 1.0)
-        closest = p0 + s[:, None] * t
+        closest, w = _closest(x, P)
         d = np.linalg.norm(x - closest, axis=1)
-        # at a master vertex two segments tie: the one of the lowest global nodes, so that
-        # the choice does not depend on the order of the ranks' segments
-        near = np.flatnonzero(d <= d.min() + 1e-12 * np.sqrt(length2.max()))
-        k = int(near[np.lexsort((nodes[near, 1], nodes[near, 0]))[0]])
-        facet[i], xi[i] = k, s[k]
-    closest = p0[facet] + xi[:, None] * t[facet]
+        # at a master vertex or edge facets tie: the one of the lowest global nodes, so
+        # that the choice does not depend on the order of the ranks' facets
+        near = np.flatnonzero(d <= d.min() + 1e-12 * scale)
+        k = int(near[np.lexsort(nodes[near].T[::-1])[0]])
+        facet[i], weights[i] = k, w[k]
+    closest = np.einsum("nk,nkg->ng", weights, P[facet])
     normal = normals[facet]
     gamma = np.einsum("ij,ij->i", points - closest, normal)
-    return facet, xi, normal, gamma
+    return facet, weights, normal, gamma
 
 
 def _nodal_areas(V, facets, weight) -> np.ndarray:
@@ -712,6 +777,8 @@ class FrictionalPair(PairContact):
         if options.get("finite_sliding"):
             raise ValueError("friction on a pair is small sliding (its slip is measured on "
                              "the projection it started from)")
+        if pair.gdim != 2:
+            raise ValueError("friction on a pair is 2D (3D's two tangents are not built)")
         super().__init__(residual, u, bcs, pair, **options)
         f = np.asarray(friction, dtype=float)
         if not np.all(f >= 0):

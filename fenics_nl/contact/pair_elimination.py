@@ -49,7 +49,7 @@ class EliminatedPair(PairContact):
         held[self.held.indices - self.start] = True
         # which component of each owned slave node is eliminated: the largest |n_k| free
         local = self.pair.slave * pair.bs  # local dof of the x component
-        free = ~np.c_[held[local], held[local + 1]]
+        free = ~np.stack([held[local + d] for d in range(pair.gdim)], axis=1)
         self.component = np.argmax(np.abs(pair.normal) * free, axis=1)
         stuck = int((~free[np.arange(len(local)), self.component]).sum())
         if pair.comm.allreduce(stuck):  # every rank raises, or none
@@ -132,10 +132,11 @@ class EliminatedPair(PairContact):
         out = []
         for i in which:
             n, k = pair.normal[i], self.component[i]
-            terms = [(bs * pair.slave_global[i] + d, -n[d] / n[k]) for d in range(2) if d != k]
-            for j, w in ((0, 1 - pair.xi[i]), (1, pair.xi[i])):
+            g = pair.gdim
+            terms = [(bs * pair.slave_global[i] + d, -n[d] / n[k]) for d in range(g) if d != k]
+            for j, w in enumerate(pair.weights[i]):
                 terms += [(bs * pair.master_nodes[i, j] + d, w * n[d] / n[k])
-                          for d in range(2)]
+                          for d in range(g)]
             out.append((bs * pair.slave_global[i] + k, terms))
         return out
 

@@ -34,8 +34,8 @@ from fenics_nl.domain.meshes import (
     threshold_field,
 )
 
-__all__ = ["BEARING_TAGS", "PIN_TAGS", "TWO_BODY_TAGS", "pin_on_flat", "shaft_in_bearing",
-           "sphere_on_body"]
+__all__ = ["BALL_TAGS", "BEARING_TAGS", "PIN_TAGS", "TWO_BODY_TAGS", "ball_on_block",
+           "pin_on_flat", "shaft_in_bearing", "sphere_on_body"]
 
 TWO_BODY_TAGS = ("upper_contact", "upper_top", "upper_axis", "lower_contact", "lower_bottom",
                  "lower_axis", "lower_side")
@@ -178,6 +178,66 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
         size_by_field(coarser)
         gmsh.model.mesh.generate(2)
     return distributed(comm, unit)
+
+
+BALL_TAGS = ("upper_contact", "upper_top", "upper_symmetry_x", "upper_symmetry_y",
+             "lower_contact", "lower_bottom", "lower_symmetry_x", "lower_symmetry_y",
+             "lower_side")
+
+
+def ball_on_block(comm: MPI.Comm, R: float, a: float, *, block: float = 4.0,
+                  fine: float = 5.0, growth: float = 0.2) -> gmshio.MeshData:
+    """A ball on a block in 3D, the quarter x ≥ 0, y ≥ 0.
+
+    The lower half of the ball of radius R centred at (0, 0, R), on the block
+    [0, L]² × [−L, 0] (L = `block` R). They touch at the origin and share no node.
+    Tetrahedra of a/`fine` within 1.5 a of the origin, growing by `growth` per unit
+    distance.
+
+    Args:
+        comm: the communicator.
+        R: the ball's radius.
+        a: the contact radius the mesh is made for.
+        block: the block's size in R.
+        fine: a/h near the origin.
+        growth: the elements' growth per unit distance beyond 1.5 a.
+
+    Returns:
+        The mesh with its cell tags (``upper`` 1, ``lower`` 2) and facet tags
+        (`BALL_TAGS`: each body's symmetry planes x = 0 and y = 0, the ball's curved
+        surface and equator, the block's top, bottom and outer sides).
+    """
+    unit = a  # gmsh's tolerances are absolute: it works in units of a
+    r, L = R / unit, block * R / unit
+    if comm.rank == 0:
+        start_model("ball_on_block")
+        occ = gmsh.model.occ
+        ball = occ.intersect([(3, occ.addSphere(0, 0, r, r))],
+                             [(3, occ.addBox(0, 0, 0, r, r, r))])[0]
+        lower = [(3, occ.addBox(0, 0, -L, L, L, L))]
+        occ.synchronize()
+        tol = 1e-6
+        groups = {name: [] for name in BALL_TAGS}
+        for body, (dim, volume) in (("upper", ball[0]), ("lower", lower[0])):
+            _, surfaces = gmsh.model.getAdjacencies(dim, volume)
+            for f in surfaces:
+                x, y, z = occ.getCenterOfMass(2, f)
+                kind = gmsh.model.getType(2, f)
+                if abs(x) < tol or abs(y) < tol:
+                    groups[f"{body}_symmetry_{'x' if abs(x) < tol else 'y'}"].append(f)
+                elif body == "upper":
+                    groups["upper_top" if kind == "Plane" else "upper_contact"].append(f)
+                else:
+                    groups["lower_contact" if abs(z) < tol else "lower_bottom"
+                           if abs(z + L) < tol else "lower_side"].append(f)
+        for i, (name, tags) in enumerate(groups.items(), start=1):
+            if tags:
+                gmsh.model.addPhysicalGroup(2, tags, i, name=name)
+        gmsh.model.addPhysicalGroup(3, [ball[0][1]], 1, name="upper")
+        gmsh.model.addPhysicalGroup(3, [lower[0][1]], 2, name="lower")
+        _graded_size_field(1.0 / fine, 1.5, 1.0 / fine + growth * L, L)
+        gmsh.model.mesh.generate(3)
+    return distributed(comm, unit, dim=3)
 
 
 PIN_TAGS = ("pin_face", "pin_top", "pin_sides", "flat_top", "flat_bottom", "flat_sides")
