@@ -513,14 +513,14 @@ class PairContact:
         """
         keep = np.ones(len(self.lam), bool) if which is None else which
         return np.array([self.pair.total((self.lam * self.pair.normal[:, k])[keep])
-                         for k in (0, 1)])
+                         for k in range(self.pair.gdim)])
 
     def profile(self) -> tuple[np.ndarray, np.ndarray]:
-        """(x, pressure) of the active slave nodes, gathered on every rank (x: n × 2)."""
-        st = self.state()
+        """(x, pressure) of the active slave nodes, gathered on every rank (x: n × dim)."""
+        st, g = self.state(), self.pair.gdim
         rows = np.c_[self.pair.x[st.active], st.pressure[st.active]]
-        every = np.vstack(self.pair.comm.allgather(rows.reshape(-1, 3)))
-        return every[:, :2], every[:, 2]
+        every = np.vstack(self.pair.comm.allgather(rows.reshape(-1, g + 1)))
+        return every[:, :g], every[:, g]
 
     def equilibrium(self, active: np.ndarray, work: WorkCounts | None = None) -> int:
         """The equilibrium with g_s = 0 on the `active` slave nodes and no force elsewhere.
