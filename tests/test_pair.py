@@ -461,6 +461,11 @@ def test_a_case_of_two_bodies_says_what_it_cannot_take(tmp_path, demo):
     assert lines[0].startswith("contact[1].master: 'block_side' is not a boundary group")
     assert lines[1].startswith("material[1].group: 'balls' is not a cell group of the mesh "
                                "(it has: ball, block)")
+    (tmp_path / "bearing_3d.geo").write_text((CASES / "bearing_3d.geo").read_text())
+    lines = said("dry.toml", (CASES / "bearing_3d.toml").read_text().replace(
+        'master = "bore"', 'master = "bore"\nfriction = 0.2'))
+    assert lines == ["contact[1].friction: 3D pairs are frictionless (friction on a pair is "
+                     "2D: 3D's two tangents are not built)"], lines
     start = text.index('[[material]]\ngroup = "block"')
     lines = said("bare.toml", text[:start] + text[text.index("[[boundary]]"):])
     assert len(lines) == 1 and lines[0].endswith(
@@ -652,3 +657,16 @@ def test_a_3d_pair_on_two_ranks_gives_the_serial_answer():
                                                            serial["nodes"])
     for key in ("force", "contact_radius", "max_pressure"):
         assert parallel[key] == pytest.approx(serial[key], rel=1e-9), key
+
+
+def test_the_bearing_in_3d_is_the_plane_strain_bearing(demo):
+    # cases/bearing_3d.toml: a 1 mm slice of the shaft and housing in 3D (tetrahedra, node
+    # to triangle), its ends held in z: plane strain; the demo's last push. The pair's force
+    # per unit length is +2.3 % from the 2D demo's (its own half model, h = 0.025) for
+    # the same push (+1.7 % at h = 0.15: the faceted circles' sag h²/8R, 1.1e-3 at
+    # h = 0.3, is 2 % of the push beyond the clearance); bounded 3 %; no force along z
+    three = demo.case(CASES / "bearing_3d.toml")["contact_pairs"][0]
+    two = demo.json("bearing.py")
+    force = three["force"]
+    assert force[1] == pytest.approx(two["force"], rel=0.03)
+    assert abs(force[2]) < 1e-3 * force[1] and abs(force[0]) < 1e-3 * force[1]
