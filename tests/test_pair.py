@@ -670,3 +670,17 @@ def test_the_bearing_in_3d_is_the_plane_strain_bearing(demo):
     force = three["force"]
     assert force[1] == pytest.approx(two["force"], rel=0.03)
     assert abs(force[2]) < 1e-3 * force[1] and abs(force[0]) < 1e-3 * force[1]
+
+
+@pytest.mark.mpi
+def test_the_bearing_demo_on_two_ranks_gives_the_serial_answer(demo):
+    # the half model's pushes (one factorization, the active-set loop written out in the
+    # demo) and the whole shaft turned with friction: the same counts, forces and torques
+    s, p = demo.json("bearing.py"), demo.json("bearing.py", ranks=2)
+    assert p["ranks"] == 2
+    assert [x["iterations"] for x in p["steps"]] == [x["iterations"] for x in s["steps"]]
+    assert [x["force"] for x in p["steps"]] == pytest.approx([x["force"] for x in s["steps"]],
+                                                             rel=1e-9)
+    ts, tp = s["torque"], p["torque"]
+    assert tp["slipping"] == ts["slipping"] and tp["in_contact"] == ts["in_contact"]
+    assert tp["torque"] == pytest.approx(ts["torque"], rel=1e-8)
