@@ -584,8 +584,10 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
     for i, t in enumerate(tables, start=1):
         where = f"contact[{i}]"
         if "wear" in t:  # said, not taken
-            r.fail(f"{where}.wear", "not built yet for case files (Archard's wear on a pair: "
-                                    "contact.pair.ArchardWear in a script)")
+            r.fail(f"{where}.wear", "not built yet for case files: Archard's wear needs a "
+                                    "sliding distance that grows while the load is held, "
+                                    "which a case has no axis for (contact.pair."
+                                    "ArchardWear.slide in a script)")
         r.unknown({k: v for k, v in t.items() if k != "wear"}, where,
                   ("slave", "master", "friction"))
         slave = r.get(t, "slave", where, str, required=True)
