@@ -419,8 +419,8 @@ CASES = Path(__file__).resolve().parents[1] / "cases"
 def test_a_case_file_of_two_bodies_is_hertz(demo):
     # cases/ball_on_block.toml: the sphere on the block above, as a case file ([[material]]
     # per cell group, a [[contact]] pair), its mesh h = a/20 at the contact. For the force
-    # the pair reports: the largest radius in contact −0.0043 (0.9 h) from Hertz's a, the
-    # largest nodal pressure (on the axis) −1.2 % from p0: bounded by one node spacing and
+    # the pair reports: the largest radius in contact −0.0019 (0.38 h) from Hertz's a, the
+    # largest nodal pressure (on the axis) −1.1 % from p0: bounded by one node spacing and
     # 2 % (the nodal values, not the fitted ellipse of the tests above); the multipliers'
     # force is the push's reaction and the block's support's (1e-8)
     d = demo.case(CASES / "ball_on_block.toml")
@@ -684,3 +684,15 @@ def test_the_bearing_demo_on_two_ranks_gives_the_serial_answer(demo):
     ts, tp = s["torque"], p["torque"]
     assert tp["slipping"] == ts["slipping"] and tp["in_contact"] == ts["in_contact"]
     assert tp["torque"] == pytest.approx(ts["torque"], rel=1e-8)
+
+
+def test_a_wear_step_takes_a_positive_sliding_distance():
+    # a negative distance would grow the surface back, NaN fail later with another cause
+    from types import SimpleNamespace
+
+    from fenics_nl.contact.pair import ArchardWear
+
+    wear = ArchardWear(SimpleNamespace(pair=SimpleNamespace(slave=np.zeros(0))), 1.0)
+    for ds in (-0.1, 0.0, float("nan")):
+        with pytest.raises(ValueError, match="sliding distance of a step must be > 0"):
+            wear.slide(ds)

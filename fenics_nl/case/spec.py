@@ -703,8 +703,13 @@ def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
         if group is not None and law is not None:
             groups.append((group, law, parameters))
     if len({LAWS[law].finite_strain for _, law, _ in groups}) > 1:
-        r.fail("material", "all groups small strain or all finite strain (one kinematics "
-                           "for the bodies)")
+        kinds = {k: ", ".join(f"{law} ({g})" for g, law, _ in groups
+                              if LAWS[law].finite_strain == (k == "finite"))
+                 for k in ("small", "finite")}
+        r.fail("material", f"all groups small strain or all finite strain (one kinematics "
+                           f"for the bodies): small strain {kinds['small']}; finite strain "
+                           f"{kinds['finite']} (saint-venant-kirchhoff and neo-hookean are "
+                           "finite strain)")
     if not groups:
         return None, {}, None
     return groups[0][1], groups[0][2], groups

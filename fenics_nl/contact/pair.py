@@ -57,7 +57,8 @@ class ContactPair:
     (frictionless: the tangential rows are 2D's).
 
     Args:
-        V: the displacement space (vector, P1, 2D: plane strain or axisymmetric).
+        V: the displacement space (vector, P1; 2D: plane strain, plane stress or
+            axisymmetric; or 3D).
         slave_facets: this rank's facets of the slave surface.
         master_facets: this rank's facets of the master surface.
         weight: the measure's weight (2πr in the axisymmetric model), for nodal areas.
@@ -375,7 +376,7 @@ class PairContact:
 
     Args:
         residual: R(u; v), the bodies' equilibrium without contact (UFL form).
-        u: the displacement (P1, 2D).
+        u: the displacement (P1).
         bcs: the Dirichlet conditions.
         pair: the contact pair.
         atol: Newton's tolerance on ‖R‖ (times `force_scale`); the gaps of the active
@@ -962,8 +963,9 @@ class ArchardWear:
     the step is solved with it in the gap, g_s + (k Δs / A_s) λ_s = 0 on the active nodes:
     a compliance in series with the bodies, which makes the update stable whatever the
     step (the explicit one, the wear of the step's start, oscillates with too few steps).
-    The worn volume Σ Δh_s A_s is k Δs Σ λ_s = k F_n Δs exactly, a discrete identity of
-    the integration.
+    The worn volume Σ Δh_s A_s is k Δs Σ λ_s exactly, a discrete identity of the
+    integration: k F_n Δs with F_n the sum of the nodal normal forces (on a flat face, the
+    normal force; on a curved one, more than the resultant).
 
     The sliding is its distance per step, not a motion of the mesh: a pin sliding on a
     long flat track meets the same flat everywhere (the track's own wear, spread over its
@@ -991,6 +993,8 @@ class ArchardWear:
         Returns:
             The contact solve's result.
         """
+        if not (np.isfinite(ds) and ds > 0):
+            raise ValueError(f"the sliding distance of a step must be > 0, got {ds}")
         contact, pair = self.contact, self.contact.pair
         areas = np.where(pair.areas > 0, pair.areas, np.inf)  # a node of no area: no wear
         contact.compliance = self.k * ds / areas
