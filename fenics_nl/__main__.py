@@ -96,6 +96,8 @@ def main(argv=None) -> int:
                             if case.time else f"{n} load factor{'s' * (n != 1)}")
         + f", {ranks} rank{'s' * (ranks != 1)}")
     if args.command == "check":
+        for line in problem.apart:  # a run says it with its results
+            say(f"warning: {line}")
         say("check: the case is complete and consistent with its mesh")
         return 0
 

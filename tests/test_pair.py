@@ -696,3 +696,18 @@ def test_a_wear_step_takes_a_positive_sliding_distance():
     for ds in (-0.1, 0.0, float("nan")):
         with pytest.raises(ValueError, match="sliding distance of a step must be > 0"):
             wear.slide(ds)
+
+
+def test_bodies_meshed_apart_without_a_pair_are_said(tmp_path, demo):
+    # ball_on_block without its [[contact]] table: the ball passes into the block unopposed;
+    # the case is valid, but `check` and the run's JSON say that nothing keeps the two
+    # bodies (cell groups sharing no node) apart
+    text = (CASES / "ball_on_block.toml").read_text()
+    text = text[:text.index("[[contact]]")] + text[text.index("[loading]"):]
+    (tmp_path / "ball_on_block.geo").write_text((CASES / "ball_on_block.geo").read_text())
+    (tmp_path / "apart.toml").write_text(text)
+    said = ("the cell groups make 2 bodies that share no node (block; ball) and no "
+            "[[contact]] pair keeps them apart: they pass through each other unopposed")
+    proc = demo.run(["-m fenics_nl", "check", tmp_path / "apart.toml"])
+    assert f"warning: {said}" in proc.stdout
+    assert said in demo.case(tmp_path / "apart.toml")["warnings"]

@@ -50,6 +50,7 @@ class CaseProblem:
         self.mesh = msh = data.mesh
         self.model = case.model
         self.facets, problems = self._groups(data)
+        self.apart: list[str] = []  # `_bodies_apart`'s warning, if any
         self.probes, outside = self._locate_probes()
         self.material, unset = self._material(data)
         if problems + outside + unset:
@@ -142,7 +143,49 @@ class CaseProblem:
             named = [g for g, t in have.items() if t not in by_tag]
             problems.append(f"material: {bare} cells are in no [[material]] group (cell groups "
                             f"without one: {', '.join(sorted(named)) or 'none'})")
+        self.apart = self._bodies_apart(data, {t: g for g, t in have.items() if t in by_tag})
         return material, problems
+
+    def _bodies_apart(self, data, names: dict[int, str]) -> list[str]:
+        """A warning if the cell groups make bodies that share no node and no pair holds apart.
+
+        Bodies meshed apart (each its own nodes) touch only through [[contact]] pairs:
+        without one they pass through each other unopposed, which nothing else would say.
+        """
+        if self.case.pairs or len(names) < 2:
+            return []
+        msh = data.mesh
+        tdim = msh.topology.dim
+        msh.topology.create_connectivity(tdim, 0)
+        c2v = msh.topology.connectivity(tdim, 0)
+        n_vertices = (msh.topology.index_map(0).size_local
+                      + msh.topology.index_map(0).num_ghosts)
+        groups_of = [set() for _ in range(n_vertices)]
+        for tag in names:
+            for cell in data.cell_tags.find(tag):
+                for v in c2v.links(cell):
+                    groups_of[v].add(tag)
+        links = {tuple(sorted(g)) for g in groups_of if len(g) > 1}
+        links = set().union(*msh.comm.allgather(links))
+        body = {t: t for t in names}  # union–find of the groups joined by shared nodes
+
+        def root(t):
+            while body[t] != t:
+                t = body[t]
+            return t
+
+        for shared in links:
+            for t in shared[1:]:
+                body[root(t)] = root(shared[0])
+        parts: dict[int, list[str]] = {}
+        for t, name in sorted(names.items()):
+            parts.setdefault(root(t), []).append(name)
+        if len(parts) < 2:
+            return []
+        bodies = "; ".join(", ".join(p) for p in parts.values())
+        return [f"the cell groups make {len(parts)} bodies that share no node ({bodies}) and "
+                "no [[contact]] pair keeps them apart: they pass through each other "
+                "unopposed"]
 
     def _residual(self, data) -> ufl.Form:
         """R(u; v) = internal work − tractions − pressures, loads scaled by the factor t."""

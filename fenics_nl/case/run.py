@@ -300,7 +300,7 @@ def step_record(problem: CaseProblem, t: float, result, at: float | None = None)
 
 def warnings(problem: CaseProblem) -> list[str]:
     """What the results cannot promise."""
-    notes = []
+    notes = list(problem.apart)
     comm = problem.mesh.comm
     x = problem.mesh.geometry.x
     size = comm.allreduce(float(np.ptp(x, axis=0).max()) if len(x) else 0.0, op=MPI.MAX)
