@@ -130,9 +130,9 @@ mesh_data = shaft_in_bearing(comm, R1, c, args.outer_radius, args.size)
 msh = mesh_data.mesh
 
 
-def tagged(name):
-    """The facets of the physical group `name`."""
-    return mesh_data.facet_tags.find(mesh_data.physical_groups[name].tag)
+def tagged(name, data=mesh_data):
+    """The facets of the physical group `name` (of the half model, or of `data`)."""
+    return data.facet_tags.find(data.physical_groups[name].tag)
 
 
 # -
@@ -296,21 +296,17 @@ torque = None
 if args.friction > 0:
     whole = shaft_in_bearing(comm, R1, c, args.outer_radius, 2 * args.size, full=True)
 
-    def on_whole(name):
-        """The facets of the whole model's physical group `name`."""
-        return whole.facet_tags.find(whole.physical_groups[name].tag)
-
     W = fem.functionspace(whole.mesh, ("Lagrange", 1, (2,)))
     w, w_v = fem.Function(W, name="displacement"), ufl.TestFunction(W)
-    hub = [boundary.component(W, k, on_whole("hub")) for k in (0, 1)]
+    hub = [boundary.component(W, k, tagged("hub", whole)) for k in (0, 1)]
     hub_x = hub[0].g.function_space.tabulate_dof_coordinates()  # the hub's rigid motion
-    bcs_whole = [*hub, *(boundary.component(W, k, on_whole("housing_outer")) for k in (0, 1))]
+    bcs_whole = [*hub, *(boundary.component(W, k, tagged("housing_outer", whole)) for k in (0, 1))]
     dxw = ufl.Measure("dx", whole.mesh, subdomain_data=whole.cell_tags)
     e, e_v = (kinematics.small_strain(x, "plane_strain") for x in (w, w_v))
     residual_whole = sum(ufl.inner(law.stress(e), e_v) * dxw(whole.physical_groups[name].tag)
                          for name, law in (("shaft", materials[shaft_tag]),
                                            ("housing", materials[housing_tag])))
-    ring = ContactPair(W, on_whole("shaft_surface"), on_whole("bore"))
+    ring = ContactPair(W, tagged("shaft_surface", whole), tagged("bore", whole))
     turning = FrictionalPair(residual_whole, w, bcs_whole, ring, args.friction,
                              force_scale=args.E_housing * c, linear=True)
 
@@ -326,7 +322,7 @@ if args.friction > 0:
         return -ring.total(ring.x[:, 0] * F[:, 1] - ring.x[:, 1] * F[:, 0])
 
     internal = fem.form(residual_whole)
-    hub_nodes = fem.locate_dofs_topological(W, 1, on_whole("hub"))
+    hub_nodes = fem.locate_dofs_topological(W, 1, tagged("hub", whole))
     hub_nodes = hub_nodes[hub_nodes < W.dofmap.index_map.size_local]
 
     def hub_torque():

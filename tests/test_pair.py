@@ -330,15 +330,16 @@ def test_friction_on_a_pair_on_two_ranks_gives_the_serial_answer(linear):
         assert a == pytest.approx(b, rel=1e-8, abs=1e-12)
 
 
-def worn_pin(steps, comm=MPI.COMM_WORLD, linear=False):
-    """A flat pin (w = 1, E = 1, ν = 0.3) pressed on a flat by F = 0.01 (a traction on its
-    top), slid a distance s = 1 in `steps` with Archard's k = 2 (a mean wear of 0.02, twice
-    the pin's elastic approach): the pressures before and after, the worn volume."""
-    from fenics_nl.contact.pair import ArchardWear
+def pin_pressed(h, comm, shift=0.0):
+    """The flat pin (w = 1, E = 1, ν = 0.3) on the flat (`pin_on_flat`, h along the pin's
+    face), pressed by F = 0.01 (a traction on its top), its top held at u_x = `shift`:
+    the mesh data, `tag`, V, u, ε(u), the residual, the supports and the pair."""
+    from types import SimpleNamespace
+
     from fenics_nl.domain.two_bodies import pin_on_flat
 
-    w, E, nu, F, k = 1.0, 1.0, 0.3, 0.01, 2.0
-    d = pin_on_flat(comm, w, w, 0.02)
+    w, E, nu, F = 1.0, 1.0, 0.3, 0.01
+    d = pin_on_flat(comm, w, w, h)
 
     def tag(name):
         return d.facet_tags.find(d.physical_groups[name].tag)
@@ -349,10 +350,23 @@ def worn_pin(steps, comm=MPI.COMM_WORLD, linear=False):
     ds = ufl.Measure("ds", d.mesh, subdomain_data=d.facet_tags)
     residual = (ufl.inner(LinearElastic(E, nu).stress(eps), eps_v) * ufl.dx
                 + F / w * v[1] * ds(d.physical_groups["pin_top"].tag))
-    bcs = [boundary.component(V, 0, tag("pin_top")),
-           *(boundary.component(V, c, tag("flat_bottom")) for c in (0, 1))]
-    contact = PairContact(residual, u, bcs, ContactPair(V, tag("pin_face"), tag("flat_top")),
-                          force_scale=F, linear=linear)
+    side = boundary.component(V, 0, tag("pin_top"))
+    side.g.x.array[:] = shift
+    bcs = [side, *(boundary.component(V, c, tag("flat_bottom")) for c in (0, 1))]
+    return SimpleNamespace(d=d, tag=tag, V=V, u=u, eps=eps, residual=residual, bcs=bcs,
+                           pair=ContactPair(V, tag("pin_face"), tag("flat_top")), w=w, E=E,
+                           nu=nu, F=F)
+
+
+def worn_pin(steps, comm=MPI.COMM_WORLD, linear=False):
+    """A flat pin (w = 1, E = 1, ν = 0.3) pressed on a flat by F = 0.01 (a traction on its
+    top), slid a distance s = 1 in `steps` with Archard's k = 2 (a mean wear of 0.02, twice
+    the pin's elastic approach): the pressures before and after, the worn volume."""
+    from fenics_nl.contact.pair import ArchardWear
+
+    pin, k = pin_pressed(0.02, comm), 2.0
+    d, tag, u, eps, F, w, E, nu = pin.d, pin.tag, pin.u, pin.eps, pin.F, pin.w, pin.E, pin.nu
+    contact = PairContact(pin.residual, u, pin.bcs, pin.pair, force_scale=F, linear=linear)
     wear = ArchardWear(contact, k)
 
     def profile():
@@ -517,25 +531,10 @@ def slid_pin(shift, finite, comm=MPI.COMM_WORLD):
     its top's nodes (R its internal forces: the flat's equilibrium, not the multipliers)."""
     from dolfinx.fem import petsc
 
-    from fenics_nl.domain.two_bodies import pin_on_flat
-
-    w, E, nu, F = 1.0, 1.0, 0.3, 0.01
-    d = pin_on_flat(comm, w, w, 0.04)
-
-    def tag(name):
-        return d.facet_tags.find(d.physical_groups[name].tag)
-
-    V = fem.functionspace(d.mesh, ("Lagrange", 1, (2,)))
-    u, v = fem.Function(V), ufl.TestFunction(V)
-    eps, eps_v = (kinematics.small_strain(x, "plane_strain") for x in (u, v))
-    ds = ufl.Measure("ds", d.mesh, subdomain_data=d.facet_tags)
-    residual = (ufl.inner(LinearElastic(E, nu).stress(eps), eps_v) * ufl.dx
-                + F / w * v[1] * ds(d.physical_groups["pin_top"].tag))
-    side = boundary.component(V, 0, tag("pin_top"))
-    side.g.x.array[:] = shift
-    bcs = [side, *(boundary.component(V, c, tag("flat_bottom")) for c in (0, 1))]
-    pair = ContactPair(V, tag("pin_face"), tag("flat_top"))
-    contact = PairContact(residual, u, bcs, pair, force_scale=F, finite_sliding=finite)
+    pin = pin_pressed(0.04, comm, shift)
+    V, u, residual, tag, F, w = pin.V, pin.u, pin.residual, pin.tag, pin.F, pin.w
+    contact = PairContact(residual, u, pin.bcs, pin.pair, force_scale=F,
+                          finite_sliding=finite)
     result = contact.solve()
     x, p = contact.profile()
     order = np.argsort(x[:, 0])

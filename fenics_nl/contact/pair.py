@@ -617,11 +617,16 @@ class PairContact:
         for bc in self.bcs:
             bc.set(self.u.x.array)
         self.u.x.scatter_forward()
+        return self._unbalanced(work, self._contact_forces())
+
+    def _unbalanced(self, work: WorkCounts, forces: PETSc.Vec | None) -> PETSc.Vec:
+        """R(u) − `forces` (None: R(u)) at u as it is, the prescribed dofs' rows zeroed."""
         R = petsc.assemble_vector(self.F)
         R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
         work.residual_assemblies += 1
-        R.axpy(-1.0, self._contact_forces())
-        _zero(R, self.held)
+        if forces is not None:
+            R.axpy(-1.0, forces)
+        _zero(R, self.held)  # the prescribed dofs: no equation
         return R
 
     def _saddle(self, B, offset, forces, work, compliance=None):
@@ -636,15 +641,11 @@ class PairContact:
             bc.set(u.x.array)
         u.x.scatter_forward()
         for it in range(1, self.max_it + 1):
-            R = petsc.assemble_vector(self.F)
-            R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            work.residual_assemblies += 1
             Bt_lam = B.createVecRight()
             B.multTranspose(_vec(B, lam), Bt_lam)
-            R.axpy(-1.0, Bt_lam)  # R(u) − Bᵀλ
             if forces is not None:
-                R.axpy(-1.0, forces)
-            _zero(R, self.held)  # the prescribed dofs: no equation
+                Bt_lam.axpy(1.0, forces)
+            R = self._unbalanced(work, Bt_lam)  # R(u) − Bᵀλ − forces
             g = B.createVecLeft()
             B.mult(u.x.petsc_vec, g)
             g.array[:] += offset + (0.0 if compliance is None else compliance * lam)

@@ -25,7 +25,7 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.contact.condensed import every_rank
-from fenics_nl.contact.pair import PairContact, _zero
+from fenics_nl.contact.pair import PairContact
 from fenics_nl.errors import SolveError
 from fenics_nl.solvers.result import WorkCounts
 
@@ -71,10 +71,7 @@ class EliminatedPair(PairContact):
             bc.set(u.x.array)
         for it in range(1, self.max_it + 1):
             self._close(which)  # the gaps exactly closed: u on the constraint
-            R = petsc.assemble_vector(self.F)
-            R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            work.residual_assemblies += 1
-            _zero(R, self.held)
+            R = self._unbalanced(work, None)
             r = T.createVecRight()
             T.multTranspose(R, r)  # Tᵀ R: the equations of the free dofs
             r.array[eliminated - self.start] = 0.0
@@ -111,9 +108,9 @@ class EliminatedPair(PairContact):
             raise SolveError(f"contact pair (eliminated): Newton did not converge in "
                              f"{self.max_it} iterations (|Tᵀ R| = {norm:.2e})")
         self._iterations = it - 1
-        self.lam[:] = 0.0  # the reactions at the eliminated dofs: R_{s,k} = n_k λ_s
-        R = petsc.assemble_vector(self.F)
-        R.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+        # the reactions at the eliminated dofs (no support holds them: R has their rows),
+        # R_{s,k} = n_k λ_s, from the converged step's residual
+        self.lam[:] = 0.0
         n_k = self.pair.normal[which, self.component[which]]
         self.lam[which] = R.array[eliminated - self.start] / n_k
         return self._iterations

@@ -37,6 +37,33 @@ from fenics_nl.domain.meshes import (
 __all__ = ["BALL_TAGS", "BEARING_TAGS", "PIN_TAGS", "TWO_BODY_TAGS", "ball_on_block",
            "pin_on_flat", "shaft_in_bearing", "sphere_on_body"]
 
+TOL = 1e-6  # gmsh's model works in units of the contact's size: a point on a line
+
+
+def _name_groups(bodies: dict[str, tuple[int, int]], names: tuple[str, ...], name_of
+                 ) -> dict[str, list[int]]:
+    """The physical groups of two (or more) bodies: their cells, and their boundaries'.
+
+    Each body (its gmsh (dim, tag)) is a cell group numbered in order, 1, 2, ...; each
+    entity of its boundary is in the facet group `name_of(body, entity)`, one of `names`,
+    numbered in the order of `names` (an empty one left out).
+
+    Returns:
+        The entities of each name (for size fields near some of them).
+    """
+    groups = {name: [] for name in names}
+    for body, (dim, tag) in bodies.items():
+        _, boundary = gmsh.model.getAdjacencies(dim, tag)
+        for entity in boundary:
+            groups[name_of(body, entity)].append(entity)
+    for i, (name, tags) in enumerate(groups.items(), start=1):
+        if tags:
+            gmsh.model.addPhysicalGroup(dim - 1, tags, i, name=name)
+    for i, (body, (dim, tag)) in enumerate(bodies.items(), start=1):
+        gmsh.model.addPhysicalGroup(dim, [tag], i, name=body)
+    return groups
+
+
 TWO_BODY_TAGS = ("upper_contact", "upper_top", "upper_axis", "lower_contact", "lower_bottom",
                  "lower_axis", "lower_side")
 
@@ -80,26 +107,19 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
             lower = [e for e in occ.fragment(lower, [(0, occ.addPoint(0, 0, 0))])[0]
                      if e[0] == 2]
         occ.synchronize()
-        tol = 1e-6
-        groups = {name: [] for name in TWO_BODY_TAGS}
-        for body, (dim, surface) in (("upper", upper[0]), ("lower", lower[0])):
-            _, curves = gmsh.model.getAdjacencies(dim, surface)
-            for c in curves:
-                x, y, _ = occ.getCenterOfMass(1, c)
-                if abs(x) < tol and not both_sides:
-                    groups[f"{body}_axis"].append(c)
-                elif body == "upper":
-                    groups["upper_top" if abs(y - r1) < tol else "upper_contact"].append(c)
-                elif r2 is None:
-                    groups["lower_contact" if abs(y) < tol else "lower_bottom"
-                           if abs(y + depth) < tol else "lower_side"].append(c)
-                else:
-                    groups["lower_bottom" if abs(y + r2) < tol else "lower_contact"].append(c)
-        for i, (name, tags) in enumerate(groups.items(), start=1):
-            if tags:
-                gmsh.model.addPhysicalGroup(1, tags, i, name=name)
-        gmsh.model.addPhysicalGroup(2, [upper[0][1]], 1, name="upper")
-        gmsh.model.addPhysicalGroup(2, [lower[0][1]], 2, name="lower")
+
+        def name_of(body, c):
+            x, y, _ = occ.getCenterOfMass(1, c)
+            if abs(x) < TOL and not both_sides:
+                return f"{body}_axis"
+            if body == "upper":
+                return "upper_top" if abs(y - r1) < TOL else "upper_contact"
+            if r2 is None:
+                return "lower_contact" if abs(y) < TOL else "lower_bottom" \
+                    if abs(y + depth) < TOL else "lower_side"
+            return "lower_bottom" if abs(y + r2) < TOL else "lower_contact"
+
+        _name_groups({"upper": upper[0], "lower": lower[0]}, TWO_BODY_TAGS, name_of)
         far = max(width, depth, r1, r2 or 0.0)
         _graded_size_field(a / fine / unit, 1.5, a / fine / unit + growth * far, far)
         gmsh.model.mesh.generate(2)
@@ -147,27 +167,20 @@ def shaft_in_bearing(comm: MPI.Comm, R1: float, clearance: float, R3: float, h: 
 
         shaft, housing = annulus(r1, hub), annulus(r3, r2)
         occ.synchronize()
-        tol = 1e-6
-        groups = {name: [] for name in BEARING_TAGS}
-        for body, (dim, surface) in (("shaft", shaft[0]), ("housing", housing[0])):
-            _, curves = gmsh.model.getAdjacencies(dim, surface)
-            for c in curves:
-                x, _, _ = occ.getCenterOfMass(1, c)
-                if abs(x) < tol and not full:
-                    groups[f"{body}_symmetry"].append(c)
-                    continue
-                lo, hi = gmsh.model.getParametrizationBounds(1, c)
-                px, py, _ = gmsh.model.getValue(1, c, [0.5 * (lo[0] + hi[0])])
-                r = (px * px + py * py) ** 0.5
-                if body == "shaft":
-                    groups["hub" if abs(r - hub) < 1e-3 else "shaft_surface"].append(c)
-                else:
-                    groups["bore" if abs(r - r2) < 1e-3 else "housing_outer"].append(c)
-        for i, (name, tags) in enumerate(groups.items(), start=1):
-            if tags:
-                gmsh.model.addPhysicalGroup(1, tags, i, name=name)
-        gmsh.model.addPhysicalGroup(2, [shaft[0][1]], 1, name="shaft")
-        gmsh.model.addPhysicalGroup(2, [housing[0][1]], 2, name="housing")
+
+        def name_of(body, c):
+            x, _, _ = occ.getCenterOfMass(1, c)
+            if abs(x) < TOL and not full:
+                return f"{body}_symmetry"
+            lo, hi = gmsh.model.getParametrizationBounds(1, c)
+            px, py, _ = gmsh.model.getValue(1, c, [0.5 * (lo[0] + hi[0])])
+            r = (px * px + py * py) ** 0.5
+            if body == "shaft":
+                return "hub" if abs(r - hub) < 1e-3 else "shaft_surface"
+            return "bore" if abs(r - r2) < 1e-3 else "housing_outer"
+
+        groups = _name_groups({"shaft": shaft[0], "housing": housing[0]}, BEARING_TAGS,
+                              name_of)
         field = gmsh.model.mesh.field
         near = threshold_field(hh, 2 * hh, hh + growth * r3, r3,
                                curves=groups["shaft_surface"] + groups["bore"])
@@ -216,25 +229,17 @@ def ball_on_block(comm: MPI.Comm, R: float, a: float, *, block: float = 4.0,
                              [(3, occ.addBox(0, 0, 0, r, r, r))])[0]
         lower = [(3, occ.addBox(0, 0, -L, L, L, L))]
         occ.synchronize()
-        tol = 1e-6
-        groups = {name: [] for name in BALL_TAGS}
-        for body, (dim, volume) in (("upper", ball[0]), ("lower", lower[0])):
-            _, surfaces = gmsh.model.getAdjacencies(dim, volume)
-            for f in surfaces:
-                x, y, z = occ.getCenterOfMass(2, f)
-                kind = gmsh.model.getType(2, f)
-                if abs(x) < tol or abs(y) < tol:
-                    groups[f"{body}_symmetry_{'x' if abs(x) < tol else 'y'}"].append(f)
-                elif body == "upper":
-                    groups["upper_top" if kind == "Plane" else "upper_contact"].append(f)
-                else:
-                    groups["lower_contact" if abs(z) < tol else "lower_bottom"
-                           if abs(z + L) < tol else "lower_side"].append(f)
-        for i, (name, tags) in enumerate(groups.items(), start=1):
-            if tags:
-                gmsh.model.addPhysicalGroup(2, tags, i, name=name)
-        gmsh.model.addPhysicalGroup(3, [ball[0][1]], 1, name="upper")
-        gmsh.model.addPhysicalGroup(3, [lower[0][1]], 2, name="lower")
+
+        def name_of(body, f):
+            x, y, z = occ.getCenterOfMass(2, f)
+            if abs(x) < TOL or abs(y) < TOL:
+                return f"{body}_symmetry_{'x' if abs(x) < TOL else 'y'}"
+            if body == "upper":
+                return "upper_top" if gmsh.model.getType(2, f) == "Plane" else "upper_contact"
+            return "lower_contact" if abs(z) < TOL else "lower_bottom" \
+                if abs(z + L) < TOL else "lower_side"
+
+        _name_groups({"upper": ball[0], "lower": lower[0]}, BALL_TAGS, name_of)
         _graded_size_field(1.0 / fine, 1.5, 1.0 / fine + growth * L, L)
         gmsh.model.mesh.generate(3)
     return distributed(comm, unit, dim=3)
@@ -266,23 +271,16 @@ def pin_on_flat(comm: MPI.Comm, width: float, height: float, h: float,
         pin = occ.addRectangle(-w / 2, 0, 0, w, H)
         base = occ.addRectangle(-L, -L, 0, 2 * L, L)
         occ.synchronize()
-        tol = 1e-6
-        groups = {name: [] for name in PIN_TAGS}
-        for body, surface in (("pin", pin), ("flat", base)):
-            _, curves = gmsh.model.getAdjacencies(2, surface)
-            for c in curves:
-                _, y, _ = occ.getCenterOfMass(1, c)
-                if body == "pin":
-                    name = "pin_face" if abs(y) < tol else "pin_top" if abs(y - H) < tol \
-                        else "pin_sides"
-                else:
-                    name = "flat_top" if abs(y) < tol else "flat_bottom" \
-                        if abs(y + L) < tol else "flat_sides"
-                groups[name].append(c)
-        for i, (name, tags) in enumerate(groups.items(), start=1):
-            gmsh.model.addPhysicalGroup(1, tags, i, name=name)
-        gmsh.model.addPhysicalGroup(2, [pin], 1, name="pin")
-        gmsh.model.addPhysicalGroup(2, [base], 2, name="flat")
+
+        def name_of(body, c):
+            _, y, _ = occ.getCenterOfMass(1, c)
+            if body == "pin":
+                return "pin_face" if abs(y) < TOL else "pin_top" if abs(y - H) < TOL \
+                    else "pin_sides"
+            return "flat_top" if abs(y) < TOL else "flat_bottom" if abs(y + L) < TOL \
+                else "flat_sides"
+
+        groups = _name_groups({"pin": (2, pin), "flat": (2, base)}, PIN_TAGS, name_of)
         size_by_field(threshold_field(hh, 0.05, hh + growth * L, L,
                                       curves=groups["pin_face"], sampling=200))
         gmsh.model.mesh.generate(2)
