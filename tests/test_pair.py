@@ -710,3 +710,19 @@ def test_bodies_meshed_apart_without_a_pair_are_said(tmp_path, demo):
     proc = demo.run(["-m fenics_nl", "check", tmp_path / "apart.toml"])
     assert f"warning: {said}" in proc.stdout
     assert said in demo.case(tmp_path / "apart.toml")["warnings"]
+
+
+def test_a_body_that_nothing_holds_is_refused_not_solved(tmp_path, demo):
+    # ball_on_block without the block's support: the ball's push moves the block rigidly,
+    # and once the contact lets go nothing holds it (K and then the saddle point singular:
+    # MUMPS's null pivots counted). One line, exit 2 — it had ended "ok", the block moved
+    # by the push with no force anywhere
+    text = (CASES / "ball_on_block.toml").read_text()
+    start = text.index('[[boundary]]\ngroup = "block_bottom"')
+    text = text[:start] + text[text.index("[[contact]]"):]
+    (tmp_path / "ball_on_block.geo").write_text((CASES / "ball_on_block.geo").read_text())
+    (tmp_path / "loose.toml").write_text(text)
+    proc = demo.run(["-m fenics_nl", "run", tmp_path / "loose.toml"], check=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert ("contact pair: 1 motion(s) free: a body that neither its supports nor the "
+            "contact in force hold") in proc.stderr

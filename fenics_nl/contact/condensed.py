@@ -33,10 +33,12 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from fenics_nl.errors import SolveError
+from fenics_nl.solvers.linear_solver import create_ksp, factorized_counting_null_pivots
 from fenics_nl.solvers.result import WorkCounts
 
 __all__ = ["CondensedSaddle"]
 
+PREFIX = "pair_"  # the PETSc options of a pair's solves (-pair_ksp_view, ...)
 CHUNK = 64  # new columns solved at once: MUMPS's multiple right-hand sides, memory bounded
 
 
@@ -76,15 +78,13 @@ class CondensedSaddle:
         K = petsc.assemble_matrix(self.J, self.bcs)
         K.assemble()
         work.tangent_assemblies += 1
-        self.ksp = PETSc.KSP().create(K.comm)
-        self.ksp.setOperators(K)
-        self.ksp.setType("preonly")
-        self.ksp.getPC().setType("lu")
-        self.ksp.getPC().setFactorSolverType("mumps")
+        self.ksp = create_ksp(K, "lu", prefix=PREFIX)
         t0 = time.perf_counter()
-        self.ksp.setUp()
+        free = factorized_counting_null_pivots(self.ksp)
         work.factorizations += 1
         work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
+        if free:  # a body the contact alone holds: its saddle point may not be singular
+            raise SolveError(f"K is singular ({free} motion(s) free without the contact)")
 
     def back_solve(self, b: PETSc.Vec, work: WorkCounts) -> PETSc.Vec:
         """K⁻¹ b on the kept factorization."""

@@ -41,8 +41,9 @@ from dolfinx.fem import petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from fenics_nl.contact.condensed import CondensedSaddle, every_rank
-from fenics_nl.errors import SolveError
+from fenics_nl.contact.condensed import PREFIX, CondensedSaddle, every_rank
+from fenics_nl.errors import SolveError, SupportError
+from fenics_nl.solvers.linear_solver import create_ksp, factorized_counting_null_pivots
 from fenics_nl.solvers.result import SolveResult, WorkCounts
 
 __all__ = ["ArchardWear", "ContactPair", "FrictionalPair", "PairContact", "PairState"]
@@ -701,13 +702,14 @@ def _saddle_solve(K, B, R, g, held, work: WorkCounts, compliance=None):
     n_u = R.getLocalSize()
     rhs.array[:n_u] = R.array
     rhs.array[n_u:] = -g.array
-    ksp = PETSc.KSP().create(K.comm)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
+    ksp = create_ksp(A, "lu", prefix=PREFIX)
     x = A.createVecLeft()
     t0 = time.perf_counter()
+    free = factorized_counting_null_pivots(ksp)
+    if free:
+        raise SupportError(f"contact pair: {free} motion(s) free: a body that neither its "
+                           "supports nor the contact in force hold (the saddle point is "
+                           "singular)")
     ksp.solve(rhs, x)
     work.factorizations += 1
     work.linear_solves += 1

@@ -25,8 +25,9 @@ from dolfinx.fem import petsc
 from petsc4py import PETSc
 
 from fenics_nl.contact.condensed import every_rank
-from fenics_nl.contact.pair import PairContact
-from fenics_nl.errors import SolveError
+from fenics_nl.contact.pair import PREFIX, PairContact
+from fenics_nl.errors import SolveError, SupportError
+from fenics_nl.solvers.linear_solver import create_ksp, factorized_counting_null_pivots
 from fenics_nl.solvers.result import WorkCounts
 
 __all__ = ["EliminatedPair"]
@@ -89,11 +90,12 @@ class EliminatedPair(PairContact):
                 Kt.setValue(int(dof), int(dof), 1.0, addv=PETSc.InsertMode.INSERT_VALUES)
             Kt.assemble()
             dz = r.duplicate()
-            ksp = PETSc.KSP().create(K.comm)
-            ksp.setOperators(Kt)
-            ksp.setType("preonly")
-            ksp.getPC().setType("lu")
-            ksp.getPC().setFactorSolverType("mumps")
+            ksp = create_ksp(Kt, "lu", prefix=PREFIX)
+            free = factorized_counting_null_pivots(ksp)
+            if free:
+                raise SupportError(f"contact pair (eliminated): {free} motion(s) free: a "
+                                   "body that neither its supports nor the contact in force "
+                                   "hold")
             ksp.solve(r, dz)
             work.factorizations += 1
             work.linear_solves += 1

@@ -111,6 +111,19 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
     return ksp
 
 
+def factorized_counting_null_pivots(ksp: PETSc.KSP) -> int:
+    """Factorize a direct (MUMPS) KSP with null pivots detected (ICNTL(24)): their number.
+
+    A singular matrix (a body that nothing holds) factorizes all the same, and its solve
+    adds an arbitrary motion: the count is what says so. Collective.
+    """
+    pc = ksp.getPC()
+    pc.setFactorSetUpSolverType()
+    pc.getFactorMatrix().setMumpsIcntl(24, 1)
+    ksp.setUp()
+    return pc.getFactorMatrix().getMumpsInfog(28)
+
+
 def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
     """GMRES preconditioned on the right: it stops on ‖A x − b‖, what Newton needs."""
     ksp.setType("gmres")
