@@ -403,7 +403,8 @@ def picture():
     arc = x_contact[np.argsort(np.arctan2(x_contact[:, 0], -x_contact[:, 1]))]
     deformed_picture(u, vm, args.png, f"P = {heavy['force']:.4g} per unit length, arc "
                      f"±{heavy['arc_degrees']:.1f}°", curves={"the contact arc": arc},
-                     label="von Mises stress [stress]", axes=("x (length)", "y (length)"))
+                     label="von Mises stress [stress]", axes=("x (length)", "y (length)"),
+                     true_scale=True)  # magnified, the shaft would pass into the bore
     say(f"wrote {args.png}")
 
 

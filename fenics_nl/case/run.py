@@ -423,7 +423,8 @@ def write_outputs(problem: CaseProblem, out: dict, png: str | None, plot: str | 
             deformed_picture(problem.displacement(), vm, png, title, marked, arrows, focus,
                              obstacle, label="von Mises stress (the mean over each cell)",
                              labels=labels, detail=focus is None,
-                             axes=(f"{names[0]} (length)", f"{names[1]} (length)"))
+                             axes=(f"{names[0]} (length)", f"{names[1]} (length)"),
+                             true_scale=bool(problem.case.pairs))  # bodies in contact
             say(f"wrote {png}")
         writers.append(picture)
     return writers

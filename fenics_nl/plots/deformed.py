@@ -136,7 +136,7 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
                      focus: np.ndarray | None = None, obstacle: dict | None = None,
                      label: str = "von Mises stress", labels: dict | None = None,
                      detail: bool = False, curves: dict | None = None,
-                     axes: tuple[str, str] | None = None) -> None:
+                     axes: tuple[str, str] | None = None, true_scale: bool = False) -> None:
     """The deformed body (2D or 3D) coloured by σ_eq (or the `label`led cell field `vm`).
 
     `marked`: name → this rank's points to draw (e.g. the nodes of each support group);
@@ -153,7 +153,9 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
     the deformation takes them. `axes`: a 2D body's axis titles (e.g. "r (length)",
     "z (length)"), drawn with their ticks.
     The displacement is magnified until the largest motion is 5 % of the body (said in
-    the picture). Collective; rank 0 writes `path`.
+    the picture), unless `true_scale` (bodies in contact with each other: a magnified
+    motion would pass one through the other) or an obstacle. Collective; rank 0 writes
+    `path`.
     """
     comm = u.function_space.mesh.comm
     u1 = vertex_interpolant(u)
@@ -185,7 +187,7 @@ def deformed_picture(u: fem.Function, vm: fem.Function, path: str, title: str,
         points = {k: inside(v) for k, v in points.items()}
         loads = {k: (inside(x), d) for k, (x, d) in loads.items()}
     u_max = np.linalg.norm(disp, axis=1).max()
-    scale = 1.0 if obstacle else max(1.0, 0.05 * size / max(u_max, 1e-300))
+    scale = 1.0 if obstacle or true_scale else max(1.0, 0.05 * size / max(u_max, 1e-300))
     warped = mesh.warp_by_vector("u", factor=scale)
     flat = bool(np.ptp(grid.points[:, 2]) == 0)
     zoom = _small_peak(mesh, warped, size) if detail else None
