@@ -289,7 +289,7 @@ def pulled_sideways(comm=MPI.COMM_WORLD, linear=False):
     return steps, a_fit, spacing, f, work
 
 
-def test_cattaneo_mindlin_between_two_identical_cylinders():
+def test_cattaneo_mindlin_between_two_identical_cylinders_and_on_one_factorization():
     # identical materials uncouple the normal and tangential problems; pressed (a = 0.058,
     # Hertz to 0.03 %) then pulled sideways: Q/(fP) = 0.34, 0.66, 0.82. The stick zone's
     # half-width (half the span of the stuck nodes) against c = a √(1 − Q/(fP)): −0.0026,
@@ -304,14 +304,12 @@ def test_cattaneo_mindlin_between_two_identical_cylinders():
         assert width == pytest.approx(a_fit * np.sqrt(1 - abs(Q) / (f * P)), abs=spacing)
     widths = [w for _, _, w, _ in steps]
     assert widths[0] > widths[1] > widths[2]
-
-
-def test_friction_on_one_factorization_is_the_saddle_points_answer():
-    # the same Cattaneo–Mindlin run with K factorized once (contact.condensed: the stuck
-    # nodes' slips are rows too, the slipping nodes' f λ_n known forces): the same statuses
-    # at every iteration (the counts), the same forces and stick zones (measured 1e-13);
-    # one factorization for the run, a back-substitution per status iteration and one a
-    # step, against a factorization per status iteration
+    # the same run with K factorized once (contact.condensed: the stuck nodes' slips are
+    # rows too, the slipping nodes' f λ_n known forces): the same statuses at every
+    # iteration (the counts), the same forces and stick zones (measured 1e-13); one
+    # factorization for the run, a back-substitution per status iteration and one a step,
+    # against a factorization per status iteration (one test: the saddle point's run is
+    # this one's, not made again on the other worker)
     saddle, condensed = pulled_sideways(), pulled_sideways(linear=True)
     for a, b in zip(saddle[0], condensed[0], strict=True):
         assert a == pytest.approx(b, rel=1e-10, abs=1e-14)
