@@ -317,8 +317,7 @@ if args.friction > 0:
 
     def resisting_torque():
         """−Σ x × (λ_n n + λ_t t): the bore's torque against the turn (every rank's)."""
-        n = ring.normal
-        F = turning.lam[:, None] * n + turning.lam_t[:, None] * np.c_[-n[:, 1], n[:, 0]]
+        F = turning.nodal_forces()
         return -ring.total(ring.x[:, 0] * F[:, 1] - ring.x[:, 1] * F[:, 0])
 
     internal = fem.form(residual_whole)

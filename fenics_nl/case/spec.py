@@ -92,8 +92,8 @@ contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
 # inside the braces, displacement moves the obstacle (scaled by the load factor). In the
 # axisymmetric model a sphere is centred on the axis and a plane is normal to it.
 
-# [[contact]]            # contact between two bodies (degree 1; 3D: frictionless,
-# slave = "ball_surface" # displacement formulation): the slave group's nodes against the
+# [[contact]]            # contact between two bodies (degree 1, displacement
+# slave = "ball_surface" # formulation; 2D and 3D): the slave group's nodes against the
 # master = "block_top"   # master group's facets (facet groups of the two bodies), small
 # friction = 0.0         # sliding; optional Coulomb coefficient (default 0). One table per
 #                        # pair; the JSON reports each pair's force, nodes in contact,
@@ -206,7 +206,7 @@ KEYS = [
      "master's facets (the finer surface)", "required", "—"),
     ("contact", "master", "[[contact]]: the facet group of the other body", "required", "—"),
     ("contact", "friction", "[[contact]]: Coulomb's coefficient f (stick and slip, as on a "
-     "rigid obstacle; 2D only)", "0", "—"),
+     "rigid obstacle)", "0", "—"),
     ("loading", "steps", "load control: n equal steps to the load factor 1, or a list of "
      "load factors to visit", "required there", "—"),
     ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
@@ -606,11 +606,6 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
 def _pair_limits(r: _Reader, pairs, model, degree, formulation, law, newton, linear,
                  conditions, arc) -> None:
     """What a case with [[contact]] pairs cannot take, each said (`contact.pair`'s reach)."""
-    if model == "3d":
-        for p in pairs:
-            if p["friction"] > 0:
-                r.fail(f"{p['key']}.friction", "3D pairs are frictionless (friction on a "
-                                               "pair is 2D: 3D's two tangents are not built)")
     if degree is not None and degree != 1:
         r.fail("mesh.degree", f"contact pairs take degree 1 (node to segment or triangle), "
                               f"got {degree}")

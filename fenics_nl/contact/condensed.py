@@ -61,6 +61,7 @@ class CondensedSaddle:
         self.start, self.local = B.getOwnershipRange()[0], B.getLocalSize()[0]
         self.n = B.getSize()[0]  # rows per block (every rank's)
         self.ksp = None
+        self.free_motions = 0  # K's null pivots: motions its supports leave free
         self.column: dict[int, int] = {}  # row (block * n + j) -> its column of S
         # S's columns [B w; B_t w; ...] (every row), in an array with room for twice
         # the columns (grown by doubling, not copied at every new column); the w
@@ -83,6 +84,7 @@ class CondensedSaddle:
         free = factorized_counting_null_pivots(self.ksp)
         work.factorizations += 1
         work.time["solve"] = work.time.get("solve", 0.0) + time.perf_counter() - t0
+        self.free_motions = free
         if free:  # a body the contact alone holds: its saddle point may not be singular
             raise SolveError(f"K is singular ({free} motion(s) free without the contact)")
 
@@ -166,7 +168,7 @@ class CondensedSaddle:
 
     def solve(self, before: np.ndarray, unknown: np.ndarray, known: np.ndarray,
               residual: np.ndarray, work: WorkCounts,
-              compliance: np.ndarray | None = None) -> np.ndarray:
+              compliance: np.ndarray | None = None, frame=None) -> np.ndarray:
         """The rows' new forces, and u moved by their columns (`move` applies it).
 
         Args:
@@ -176,22 +178,28 @@ class CondensedSaddle:
             residual: every row's condition at u now (gaps, slips since the last step),
                 with its compliance's term c λ if any.
             work: the counts.
-            compliance: c, one per row (of the first block) or None: each unknown row's
-                condition is then residual + S Δλ + c Δλ = 0 (wear in the gap).
+            compliance: c, one per row (the first ones: of the first block) or None: each
+                unknown row's condition is then residual + S Δλ + c Δλ = 0 (wear in the
+                gap, a spring across a slip).
+            frame: Q, an orthonormal sparse matrix (rows × rows) whose columns are new
+                rows in the blocks' (a 3D slipping node's tangential rows turned along and
+                across its slip), or None. With it every argument and the answer are the
+                new rows' (forces Qᵀλ, conditions Qᵀr) and S is QᵀSQ.
 
         Returns:
             Every row's new force (0 outside `unknown` and the given ones).
         """
         after = known.copy()
         loaded = np.flatnonzero(before)
-        self.columns(np.union1d(unknown, np.flatnonzero(known)), work)
-        free = np.array([k for k in unknown if abs(self.S[int(k), self.column[int(k)]]) > 0],
-                        dtype=int)
+        rows = np.union1d(np.union1d(unknown, np.flatnonzero(known)), loaded)
+        self.columns(rows if frame is None else _support(frame, rows), work)
+        diagonal = np.diag(self.flexibility(unknown, unknown, frame)) if len(unknown) else []
+        free = np.asarray(unknown, dtype=int)[np.abs(diagonal) > 0]
         if len(free):  # a row on held dofs only (S_kk = 0) takes no force
-            rhs = -residual[free] + self.flexibility(free, loaded) @ before[loaded]
+            rhs = -residual[free] + self.flexibility(free, loaded, frame) @ before[loaded]
             given = np.flatnonzero(known)
-            rhs -= self.flexibility(free, given) @ known[given]
-            S = self.flexibility(free, free)
+            rhs -= self.flexibility(free, given, frame) @ known[given]
+            S = self.flexibility(free, free, frame)
             if compliance is not None:  # c (λ_new − λ_before) joins the residual's c λ_before
                 c = np.zeros(len(before))
                 c[:len(compliance)] = compliance
@@ -200,10 +208,15 @@ class CondensedSaddle:
             after[free] = np.linalg.solve(S, rhs)
         return after
 
-    def flexibility(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """S[rows, cols] (dense, the same on every rank)."""
-        where = [self.column[int(k)] for k in cols]
-        return self.S[np.ix_(np.asarray(rows, dtype=int), where)]
+    def flexibility(self, rows: np.ndarray, cols: np.ndarray, frame=None) -> np.ndarray:
+        """S[rows, cols] (dense, the same on every rank); with a `frame` Q, (QᵀSQ)[rows, cols]."""
+        rows, cols = np.asarray(rows, dtype=int), np.asarray(cols, dtype=int)
+        if frame is None:
+            return self.S[np.ix_(rows, [self.column[int(k)] for k in cols])]
+        old_rows, old_cols = _support(frame, rows), _support(frame, cols)
+        left = frame[old_rows][:, rows].toarray()  # Q[old, new]
+        right = frame[old_cols][:, cols].toarray()
+        return left.T @ self.flexibility(old_rows, old_cols) @ right
 
     def move(self, u: PETSc.Vec, before: np.ndarray, after: np.ndarray,
              work: WorkCounts) -> None:
@@ -211,6 +224,11 @@ class CondensedSaddle:
         if np.any(after != before):
             u.axpy(1.0, self.back_solve(self._load(after - before), work))
             work.linear_solves += 1
+
+
+def _support(frame, rows: np.ndarray) -> np.ndarray:
+    """The old rows that the new `rows` (columns of the frame Q) are made of."""
+    return np.unique(frame[:, np.asarray(rows, dtype=int)].nonzero()[0])
 
 
 def every_rank(comm: MPI.Comm, values: np.ndarray) -> np.ndarray:

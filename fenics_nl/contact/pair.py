@@ -54,8 +54,9 @@ log = logging.getLogger(__name__)
 class ContactPair:
     """Slave nodes on one body's facets against the master facets of the other (P1).
 
-    2D: node to segment (plane strain, plane stress, axisymmetric); 3D: node to triangle
-    (frictionless: the tangential rows are 2D's).
+    2D: node to segment (plane strain, plane stress, axisymmetric); 3D: node to triangle.
+    Each slave node has its master's normal n and a tangent basis (2D: t = (−n_y, n_x);
+    3D: t1 the coordinate axis farthest from n made orthogonal to it, t2 = n × t1).
 
     Args:
         V: the displacement space (vector, P1; 2D: plane strain, plane stress or
@@ -89,10 +90,8 @@ class ContactPair:
         self.facet, self.weights, self.normal, self.gamma = _project(self.x, segments)
         self.opened = np.zeros(len(self.slave))  # gap added to the geometry's (wear)
         self.master_nodes = segments["nodes"][self.facet]  # (n, nodes) global blocks
-        self.B = self.rows(np.arange(len(self.slave)))
-        # the tangential rows (friction): 2D only (3D's two tangents are not built)
-        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True) if \
-            self.gdim == 2 else None
+        self.tangents = _tangents(self.normal)  # (nodes, gdim − 1, gdim)
+        self.B, self._Bt = self.rows(np.arange(len(self.slave))), None
         self.areas = _nodal_areas(V, np.asarray(slave_facets, np.int32), weight)[self.slave]
         self.part = np.zeros(len(self.slave), dtype=np.int64)  # which pair (`joined`)
         # the bodies' size: what a gap is small against (round-off)
@@ -112,14 +111,12 @@ class ContactPair:
         first = pairs[0]
         out.V, out.mesh, out.comm, out.bs = first.V, first.mesh, first.comm, first.bs
         out.gdim = first.gdim
-        for name in ("slave", "x", "slave_global", "weights", "normal", "gamma",
+        for name in ("slave", "x", "slave_global", "weights", "normal", "tangents", "gamma",
                      "master_nodes", "areas", "opened"):
             setattr(out, name, np.concatenate([getattr(p, name) for p in pairs]))
         out.part = np.concatenate([np.full(len(p.slave), k) for k, p in enumerate(pairs)])
         out.length = max(p.length for p in pairs)
-        out.B = out.rows(np.arange(len(out.slave)))
-        out.Bt = out.rows(np.arange(len(out.slave)), tangential=True) if out.gdim == 2 \
-            else None
+        out.B, out._Bt = out.rows(np.arange(len(out.slave))), None
         return out
 
     def open(self, depth: np.ndarray) -> None:
@@ -158,8 +155,8 @@ class ContactPair:
         facet, self.weights, self.normal, gap = _project(x, now)
         changed = self.comm.allreduce(int((facet != self.facet).sum()))
         self.facet, self.master_nodes = facet, seg["nodes"][facet]
-        self.B = self.rows(np.arange(len(self.slave)))
-        self.Bt = self.rows(np.arange(len(self.slave)), tangential=True)
+        self.tangents = _tangents(self.normal)
+        self.B, self._Bt = self.rows(np.arange(len(self.slave))), None
         Bu = self.B.createVecLeft()
         self.B.mult(u.x.petsc_vec, Bu)
         self.gamma = gap - Bu.array + self.opened
@@ -176,20 +173,19 @@ class ContactPair:
         """The slave nodes over every rank."""
         return self.comm.allreduce(len(self.slave))
 
-    def rows(self, which: np.ndarray, tangential: bool = False) -> PETSc.Mat:
-        """B's rows of the owned slave nodes `which` (a new PETSc matrix, global columns).
+    def rows(self, which: np.ndarray, directions: np.ndarray | None = None) -> PETSc.Mat:
+        """The rows d·(u_s − Σ_j N_j u_{m_j}) of the owned slave nodes `which` (global columns).
 
         Args:
             which: indices into this rank's slave nodes.
-            tangential: the rows along the tangent t = (−n_y, n_x) (the relative tangential
-                displacement) instead of the normal.
+            directions: d, one unit vector per node of `which` (a tangent: the relative
+                tangential displacement); None: the normals (B's rows).
 
         Returns:
-            The matrix, one row per node of `which`.
+            A new PETSc matrix, one row per node of `which`.
         """
-        if tangential and self.gdim != 2:
-            raise ValueError("tangential rows: 2D only")
         g = self.gdim
+        d_all = self.normal[which] if directions is None else np.asarray(directions)
         n_local = len(which)
         N = self.V.dofmap.index_map.size_global * self.bs
         n_owned = self.V.dofmap.index_map.size_local * self.bs
@@ -198,23 +194,35 @@ class ContactPair:
                                   comm=self.comm)
         B.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         start = B.getOwnershipRange()[0]
-        for row, i in enumerate(which):
-            n = self.normal[i]
-            d = np.array([-n[1], n[0]]) if tangential else n
+        for row, (i, d) in enumerate(zip(which, d_all, strict=True)):
             cols = [self.bs * self.slave_global[i] + k for k in range(g)]
             vals = list(d)
             for j, w in enumerate(self.weights[i]):
                 cols += [self.bs * self.master_nodes[i, j] + k for k in range(g)]
                 vals += list(-w * d)
-            B.setValues(start + row, cols, vals, addv=PETSc.InsertMode.ADD_VALUES)
+            # (round-off entries dropped: a row on a symmetry plane's held dofs stays one)
+            keep = np.abs(vals) > 1e-14
+            B.setValues(start + row, np.asarray(cols, PETSc.IntType)[keep], np.asarray(vals)[keep],
+                        addv=PETSc.InsertMode.ADD_VALUES)
         B.assemble()
         return B
 
+    @property
+    def Bt(self) -> list[PETSc.Mat]:
+        """The tangential rows, one matrix per tangent (every slave node; friction)."""
+        if self._Bt is None:
+            every = np.arange(len(self.slave))
+            self._Bt = [self.rows(every, self.tangents[:, k]) for k in range(self.gdim - 1)]
+        return self._Bt
+
     def tangential(self, u: fem.Function) -> np.ndarray:
-        """The relative tangential displacement (u_s − u_m)·t at this rank's slave nodes (2D)."""
-        g = self.Bt.createVecLeft()
-        self.Bt.mult(u.x.petsc_vec, g)
-        return g.array.copy()
+        """(u_s − u_m)·t_k at this rank's slave nodes, one column per tangent."""
+        out = np.zeros((len(self.slave), self.gdim - 1))
+        for k, Bt in enumerate(self.Bt):
+            g = Bt.createVecLeft()
+            Bt.mult(u.x.petsc_vec, g)
+            out[:, k] = g.array
+        return out
 
     def gaps(self, u: fem.Function) -> np.ndarray:
         """g_s(u) = γ_s + B_s u at this rank's slave nodes."""
@@ -279,6 +287,22 @@ def _normal(P: np.ndarray) -> np.ndarray:
     else:
         n = np.cross(P[..., 1, :] - P[..., 0, :], P[..., 2, :] - P[..., 0, :])
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def _tangents(normal: np.ndarray) -> np.ndarray:
+    """Each normal's tangent basis (nodes × (dim − 1) × dim), orthonormal with it.
+
+    2D: t = (−n_y, n_x); 3D: t1 the coordinate axis least along n made orthogonal to it
+    (so that on a flat face normal to an axis the tangents are the other two axes, and a
+    symmetry plane's held component is one tangent's), t2 = n × t1.
+    """
+    n = np.asarray(normal, dtype=float)
+    if n.shape[1] == 2:
+        return np.stack([-n[:, 1], n[:, 0]], axis=1)[:, None, :]
+    e = np.eye(3)[np.argmin(np.abs(n), axis=1)]
+    t1 = e - np.einsum("ij,ij->i", e, n)[:, None] * n
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    return np.stack([t1, np.cross(n, t1)], axis=1)
 
 
 def _closest(x: np.ndarray, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -421,6 +445,9 @@ class PairContact:
         # a compliance in the gap of each owned slave node (g + c λ = 0 where active):
         # the wear of a step (`ArchardWear`); None: none
         self.compliance: np.ndarray | None = None
+        # the motions K's supports leave free (a linear K's factorization counts them)
+        # and the last solve's force scale (its first residual's, or `force_scale`)
+        self.free_motions, self._load = 0, 0.0
 
     def solve(self) -> SolveResult:
         """The active-set loop from the current set (warm start) to a set that repeats.
@@ -451,6 +478,7 @@ class PairContact:
                             "leave": comm.allreduce(int(leave.sum())),
                             "join": comm.allreduce(int(join.sum())), "moved": moved})
             if changes == 0 and open_gap <= 1e-10 * length:
+                self._held()
                 self.history = history
                 return SolveResult(True, "converged", its, [], work,
                                    time.perf_counter() - t0, active_set_iterations=k,
@@ -462,6 +490,27 @@ class PairContact:
             seen.add(key)
             self.active = new
         raise SolveError(f"the active set did not settle in {self.max_iterations} iterations")
+
+    def _held(self) -> None:
+        """Refuse an answer that no force holds.
+
+        K leaves motions free and the contact carries no force (round-off of the load):
+        the bodies' position along those motions is anyone's (a block without its
+        support, moved by the push and touching it with no force: any lower position is
+        as good).
+
+        Raises:
+            SupportError: the supports and the contact in force leave a motion free.
+        """
+        if not self.free_motions:
+            return
+        carried = self.pair.comm.allreduce(float(np.abs(self.lam).max(initial=0.0)),
+                                           op=MPI.MAX)
+        if carried <= 1e-9 * self._load:
+            raise SupportError(f"contact pair: {self.free_motions} motion(s) free: a body "
+                               "that neither its supports nor the contact in force hold "
+                               f"(the contact carries {carried:.1e}, the load "
+                               f"{self._load:.1e})")
 
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
         """What a restart needs after a converged step: the set and the forces (this rank's).
@@ -507,15 +556,19 @@ class PairContact:
         areas = np.where(self.pair.areas > 0, self.pair.areas, 1.0)
         return PairState(self.active.copy(), self.lam.copy(), self.lam / areas)
 
+    def nodal_forces(self) -> np.ndarray:
+        """The force the master exerts on each owned slave node, λ_s n_s (nodes × dim)."""
+        return self.lam[:, None] * self.pair.normal
+
     def force(self, which: np.ndarray | None = None) -> np.ndarray:
-        """The force the master exerts on the slave body, Σ λ_s n_s (every rank's).
+        """The force the master exerts on the slave body, the nodal forces' sum (every rank's).
 
         Args:
             which: flags of the slave nodes to sum over (one pair's); None: all.
         """
-        keep = np.ones(len(self.lam), bool) if which is None else which
-        return np.array([self.pair.total((self.lam * self.pair.normal[:, k])[keep])
-                         for k in range(self.pair.gdim)])
+        F = self.nodal_forces()
+        keep = np.ones(len(F), bool) if which is None else which
+        return np.array([self.pair.total(F[keep, k]) for k in range(self.pair.gdim)])
 
     def profile(self) -> tuple[np.ndarray, np.ndarray]:
         """(x, pressure) of the active slave nodes, gathered on every rank (x: n × dim)."""
@@ -571,7 +624,7 @@ class PairContact:
         return out
 
     def _condensed(self, unknown, known, conditions, work: WorkCounts,
-                   compliance=None) -> bool:
+                   compliance=None, frame=None) -> bool:
         """The statuses' equilibrium on the kept factorization; False if it cannot be.
 
         First the equilibrium with the forces now (a back-substitution, only if the loads
@@ -580,7 +633,9 @@ class PairContact:
         Checked, as a Newton solve checks its answer: R(u) − Bᵀλ = 0 and the conditions met
         to 1e-12 of the bodies' size. K singular (a body held by the contact alone) or a
         residual not linear in u fails the check: the state is put back, said, and from
-        then on each set is a saddle point factorized (False).
+        then on each set is a saddle point factorized (False). With a `frame` Q (rows
+        turned, `CondensedSaddle.solve`), `unknown`, `known`, `compliance` and
+        `conditions()` are the turned rows'.
         """
         c = self.condensed
         saved = self.u.x.array.copy(), self._rows()
@@ -593,7 +648,11 @@ class PairContact:
                 self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
                 self.u.x.scatter_forward()
                 work.linear_solves += 1
-            after = c.solve(before, unknown, known, conditions(), work, compliance)
+            if frame is None:
+                after = c.solve(before, unknown, known, conditions(), work, compliance)
+            else:
+                after = frame @ c.solve(frame.T @ before, unknown, known, conditions(), work,
+                                        compliance, frame)
             c.move(self.u.x.petsc_vec, before, after, work)
             self.u.x.scatter_forward()
             self._set_rows(after)
@@ -610,6 +669,7 @@ class PairContact:
             self.u.x.array[:] = saved[0]
             self._set_rows(saved[1])
             log.warning("contact pair: %s: each set is solved as a saddle point", err)
+            self.free_motions = c.free_motions
             self.condensed = None
             return False
 
@@ -654,6 +714,7 @@ class PairContact:
             closed = g.norm(PETSc.NormType.INFINITY) <= 1e-12 * self.pair.length
             if it == 1:
                 reference = self.scale if self.scale is not None else norm
+                self._load = reference
             if norm <= self.rel * reference and closed and it > 1:
                 self._iterations = it - 1
                 return (lam,)
@@ -748,29 +809,38 @@ def _multiplier_block(Bt: PETSc.Mat, compliance=None) -> PETSc.Mat | None:
 
 
 class FrictionalPair(PairContact):
-    """The active set on a pair with Coulomb friction (2D): open, stuck or slipping nodes.
+    """The active set on a pair with Coulomb friction: open, stuck or slipping nodes.
 
     The course's statuses, as on a rigid obstacle (`contact.friction`), between the bodies:
-    the relative tangential displacement g_t = (u_s − u_m)·t since the last committed state
-    (`commit`) is the slip. Each iteration solves the saddle point with
+    the relative tangential displacement g_t = (u_s − u_m)·t_k (one per tangent of the
+    node's basis, `ContactPair.tangents`) since the last committed state (`commit`) is the
+    slip. Each iteration solves the saddle point with
 
     * open nodes free;
-    * stuck nodes: g_n = 0 and Δg_t = 0 (two multipliers, λ_n and λ_t);
-    * slipping nodes: g_n = 0 and the tangential force f λ_n s on the slave (its opposite,
-      by the shape functions, on the master), λ_n from the last iteration;
+    * stuck nodes: g_n = 0 and Δg_t = 0 (multipliers λ_n and λ_t, one per tangent);
+    * slipping nodes: g_n = 0 and the tangential force f λ_n s on the slave (s a unit
+      direction in the tangent plane; its opposite, by the shape functions, on the master),
+      λ_n from the last iteration;
 
     then updates the statuses: a closed node in tension opens; an open node that penetrates
     closes, slipping without friction (it cannot stick where it was at the step's start:
-    it touched down within the step), until its slip gives the friction's sense, s =
-    −sign(Δg_t), or sticks if it has not slipped; a stuck node whose |λ_t| exceeds f λ_n
-    slips, s = sign(λ_t); a slipping node whose slip goes along its friction force
-    (Δg_t s > 0) sticks. (As on a rigid obstacle, `contact.friction`.) The loop ends when no
-    status changes and the friction forces agree with the normal forces of the same solve
-    (to 1e-9 of the largest).
+    it touched down within the step), until its slip gives the friction's sense,
+    s = −Δg_t/|Δg_t|, or sticks if it has not slipped; a stuck node whose |λ_t| exceeds
+    f λ_n slips, s = λ_t/|λ_t|; a slipping node whose slip goes along its friction force
+    (Δg_t·s > 0) sticks.
+
+    3D: the direction of a slipping node is found by Newton's method as on a rigid
+    obstacle: the node carries f λ_n s and a spring k = f λ_n/(−Δg_t·s) against slip across
+    s (a multiplier μ on the row s⊥·Δg_t with the compliance 1/k: the linearization of
+    −f λ_n Δg_t/|Δg_t|); s then turns to the node's whole tangential force, f λ_n s + μ s⊥,
+    and at the fixed point μ = 0, the slip along −s.
+
+    The loop ends when no status changes and the friction forces agree with the normal
+    forces and directions of the same solve (to 1e-9 of the largest normal force).
 
     Args:
         residual: R(u; v), the bodies' equilibrium without contact (UFL form).
-        u: the displacement (P1, 2D).
+        u: the displacement (P1, 2D or 3D).
         bcs: the Dirichlet conditions.
         pair: the contact pair.
         friction: Coulomb's coefficient f, or one per pair (`ContactPair.part`).
@@ -781,49 +851,78 @@ class FrictionalPair(PairContact):
         if options.get("finite_sliding"):
             raise ValueError("friction on a pair is small sliding (its slip is measured on "
                              "the projection it started from)")
-        if pair.gdim != 2:
-            raise ValueError("friction on a pair is 2D (3D's two tangents are not built)")
         super().__init__(residual, u, bcs, pair, **options)
         f = np.asarray(friction, dtype=float)
         if not np.all(f >= 0):
             raise ValueError(f"the friction coefficient must be >= 0, got {friction}")
         # one per pair (`ContactPair.joined`), as one per slave node
         self.f = f[pair.part] if f.ndim else np.full(len(pair.slave), float(f))
-        n = len(pair.slave)
-        self.slip, self.s = self.f == 0, np.zeros(n)  # no friction: slipping for good
-        self.lam_t = np.zeros(n)
+        n, m = len(pair.slave), pair.gdim - 1
+        if m == 2:
+            self._tangents_along_supports()
+        self.slip = self.f == 0  # no friction: slipping for good
+        self.s = np.zeros((n, m))  # the friction force's direction (tangent basis; 0: none)
+        self.lam_t = np.zeros((n, m))
+        self.spring = np.zeros(n)  # 3D: k against slip across s
         self.committed = pair.tangential(u)
         if self.condensed is not None:  # the stuck nodes' slips are rows too
-            self.condensed = CondensedSaddle(self.J, self.bcs, [pair.B, pair.Bt], self.held)
+            self.condensed = CondensedSaddle(self.J, self.bcs, [pair.B, *pair.Bt], self.held)
 
     def commit(self) -> None:
         """The converged step's tangential displacement: the next step's slip is from it."""
         self.committed = self.pair.tangential(self.u)
 
-    def force(self, which: np.ndarray | None = None) -> np.ndarray:
-        """The force the master exerts on the slave body, Σ λ_n n + λ_t t (every rank's).
+    def _tangents_along_supports(self) -> None:
+        """3D: tangents along the axes the supports hold.
 
-        Args:
-            which: flags of the slave nodes to sum over (one pair's); None: all.
+        A slave node whose relative motion along an axis the supports hold (that
+        component held at the node and at its master nodes: a symmetry plane, a slice's
+        ends) gets that axis as its first tangent t1, and t2 = n × t1 normalized. The row
+        along t1 then binds held dofs only, and takes no multiplier; the basis made
+        orthogonal to a normal tilted by the facets (the faceted bore of a slice) would
+        give t1 a part of the normal's row on the free dofs: two rows nearly dependent, a
+        singular saddle point.
         """
-        keep = np.ones(len(self.lam), bool) if which is None else which
-        n = self.pair.normal
-        t = np.c_[-n[:, 1], n[:, 0]]
-        return np.array([self.pair.total((self.lam * n[:, k] + self.lam_t * t[:, k])[keep])
-                         for k in (0, 1)])
+        pair = self.pair
+        held = np.concatenate(pair.comm.allgather(self.held.indices.astype(np.int64)))
+        bs, g = pair.bs, pair.gdim
+        touching = pair.weights > 1e-14  # the master nodes the slave node's rows bind
+        axes = np.zeros((len(pair.slave), g), dtype=bool)
+        for k in range(g):
+            master = np.isin(bs * pair.master_nodes + k, held) | ~touching
+            axes[:, k] = np.isin(bs * pair.slave_global + k, held) & master.all(axis=1)
+        # an axis held and in the tangent plane (roughly: the normal's own axis is not)
+        axes &= np.abs(pair.normal) < 0.5
+        turned = np.flatnonzero(axes.any(axis=1))
+        if not pair.comm.allreduce(len(turned)):
+            return
+        t1 = np.eye(g)[np.argmax(axes[turned], axis=1)]
+        t2 = np.cross(pair.normal[turned], t1)
+        pair.tangents[turned] = np.stack([t1, t2 / np.linalg.norm(t2, axis=1)[:, None]],
+                                         axis=1)
+        pair._Bt = None  # built again on these
+
+    def nodal_forces(self) -> np.ndarray:
+        """The force on each owned slave node, λ_n n + Σ_k λ_t,k t_k (nodes × dim)."""
+        return super().nodal_forces() + np.einsum("nk,nkg->ng", self.lam_t,
+                                                  self.pair.tangents)
 
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
-        """The set, the slip statuses and directions, the forces and the committed slip."""
+        """The set, the slip statuses, directions and springs, the forces, the committed slip."""
         return super().checkpoint_arrays() | {
             "slip": self.slip.astype(np.uint8), "s": self.s.copy(),
-            "lam_t": self.lam_t.copy(), "committed": self.committed.copy()}
+            "lam_t": self.lam_t.copy(), "spring": self.spring.copy(),
+            "committed": self.committed.copy()}
 
     def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
         """The state of `checkpoint_arrays` back."""
         super().restore_arrays(arrays)
         self.slip = arrays["slip"].astype(bool)
-        self.s, self.lam_t = arrays["s"].copy(), arrays["lam_t"].copy()
-        self.committed = arrays["committed"].copy()
+        m = self.pair.gdim - 1
+        self.s = arrays["s"].reshape(-1, m).copy()
+        self.lam_t = arrays["lam_t"].reshape(-1, m).copy()
+        self.spring = arrays["spring"].copy()
+        self.committed = arrays["committed"].reshape(-1, m).copy()
 
     def solve(self) -> SolveResult:
         """The active-set loop with friction, from the current statuses (warm start).
@@ -843,37 +942,49 @@ class FrictionalPair(PairContact):
             its += self._equilibrium(lam_n, work)
             g = self.pair.gaps(self.u)
             dg = self.pair.tangential(self.u) - self.committed
+            slid = np.linalg.norm(dg, axis=1)
+            size = np.linalg.norm(self.lam_t, axis=1)
+            sensed = np.any(self.s != 0, axis=1)
             stick = self.active & ~self.slip
             scale = comm.allreduce(float(np.abs(self.lam).max(initial=0.0)), op=MPI.MAX)
             opening = self.active & (self.lam < 0)
             closing = ~self.active & (g < -tol_u)
-            sliding = stick & (np.abs(self.lam_t) > self.f * self.lam * (1 + 1e-9)
-                               + 1e-12 * scale)
-            holding = self.active & self.slip & rubs & (dg * self.s > tol_u)
-            landed = self.active & self.slip & rubs & (self.s == 0)  # no sense yet
-            sensing = landed & (np.abs(dg) > tol_u)
+            sliding = stick & (size > self.f * self.lam * (1 + 1e-9) + 1e-12 * scale)
+            slipping = self.active & self.slip & rubs
+            holding = slipping & (np.einsum("ij,ij->i", dg, self.s) > tol_u)
+            landed = slipping & ~sensed  # no sense yet
+            sensing = landed & (slid > tol_u)
             resting = landed & ~sensing  # it has not slipped since it landed: it sticks
-            drift = comm.allreduce(float(np.abs((self.lam - lam_n)[self.slip]).max(
-                initial=0.0)), op=MPI.MAX)
+            s = self.s.copy()
+            s[sliding] = self.lam_t[sliding] / size[sliding, None]
+            s[sensing] = -dg[sensing] / slid[sensing, None]  # friction against the slip
+            kept = slipping & sensed & ~holding & (size > 1e-12 * scale)
+            spring = self._springs(s, kept, dg)
+            # the friction forces the solve had (λ_n s of the last iteration) and those of
+            # its answer: their drift
+            drift = comm.allreduce(float(np.abs(
+                (self.lam[:, None] * s - lam_n[:, None] * self.s)[slipping]).max(initial=0.0)),
+                op=MPI.MAX)
             changes = comm.allreduce(int((opening | closing | sliding | holding | landed
                                           ).sum()))
             history.append({"iteration": k, "active": comm.allreduce(int(self.active.sum())),
                             "slip": comm.allreduce(int((self.active & self.slip).sum())),
-                            "changes": changes})
+                            "changes": changes, "drift": drift})
             if changes == 0 and drift <= 1e-9 * max(scale, 1e-300):
+                self._held()
                 self.history = history
                 return SolveResult(True, "converged", its, [], work, time.perf_counter() - t0,
                                    active_set_iterations=k, history=history)
-            self.s = np.where(sliding, np.sign(self.lam_t), self.s)
-            self.s = np.where(sensing, -np.sign(dg), self.s)  # friction against the slip
-            self.s = np.where(closing, 0.0, self.s)
+            self.s = np.where(closing[:, None], 0.0, s)
             # a node that lands sticks, if it does, where it landed (not where it was at
             # the step's start, when it was open)
-            self.committed = np.where(closing, self.pair.tangential(self.u), self.committed)
+            self.committed = np.where(closing[:, None], self.pair.tangential(self.u),
+                                      self.committed)
             self.slip = (self.slip & ~holding & ~resting | sliding | closing) & ~opening
             self.active = (self.active & ~opening) | closing
+            self.spring = np.where(self.active & self.slip, spring, 0.0)
             key = self.pair.keys(self.active) + self.pair.keys(self.active & self.slip) + \
-                tuple(np.concatenate(comm.allgather(self.s[self.active])))
+                tuple(np.concatenate(comm.allgather(self.s[self.active].ravel())))
             if key in seen and changes:
                 raise SolveError(f"the frictional statuses cycle (iteration {k})")
             seen.add(key)
@@ -881,76 +992,160 @@ class FrictionalPair(PairContact):
         raise SolveError(f"the frictional statuses did not settle in {self.max_iterations} "
                          "iterations")
 
+    def _springs(self, s: np.ndarray, kept: np.ndarray, dg: np.ndarray) -> np.ndarray:
+        """3D: each slipping node's spring against slip across s (0 in 2D).
+
+        The nodes `kept` turned to their tangential force (`s` updated in place), and
+        each one's spring k = f λ_n/(−Δg_t·s). A node that barely slides (below 1e-6 of
+        the largest slip) gets no spring: k = f λ_n/slip would amplify round-off in u into
+        the residual.
+        """
+        spring = np.zeros(len(s))
+        if s.shape[1] == 1:  # 2D: the direction is a sense, kept until the node sticks
+            return spring
+        s[kept] = self.lam_t[kept] / np.linalg.norm(self.lam_t[kept], axis=1)[:, None]
+        along = -np.einsum("ij,ij->i", dg, s)
+        floor = 1e-6 * self.pair.comm.allreduce(float(np.where(kept, along, 0.0).max(
+            initial=0.0)), op=MPI.MAX)
+        moving = kept & (along > max(1e-12 * self.pair.length, floor))
+        spring[moving] = self.f[moving] * self.lam[moving] / along[moving]
+        return spring
+
+    def _across(self) -> np.ndarray:
+        """s⊥ = n × s in the tangent basis, (−s_2, s_1) (3D)."""
+        return np.c_[-self.s[:, 1], self.s[:, 0]]
+
     def _rows(self) -> np.ndarray:
-        """Every row's force (every rank's): the normal ones, then the tangential ones."""
+        """Every row's force (every rank's): the normal ones, then each tangent's."""
         comm = self.pair.comm
-        return np.concatenate([every_rank(comm, self.lam), every_rank(comm, self.lam_t)])
+        return np.concatenate([every_rank(comm, self.lam),
+                               *(every_rank(comm, t) for t in self.lam_t.T)])
 
     def _set_rows(self, forces: np.ndarray) -> None:
         n, start, local = self.condensed.n, self.condensed.start, len(self.lam)
         self.lam[:] = forces[start:start + local]
-        self.lam_t[:] = forces[n + start:n + start + local]
+        for k in range(self.lam_t.shape[1]):
+            first = (k + 1) * n + start
+            self.lam_t[:, k] = forces[first:first + local]
 
     def _contact_forces(self) -> PETSc.Vec:
-        """Bᵀλ_n + B_tᵀλ_t."""
+        """Bᵀλ_n + Σ_k B_t,kᵀλ_t,k."""
         out = super()._contact_forces()
-        tangential = self.pair.Bt.createVecRight()
-        self.pair.Bt.multTranspose(_vec(self.pair.Bt, self.lam_t), tangential)
-        out.axpy(1.0, tangential)
+        for Bt, lam in zip(self.pair.Bt, self.lam_t.T, strict=True):
+            tangential = Bt.createVecRight()
+            Bt.multTranspose(_vec(Bt, lam), tangential)
+            out.axpy(1.0, tangential)
         return out
 
     def _condensed_statuses(self, lam_n: np.ndarray, work: WorkCounts) -> bool:
-        """The statuses' equilibrium on the kept factorization (False: it cannot be)."""
-        comm, n = self.pair.comm, self.condensed.n
+        """The statuses' equilibrium on the kept factorization (False: it cannot be).
+
+        The rows: the normals, then each tangent's. 3D: a slipping node's two tangential
+        rows turned to (along s, across s) (the frame Q, `CondensedSaddle.solve`): its
+        force along s is known, f λ_n, and across s the spring's, compliance 1/k.
+        """
+        comm, n, m = self.pair.comm, self.condensed.n, self.lam_t.shape[1]
         closed = every_rank(comm, self.active)
         slipping = closed & every_rank(comm, self.slip)
-        unknown = np.concatenate([np.flatnonzero(closed),
-                                  n + np.flatnonzero(closed & ~slipping)])
-        known = np.zeros(2 * n)
-        known[n:][slipping] = every_rank(comm, self.f * lam_n * self.s)[slipping]
+        stuck = np.flatnonzero(closed & ~slipping)
+        s = np.vstack(comm.allgather(self.s))
+        force = every_rank(comm, self.f * lam_n)
+        known = np.zeros((m + 1) * n)
+        frame, compliance = None, None
+        unknown = [np.flatnonzero(closed), *(k * n + stuck for k in range(1, m + 1))]
+        if m == 1:
+            known[n:][slipping] = (force * s[:, 0])[slipping]
+        else:
+            turned = np.flatnonzero(slipping & np.any(s != 0, axis=1))
+            frame = _turned_rows(n, turned, s[turned])
+            known[n + turned] = force[turned]
+            spring = every_rank(comm, self.spring)
+            sprung = turned[spring[turned] > 0]
+            unknown.append(2 * n + sprung)
+            compliance = np.zeros((m + 1) * n)
+            compliance[2 * n + sprung] = 1.0 / spring[sprung]
 
         def conditions():  # the gaps, and the slips since the last committed state
-            return np.concatenate([every_rank(comm, self.pair.gaps(self.u)), every_rank(
-                comm, self.pair.tangential(self.u) - self.committed)])
+            dg = self.pair.tangential(self.u) - self.committed
+            rows = np.concatenate([every_rank(comm, self.pair.gaps(self.u)),
+                                   *(every_rank(comm, d) for d in dg.T)])
+            if frame is None:
+                return rows
+            return frame.T @ rows + compliance * (frame.T @ self._rows())
 
-        return self._condensed(unknown, known, conditions, work)
+        return self._condensed(np.concatenate(unknown), known, conditions, work,
+                               compliance, frame)
 
     def _equilibrium(self, lam_n: np.ndarray, work: WorkCounts) -> int:
         """One solve for the current statuses; the slip forces from `lam_n`."""
         if self.condensed is not None and self._condensed_statuses(lam_n, work):
             return 1
-        pair = self.pair
+        pair, m = self.pair, self.lam_t.shape[1]
+        t = pair.tangents
         stick = np.flatnonzero(self.active & ~self.slip)
         closed = np.flatnonzero(self.active)
         sliding = np.flatnonzero(self.active & self.slip)
-        B = _stacked(pair.rows(closed), pair.rows(stick, tangential=True))
-        offset = np.concatenate([pair.gamma[closed], -self.committed[stick]])
+        sprung = np.flatnonzero(self.active & self.slip & (self.spring > 0))
+        across = self._across() if m > 1 else np.zeros((len(self.s), 0))
+        blocks = [pair.rows(closed), *(pair.rows(stick, t[stick, k]) for k in range(m))]
+        offset = [pair.gamma[closed], *(-self.committed[stick, k] for k in range(m))]
+        compliance = None
+        if m > 1 and pair.comm.allreduce(len(sprung)):  # 3D: the springs across s
+            blocks.append(pair.rows(sprung, np.einsum("nk,nkg->ng", across[sprung],
+                                                      t[sprung])))
+            offset.append(-np.einsum("ij,ij->i", across, self.committed)[sprung])
+            compliance = np.concatenate([np.zeros(len(closed) + m * len(stick)),
+                                         1.0 / self.spring[sprung]])
         forces = None
-        if self.pair.comm.allreduce(len(sliding)):
-            Bs = pair.rows(sliding, tangential=True)
+        if pair.comm.allreduce(len(sliding)):
+            Bs = pair.rows(sliding, np.einsum("nk,nkg->ng", self.s[sliding], t[sliding]))
             forces = Bs.createVecRight()
-            Bs.multTranspose(_vec(Bs, (self.f * lam_n * self.s)[sliding]), forces)
-        lam = self._saddle(B, offset, forces, work)[0]
+            Bs.multTranspose(_vec(Bs, (self.f * lam_n)[sliding]), forces)
+        lam = self._saddle(_stacked(blocks), np.concatenate(offset), forces, work,
+                           compliance)[0]
         self.lam[:] = 0.0
         self.lam_t[:] = 0.0
         self.lam[closed] = lam[: len(closed)]
-        self.lam_t[stick] = lam[len(closed):]
-        self.lam_t[sliding] = (self.f * lam_n * self.s)[sliding]
+        first = len(closed)
+        for k in range(m):
+            self.lam_t[stick, k] = lam[first:first + len(stick)]
+            first += len(stick)
+        self.lam_t[sliding] = (self.f * lam_n)[sliding, None] * self.s[sliding]
+        if compliance is not None:
+            self.lam_t[sprung] += lam[first:, None] * across[sprung]
         return self._iterations
 
 
-def _stacked(top: PETSc.Mat, bottom: PETSc.Mat) -> PETSc.Mat:
-    """The rows of `top` over those of `bottom` (each rank's, in that order)."""
-    n_top, n_bottom = top.getLocalSize()[0], bottom.getLocalSize()[0]
-    B = PETSc.Mat().createAIJ(((n_top + n_bottom, None), top.getSizes()[1]), nnz=(6, 6),
-                              comm=top.comm)
+def _turned_rows(n: int, nodes: np.ndarray, s: np.ndarray):
+    """Q: the rows [B; B_t1; B_t2] (3n) with each of `nodes`' tangential rows turned.
+
+    Its columns are the new rows in the old ones: node j's (along s, across s) =
+    (s_1 t1 + s_2 t2, −s_2 t1 + s_1 t2) at rows n + j, 2n + j; every other row kept.
+    Orthonormal: forces go to the new rows by Qᵀ, back by Q.
+    """
+    from scipy import sparse
+
+    keep = np.setdiff1d(np.arange(3 * n), np.r_[n + nodes, 2 * n + nodes])
+    a, b = n + nodes, 2 * n + nodes
+    rows = np.concatenate([keep, a, b, a, b])
+    cols = np.concatenate([keep, a, a, b, b])
+    vals = np.concatenate([np.ones(len(keep)), s[:, 0], s[:, 1], -s[:, 1], s[:, 0]])
+    return sparse.csr_array((vals, (rows, cols)), shape=(3 * n, 3 * n))
+
+
+def _stacked(blocks: list[PETSc.Mat]) -> PETSc.Mat:
+    """The rows of each block, one block after the other (each rank's, in that order)."""
+    first = blocks[0]
+    n_rows = [M.getLocalSize()[0] for M in blocks]
+    B = PETSc.Mat().createAIJ(((sum(n_rows), None), first.getSizes()[1]), nnz=(12, 12),
+                              comm=first.comm)
     B.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
     start = B.getOwnershipRange()[0]
-    for offset, M in ((0, top), (n_top, bottom)):
-        first = M.getOwnershipRange()[0]
+    for offset, M in zip(np.cumsum([0, *n_rows[:-1]]), blocks, strict=True):
+        head = M.getOwnershipRange()[0]
         for i in range(M.getLocalSize()[0]):
-            cols, vals = M.getRow(first + i)
-            B.setValues(start + offset + i, cols, vals)
+            cols, vals = M.getRow(head + i)
+            B.setValues(start + int(offset) + i, cols, vals)
     B.assemble()
     return B
 

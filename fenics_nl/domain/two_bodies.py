@@ -81,6 +81,8 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
         block: the block's size in R1.
         fine: a/h near the origin.
         growth: the elements' growth per unit distance beyond 1.5 a.
+        half: the half y ≥ 0 (a tangential load along x keeps its symmetry) instead of
+            the quarter.
         both_sides: the half discs on both sides of the axis (plane strain under a
             tangential load: no ``upper_axis``, ``lower_axis``).
 
@@ -199,13 +201,14 @@ BALL_TAGS = ("upper_contact", "upper_top", "upper_symmetry_x", "upper_symmetry_y
 
 
 def ball_on_block(comm: MPI.Comm, R: float, a: float, *, block: float = 4.0,
-                  fine: float = 5.0, growth: float = 0.2) -> gmshio.MeshData:
-    """A ball on a block in 3D, the quarter x ≥ 0, y ≥ 0.
+                  fine: float = 5.0, growth: float = 0.2, half: bool = False
+                  ) -> gmshio.MeshData:
+    """A ball on a block in 3D, the quarter x ≥ 0, y ≥ 0 (or the half y ≥ 0).
 
     The lower half of the ball of radius R centred at (0, 0, R), on the block
-    [0, L]² × [−L, 0] (L = `block` R). They touch at the origin and share no node.
-    Tetrahedra of a/`fine` within 1.5 a of the origin, growing by `growth` per unit
-    distance.
+    [0, L]² × [−L, 0] (L = `block` R; half: [−L, L] × [0, L] × [−L, 0]). They touch at
+    the origin and share no node. Tetrahedra of a/`fine` within 1.5 a of the origin,
+    growing by `growth` per unit distance.
 
     Args:
         comm: the communicator.
@@ -214,6 +217,8 @@ def ball_on_block(comm: MPI.Comm, R: float, a: float, *, block: float = 4.0,
         block: the block's size in R.
         fine: a/h near the origin.
         growth: the elements' growth per unit distance beyond 1.5 a.
+        half: the half y ≥ 0 (a tangential load along x keeps its symmetry) instead of
+            the quarter.
 
     Returns:
         The mesh with its cell tags (``upper`` 1, ``lower`` 2) and facet tags
@@ -225,15 +230,18 @@ def ball_on_block(comm: MPI.Comm, R: float, a: float, *, block: float = 4.0,
     if comm.rank == 0:
         start_model("ball_on_block")
         occ = gmsh.model.occ
+        x0 = -1.0 if half else 0.0  # the boxes' lower x, in their sizes
         ball = occ.intersect([(3, occ.addSphere(0, 0, r, r))],
-                             [(3, occ.addBox(0, 0, 0, r, r, r))])[0]
-        lower = [(3, occ.addBox(0, 0, -L, L, L, L))]
+                             [(3, occ.addBox(x0 * r, 0, 0, (1 - x0) * r, r, r))])[0]
+        lower = [(3, occ.addBox(x0 * L, 0, -L, (1 - x0) * L, L, L))]
         occ.synchronize()
 
         def name_of(body, f):
             x, y, z = occ.getCenterOfMass(2, f)
-            if abs(x) < TOL or abs(y) < TOL:
-                return f"{body}_symmetry_{'x' if abs(x) < TOL else 'y'}"
+            if abs(y) < TOL:
+                return f"{body}_symmetry_y"
+            if abs(x) < TOL and not half:
+                return f"{body}_symmetry_x"
             if body == "upper":
                 return "upper_top" if gmsh.model.getType(2, f) == "Plane" else "upper_contact"
             return "lower_contact" if abs(z) < TOL else "lower_bottom" \
