@@ -865,13 +865,17 @@ def rewound(folder):
     return steps[-2]
 
 
-@pytest.mark.parametrize("case", ["contact", "frictional pair", "plane-stress j2"])
+@pytest.mark.parametrize("case", ["contact", "frictional pair", "worn pin", "plane-stress j2"])
 def test_a_restart_with_contact_or_a_mixed_unknown_is_the_same_path(tmp_path, demo, case):
     # the Hertz punch (the active set and its warm start), the ball on the block with
-    # friction (a pair's statuses, forces and committed slip) and the plane-stress J2 plate
-    # (a mixed unknown with ε_zz; adaptive steps grown by the driver) restarted a step short
+    # friction (a pair's statuses, forces and committed slip), the worn pin (a pair's wear:
+    # the depths, the gaps they opened, the worn volume and the sliding distance, in time)
+    # and the plane-stress J2 plate (a mixed unknown with ε_zz; adaptive steps grown by the
+    # driver) restarted a step short
     if case == "contact":
         path = CASES / "hertz_punch.toml"
+    elif case == "worn pin":
+        path = CASES / "worn_pin.toml"
     elif case == "frictional pair":
         write(tmp_path, "ball_on_block.geo", (CASES / "ball_on_block.geo").read_text())
         path = write(tmp_path, "ball.toml", (CASES / "ball_on_block.toml").read_text().replace(
@@ -883,11 +887,13 @@ def test_a_restart_with_contact_or_a_mixed_unknown_is_the_same_path(tmp_path, de
     assert rewound(tmp_path / "ck") == f"step-{len(whole['steps']) - 1:06d}"
     resumed = demo.case(path, "--restart", tmp_path / "ck")
     same_answer(whole, resumed)
-    if case == "frictional pair":  # the pair's own record: its force, set and pressure
+    if case in ("frictional pair", "worn pin"):  # the pair's record: force, set, pressure
         a, b = whole["steps"][-1]["contact_pairs"][0], resumed["steps"][-1]["contact_pairs"][0]
         assert a["nodes_in_contact"] == b["nodes_in_contact"]
         assert b["force"] == pytest.approx(a["force"], rel=1e-10, abs=1e-16)
         assert b["max_pressure"] == pytest.approx(a["max_pressure"], rel=1e-10)
+        for key in {"wear_volume", "max_wear_depth", "sliding_distance"} & set(a):
+            assert b[key] == pytest.approx(a[key], rel=1e-12), key
 
 
 def test_a_case_file_in_the_old_spellings_reads_in_the_new_ones(tmp_path):

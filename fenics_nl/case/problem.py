@@ -21,7 +21,7 @@ from fenics_nl.case.damage import DamageSteps
 from fenics_nl.case.mesh import load_mesh
 from fenics_nl.case.spec import COMPONENTS, Case, CaseError, Condition
 from fenics_nl.contact.active_set import ActiveSetContact
-from fenics_nl.contact.pair import ContactPair, FrictionalPair, PairContact
+from fenics_nl.contact.pair import ArchardWear, ContactPair, FrictionalPair, PairContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
 from fenics_nl.io import output
@@ -580,19 +580,56 @@ class PairSteps:
         else:
             self.contact = PairContact(problem.residual, problem.unknown, problem.bcs, joined,
                                        **options)
+        wear = [p["wear"] for p in problem.case.pairs]
+        self.wear = ArchardWear(self.contact, wear) if any(wear) else None
+        # each pair's sliding speed (a pair that does not wear: any, its k is 0)
+        self.speed = np.array([p["speed"] or 1.0 for p in problem.case.pairs])
 
     def solve(self) -> SolveResult:
         """The pairs' contact at the current load factor, from the last statuses."""
         return self.contact.solve()
+
+    def slide(self, dt: float) -> SolveResult:
+        """The pairs' contact at the current load factor after sliding for `dt` (wear)."""
+        return self.wear.slide(self.speed * dt)
 
     def commit(self) -> None:
         """A converged step: the next step's slip is measured from here (friction)."""
         if isinstance(self.contact, FrictionalPair):
             self.contact.commit()
 
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """The pairs' statuses and forces, and their wear (a restart's)."""
+        out = self.contact.checkpoint_arrays()
+        if self.wear is not None:
+            out |= {f"wear.{k}": v for k, v in self.wear.checkpoint_arrays().items()}
+        return out
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The state of `checkpoint_arrays` back."""
+        self.contact.restore_arrays({k: v for k, v in arrays.items()
+                                     if not k.startswith("wear.")})
+        if self.wear is not None:
+            self.wear.restore_arrays({k[len("wear."):]: v for k, v in arrays.items()
+                                      if k.startswith("wear.")})
+
     def summaries(self) -> list[dict]:
-        """Each pair's force, nodes in contact, contact radius and largest pressure."""
+        """Each pair's force, nodes in contact, contact radius and largest pressure.
+
+        With wear also its worn volume, largest wear depth and sliding distance.
+        """
         axisymmetric = self.problem.model == "axisymmetric"
-        return [{"slave": p["slave"], "master": p["master"]}
-                | self.contact.summary(k, axisymmetric)
-                for k, p in enumerate(self.problem.case.pairs)]
+        out = [{"slave": p["slave"], "master": p["master"]}
+               | self.contact.summary(k, axisymmetric)
+               for k, p in enumerate(self.problem.case.pairs)]
+        if self.wear is not None:
+            w, part, comm = self.wear, self.contact.pair.part, self.contact.pair.comm
+            volumes = w.volumes()
+            distance = np.broadcast_to(w.distance, (len(out),))
+            for k, (record, p) in enumerate(zip(out, self.problem.case.pairs, strict=True)):
+                if p["wear"]:
+                    record |= {"wear_volume": float(volumes[k]),
+                               "max_wear_depth": comm.allreduce(float(w.depth[
+                                   part == k].max(initial=0.0)), op=MPI.MAX),
+                               "sliding_distance": float(distance[k])}
+        return out

@@ -25,7 +25,9 @@ def case_checkpoints(problem, folder: str, every: int = 1) -> PathCheckpoints:
     if problem.material.path_dependent:
         functions.update(problem.material.state_functions())
     solver = problem.solver
-    contact = solver.contact if problem.contact is not None or problem.case.pairs else None
+    # the rigid obstacle's active set, or the pairs' (their statuses and wear)
+    contact = solver.contact if problem.contact is not None else solver if \
+        problem.case.pairs else None
     newton = contact.newton if problem.contact is not None else solver
     return PathCheckpoints(folder, identity, functions, every=every, contact=contact,
                            newton=newton if hasattr(newton, "force_reference") else None)

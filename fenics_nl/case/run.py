@@ -13,12 +13,13 @@ from fenics_nl.case.damage import cell_sizes
 from fenics_nl.case.problem import CaseProblem
 from fenics_nl.case.resume import case_checkpoints
 from fenics_nl.case.spec import COMPONENTS, arc_length_obstacles
+from fenics_nl.errors import SolveError
 from fenics_nl.io import cli
 from fenics_nl.io.cli import say
 from fenics_nl.io.restart import PathCheckpoints, Resumed
 from fenics_nl.parallel import global_max
 from fenics_nl.solvers.arclength import ArcLength, ArcState
-from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
+from fenics_nl.solvers.loading import DriverState, LoadStepError, solve_incrementally
 from fenics_nl.solvers.result import WorkCounts
 from fenics_nl.solvers.time_stepping import LoadHistory, solve_in_time
 
@@ -110,7 +111,9 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
             say("  " + message)
 
     critical, ended_by, in_time = None, None, None
-    if case.time is not None:  # a rate-dependent law: time is the load parameter
+    if case.time is not None and getattr(solver, "wear", None) is not None:
+        _wear_in_time(problem, solver, converged, steps, work, saving, start)
+    elif case.time is not None:  # a rate-dependent law: time is the load parameter
         axis = case.time
         in_time = solve_in_time(
             solver, problem.material, problem.set_load, LoadHistory(axis["factor"]),
@@ -166,6 +169,8 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
            "factorizations": work.factorizations, "tangent_assemblies": work.tangent_assemblies,
            "probes": last["probes"], "reactions": last["reactions"],
            "warnings": warnings(problem)}
+    if case.time is not None and in_time is None:  # a pair's wear, in equal steps
+        out |= {"time": last["time"], "time_steps": len(steps)}
     if in_time is not None:
         out |= {"time": last["time"], "time_steps": len(in_time.times),
                 "time_steps_undone": in_time.rejected,
@@ -187,6 +192,49 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     if problem.case.pairs:
         out["contact_pairs"] = last["contact_pairs"]
     return out
+
+
+def _wear_in_time(problem: CaseProblem, solver, converged, steps: list[dict],
+                  work: WorkCounts, saving: PathCheckpoints | None, start) -> None:
+    """A pair's wear in time: equal steps, each slides the pairs by speed · Δt.
+
+    The load factor follows [loading] factor against time; the load at time 0, if any, is
+    applied first without sliding (recorded at time 0). Each step's wear is that of its
+    end pressure (`ArchardWear.slide`: backward Euler, stable at any step). A checkpoint
+    after each step; a restart goes on from its time (`start.t`). The steps' work is
+    added to `work` (the run's so far).
+    """
+    axis = problem.case.time
+    history, end, n = LoadHistory(axis["factor"]), axis["end"], axis["steps"]
+    dt = end / n
+
+    def step(t, result):
+        work.add(result.work)
+        solver.commit()
+        converged(history(t), result, time=t)
+        if saving is not None:
+            saving.save(0, DriverState(t, dt), steps, work)
+
+    def failed(t, err):
+        reached = steps[-1]["time"] if steps else 0.0
+        return LoadStepError(f"time {t:.6g} not reached: the last converged time is "
+                             f"{reached:.6g} ({len(steps)} converged steps): {err}",
+                             getattr(err, "result", None), reached=reached, target=t)
+
+    done = 0 if start is None else round(start.t / dt)
+    if start is None and history(0.0) != 0:  # the load at once, before any sliding
+        problem.set_load(history(0.0))
+        try:
+            step(0.0, solver.solve())
+        except SolveError as err:
+            raise failed(0.0, err) from err
+    for k in range(done + 1, n + 1):
+        t = end if k == n else k * dt
+        problem.set_load(history(t))
+        try:
+            step(t, solver.slide(dt))
+        except SolveError as err:
+            raise failed(t, err) from err
 
 
 def _not_reached(err: LoadStepError, asked: float, failed: float, steps: list[dict],

@@ -98,12 +98,17 @@ contact = { obstacle = "plane", point = [0.0, 1.0], normal = [0.0, 1.0] }
 # friction = 0.0         # sliding; optional Coulomb coefficient (default 0). One table per
 #                        # pair; the JSON reports each pair's force, nodes in contact,
 #                        # contact radius and largest pressure every step
+# wear = 1e-3            # optional (frictionless pairs): Archard's dh = k p ds on the slave,
+# speed = 0.1            # sliding at this speed (ds = speed dt) while [loading] runs in
+#                        # time = { end, steps } (equal steps; the load factor against time
+#                        # by factor, default: at once, then held); the JSON adds each
+#                        # pair's wear_volume, max_wear_depth and sliding_distance
 
 [loading]
 steps = 10               # equal steps to the load factor 1 (cut in half on failure), or a
                          # list of load factors to visit, e.g. [0.5, 1.0, 0.0]
 adaptive = true          # optional: false stops at the first failed step instead of cutting it
-# or, for a rate-dependent law (norton, perzyna), time as the load parameter:
+# or, for a rate-dependent law (norton, perzyna) or a pair's wear, time as the load parameter:
 # time = { end = 200.0, steps = 40, adaptive = true }   # the first step end/steps (or less,
 #                        # to land on factor's first point after 0); adaptive: each step's
 #                        # local error (3 mu dt/2 times the change of the viscous strain
@@ -207,11 +212,17 @@ KEYS = [
     ("contact", "master", "[[contact]]: the facet group of the other body", "required", "—"),
     ("contact", "friction", "[[contact]]: Coulomb's coefficient f (stick and slip, as on a "
      "rigid obstacle)", "0", "—"),
+    ("contact", "wear", "[[contact]]: Archard's wear coefficient k (over the hardness): the "
+     "slave's surface wears by dh = k p ds as it slides over the master (frictionless "
+     "pairs; [loading] in time)", "0", "length²/force"),
+    ("contact", "speed", "[[contact]] with wear: the sliding speed, ds = speed dt (the "
+     "track's distance, not a motion of the mesh)", "required there", "length/time"),
     ("loading", "steps", "load control: n equal steps to the load factor 1, or a list of "
      "load factors to visit", "required there", "—"),
     ("loading", "adaptive", "a failed step is cut in half (false: the run stops)", "true",
      "—"),
-    ("loading", "time", "norton, perzyna (and only they): the time axis `{ end, steps, "
+    ("loading", "time", "norton, perzyna, and pairs with wear (equal steps): the time axis "
+     "`{ end, steps, "
      "adaptive, tolerance, stationary }`: the last time; the first step end/`steps` (20), "
      "or less to land on the first point of `factor`; `adaptive` (true) sizes the steps by "
      "their local error, at most `tolerance` (1e-3: 3μ Δt/2 times the change of the "
@@ -509,7 +520,8 @@ def read_case(path: str | Path) -> Case:
         r.fail("material.nu", '0.5 (incompressible) needs mesh.formulation = "mixed"')
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
-    time_axis = _time_axis(r, data, law)
+    pairs = _pairs(r, data)
+    time_axis = _time_axis(r, data, law, any(p["wear"] for p in pairs))
     if law == "norton" and formulation != "mixed" and model not in (None, "plane_stress"):
         r.fail("mesh.formulation", 'norton needs "mixed": its flow is incompressible and '
                                    "grows without bound, and P2 displacements alone lock "
@@ -535,7 +547,6 @@ def read_case(path: str | Path) -> Case:
             r.fail(key, message)
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
-    pairs = _pairs(r, data)
     if pairs:
         _pair_limits(r, pairs, model, degree, formulation, law, newton, linear, conditions,
                      arc)
@@ -583,23 +594,29 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
     out = []
     for i, t in enumerate(tables, start=1):
         where = f"contact[{i}]"
-        if "wear" in t:  # said, not taken
-            r.fail(f"{where}.wear", "not built yet for case files: Archard's wear needs a "
-                                    "sliding distance that grows while the load is held, "
-                                    "which a case has no axis for (contact.pair."
-                                    "ArchardWear.slide in a script)")
-        r.unknown({k: v for k, v in t.items() if k != "wear"}, where,
-                  ("slave", "master", "friction"))
+        r.unknown(t, where, ("slave", "master", "friction", "wear", "speed"))
         slave = r.get(t, "slave", where, str, required=True)
         master = r.get(t, "master", where, str, required=True)
         f = r.get(t, "friction", where, float, default=0.0, minimum=0.0)
+        wear = r.get(t, "wear", where, float, default=0.0, minimum=0.0)
+        speed = r.get(t, "speed", where, float, default=None, positive=True)
+        if wear and speed is None:
+            r.fail(f"{where}.speed", "missing: wear = k slides the slave over the master at "
+                                     "this speed (distance per unit time: Archard's "
+                                     "ds = speed dt)")
+        if speed is not None and not wear:
+            r.fail(f"{where}.speed", "only with wear = k (the sliding that wears)")
+        if wear and f:
+            r.fail(f"{where}.wear", "with friction: not built (the wear's compliance is in "
+                                    "the frictionless loop); friction = 0 here")
         if slave is not None and slave == master:
             r.fail(f"{where}.master", f"{master!r} is the slave group too: a pair is two "
                                       "surfaces")
         if any((p["slave"], p["master"]) == (slave, master) for p in out):
             r.fail(where, f"the pair {slave!r} on {master!r} is given twice")
         elif slave is not None and master is not None and f is not None:
-            out.append({"slave": slave, "master": master, "friction": f, "key": where})
+            out.append({"slave": slave, "master": master, "friction": f, "key": where,
+                        "wear": wear or 0.0, "speed": speed})
     return out
 
 
@@ -901,8 +918,12 @@ def _arc_length(r: _Reader, t: dict) -> dict | None:
 TIME_KEYS = ("end", "steps", "adaptive", "tolerance", "stationary")
 
 
-def _time_axis(r: _Reader, data: dict, law: str | None) -> dict | None:
-    """`loading.time` and `loading.factor`: a viscous law's time axis (None: none given)."""
+def _time_axis(r: _Reader, data: dict, law: str | None, wearing: bool = False
+               ) -> dict | None:
+    """`loading.time` and `loading.factor`: a viscous law's or a pair's wear's time axis.
+
+    None: none given.
+    """
     t = data.get("loading", {})
     table = t.get("time") if isinstance(t, dict) else None
     viscous = law in VISCOUS
@@ -910,8 +931,20 @@ def _time_axis(r: _Reader, data: dict, law: str | None) -> dict | None:
         if viscous:
             r.fail("loading.time", f"missing: {law} is rate-dependent, its load path is in "
                                    "time, e.g. time = { end = 100.0, steps = 20 }")
+        if wearing:
+            r.fail("loading.time", "missing: a pair's wear slides in time (ds = speed dt), "
+                                   "e.g. time = { end = 10.0, steps = 20 }")
         return None
-    if law is not None and not viscous:
+    if wearing and isinstance(table, dict):
+        for k in ("adaptive", "tolerance", "stationary"):
+            if k in table:
+                r.fail(f"loading.time.{k}", "not with wear: its steps are equal (backward "
+                                            "Euler in the sliding distance, stable at any "
+                                            "step)")
+        table = {k: v for k, v in table.items() if k not in ("adaptive", "tolerance",
+                                                             "stationary")}
+        table["adaptive"] = False
+    elif law is not None and not viscous:
         r.fail("loading.time", f"only with a rate-dependent law ({', '.join(VISCOUS)}): "
                                f"{law} has no time; give steps")
     where = "loading.time"

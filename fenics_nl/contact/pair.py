@@ -1171,31 +1171,38 @@ class ArchardWear:
 
     Args:
         contact: the pair's active set (`PairContact`), its slave surface the worn one.
-        k: the wear coefficient (volume per unit force and sliding distance).
+        k: the wear coefficient (volume per unit force and sliding distance), or one per
+            pair (`ContactPair.part`; 0: a pair that does not wear).
     """
 
-    def __init__(self, contact: PairContact, k: float):
-        if not k > 0:
+    def __init__(self, contact: PairContact, k):
+        k = np.asarray(k, dtype=float)
+        if not (np.all(np.isfinite(k)) and np.all(k >= 0) and np.any(k > 0)):
             raise ValueError(f"the wear coefficient must be > 0, got {k}")
-        self.contact, self.k = contact, k
+        if isinstance(contact, FrictionalPair):
+            raise ValueError("wear on a pair with friction is not built (the wear's "
+                             "compliance is in the frictionless loop)")
+        self.contact = contact
+        self.k = k[contact.pair.part] if k.ndim else k
         self.depth = np.zeros(len(contact.pair.slave))  # each owned slave node's wear
         self.volume = 0.0  # the worn volume so far (every rank's)
         self.distance = 0.0
 
-    def slide(self, ds: float) -> SolveResult:
+    def slide(self, ds) -> SolveResult:
         """The contact and the wear of a sliding distance `ds` (the step's end pressure).
 
         Args:
-            ds: the sliding distance of the step.
+            ds: the sliding distance of the step, or one per pair (`ContactPair.part`).
 
         Returns:
             The contact solve's result.
         """
-        if not (np.isfinite(ds) and ds > 0):
+        ds = np.asarray(ds, dtype=float)
+        if not (np.all(np.isfinite(ds)) and np.all(ds > 0)):
             raise ValueError(f"the sliding distance of a step must be > 0, got {ds}")
         contact, pair = self.contact, self.contact.pair
         areas = np.where(pair.areas > 0, pair.areas, np.inf)  # a node of no area: no wear
-        contact.compliance = self.k * ds / areas
+        contact.compliance = self.k * (ds[pair.part] if ds.ndim else ds) / areas
         try:
             result = contact.solve()
         finally:
@@ -1204,5 +1211,26 @@ class ArchardWear:
         self.depth += dh
         pair.open(dh)  # the worn slave surface moves away from the master
         self.volume += pair.total(dh * pair.areas)
-        self.distance += ds
+        self.distance = self.distance + ds  # (one per pair if ds is)
         return result
+
+    def volumes(self) -> np.ndarray:
+        """The worn volume of each pair (`ContactPair.part`; every rank's)."""
+        pair = self.contact.pair
+        parts = pair.comm.allreduce(int(pair.part.max(initial=0)), op=MPI.MAX) + 1
+        return np.array([pair.total((self.depth * pair.areas)[pair.part == k])
+                         for k in range(parts)])
+
+    def checkpoint_arrays(self) -> dict[str, np.ndarray]:
+        """The wear so far: each owned slave node's depth, the volume and the distance."""
+        return {"depth": self.depth.copy(), "volume": np.array([self.volume]),
+                "distance": np.atleast_1d(self.distance).astype(float)}
+
+    def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
+        """The wear of `checkpoint_arrays` back, the slave surface worn by it again."""
+        pair = self.contact.pair
+        pair.open(arrays["depth"] - self.depth)
+        self.depth = arrays["depth"].copy()
+        self.volume = float(arrays["volume"][0])
+        distance = arrays["distance"].copy()
+        self.distance = distance if np.ndim(self.distance) else float(distance[0])
