@@ -809,10 +809,13 @@ def test_friction_in_3d_on_one_factorization_is_the_saddle_points_answer():
 
 
 @pytest.mark.mpi
-def test_friction_in_3d_on_two_ranks_gives_the_serial_answer():
+@pytest.mark.parametrize("linear", [False, True], ids=["saddle point", "one factorization"])
+def test_friction_in_3d_on_two_ranks_gives_the_serial_answer(linear):
+    # the springs' rows (saddle point) and the turned rows (one factorization): the serial
+    # statuses and forces
     assert MPI.COMM_WORLD.size > 1
-    parallel = ball_pulled(4.0, shifts=(0.002,))[0]
-    serial = ball_pulled(4.0, comm=MPI.COMM_SELF, shifts=(0.002,))[0]
+    parallel = ball_pulled(4.0, linear=linear, shifts=(0.002,))[0]
+    serial = ball_pulled(4.0, comm=MPI.COMM_SELF, linear=linear, shifts=(0.002,))[0]
     for a, b in zip(parallel, serial, strict=True):
         assert (a["stuck"], a["slipping"]) == (b["stuck"], b["slipping"])
         for key in ("Q", "P", "lam", "lam_t"):

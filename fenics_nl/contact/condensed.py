@@ -193,13 +193,14 @@ class CondensedSaddle:
         loaded = np.flatnonzero(before)
         rows = np.union1d(np.union1d(unknown, np.flatnonzero(known)), loaded)
         self.columns(rows if frame is None else _support(frame, rows), work)
-        diagonal = np.diag(self.flexibility(unknown, unknown, frame)) if len(unknown) else []
-        free = np.asarray(unknown, dtype=int)[np.abs(diagonal) > 0]
-        if len(free):  # a row on held dofs only (S_kk = 0) takes no force
+        unknown = np.asarray(unknown, dtype=int)
+        S = self.flexibility(unknown, unknown, frame)
+        keep = np.abs(np.diag(S)) > 0  # a row on held dofs only (S_kk = 0) takes no force
+        free, S = unknown[keep], S[np.ix_(keep, keep)]
+        if len(free):
             rhs = -residual[free] + self.flexibility(free, loaded, frame) @ before[loaded]
             given = np.flatnonzero(known)
             rhs -= self.flexibility(free, given, frame) @ known[given]
-            S = self.flexibility(free, free, frame)
             if compliance is not None:  # c (λ_new − λ_before) joins the residual's c λ_before
                 c = np.zeros(len(before))
                 c[:len(compliance)] = compliance

@@ -56,7 +56,9 @@ class ContactPair:
 
     2D: node to segment (plane strain, plane stress, axisymmetric); 3D: node to triangle.
     Each slave node has its master's normal n and a tangent basis (2D: t = (−n_y, n_x);
-    3D: t1 the coordinate axis farthest from n made orthogonal to it, t2 = n × t1).
+    3D: t1 the coordinate axis farthest from n made orthogonal to it, t2 = n × t1;
+    `FrictionalPair` takes an axis its supports hold as t1 instead, not quite orthogonal
+    to a facet's tilted normal: its row binds held dofs only).
 
     Args:
         V: the displacement space (vector, P1; 2D: plane strain, plane stress or
@@ -445,9 +447,10 @@ class PairContact:
         # a compliance in the gap of each owned slave node (g + c λ = 0 where active):
         # the wear of a step (`ArchardWear`); None: none
         self.compliance: np.ndarray | None = None
-        # the motions K's supports leave free (a linear K's factorization counts them)
-        # and the last solve's force scale (its first residual's, or `force_scale`)
-        self.free_motions, self._load = 0, 0.0
+        # the motions K's supports leave free (None: not counted yet; a linear K's
+        # factorization counts them) and the last solve's force scale (its first
+        # residual's, or `force_scale`)
+        self.free_motions, self._load = None, 0.0
 
     def solve(self) -> SolveResult:
         """The active-set loop from the current set (warm start) to a set that repeats.
@@ -502,11 +505,17 @@ class PairContact:
         Raises:
             SupportError: the supports and the contact in force leave a motion free.
         """
-        if not self.free_motions:
-            return
+        # (K's null pivots are counted only then: one factorization, in that case only)
         carried = self.pair.comm.allreduce(float(np.abs(self.lam).max(initial=0.0)),
                                            op=MPI.MAX)
-        if carried <= 1e-9 * self._load:
+        if carried > 1e-9 * self._load:
+            return
+        if self.free_motions is None:  # not known yet (no K factorized alone): count them
+            K = petsc.assemble_matrix(self.J, self.bcs)
+            K.assemble()
+            self.free_motions = factorized_counting_null_pivots(create_ksp(K, "lu",
+                                                                           prefix=PREFIX))
+        if self.free_motions:
             raise SupportError(f"contact pair: {self.free_motions} motion(s) free: a body "
                                "that neither its supports nor the contact in force hold "
                                f"(the contact carries {carried:.1e}, the load "
@@ -664,6 +673,7 @@ class PairContact:
                 raise SolveError(f"the condensed solve left |R| = {norm:.2e} and conditions "
                                  f"{left:.2e} (K singular, a body held by the contact "
                                  "alone; or a residual not linear in u)")
+            self.free_motions, self._load = c.free_motions, reference
             return True
         except (SolveError, np.linalg.LinAlgError, PETSc.Error) as err:
             self.u.x.array[:] = saved[0]
@@ -829,11 +839,11 @@ class FrictionalPair(PairContact):
     f λ_n slips, s = λ_t/|λ_t|; a slipping node whose slip goes along its friction force
     (Δg_t·s > 0) sticks.
 
-    3D: the direction of a slipping node is found by Newton's method as on a rigid
-    obstacle: the node carries f λ_n s and a spring k = f λ_n/(−Δg_t·s) against slip across
-    s (a multiplier μ on the row s⊥·Δg_t with the compliance 1/k: the linearization of
-    −f λ_n Δg_t/|Δg_t|); s then turns to the node's whole tangential force, f λ_n s + μ s⊥,
-    and at the fixed point μ = 0, the slip along −s.
+    3D: the direction of a slipping node is found by iteration as on a rigid obstacle: the
+    node carries f λ_n s and a spring k = f λ_n/|Δg_t| against slip across s (a multiplier
+    μ on the row s⊥·Δg_t with the compliance 1/k: the linearization of −f λ_n Δg_t/|Δg_t|
+    at the fixed point); s then turns to the node's whole tangential force,
+    f λ_n s + μ s⊥, and at the fixed point μ = 0, the slip along −s.
 
     The loop ends when no status changes and the friction forces agree with the normal
     forces and directions of the same solve (to 1e-9 of the largest normal force).
@@ -884,8 +894,13 @@ class FrictionalPair(PairContact):
         singular saddle point.
         """
         pair = self.pair
-        held = np.concatenate(pair.comm.allgather(self.held.indices.astype(np.int64)))
         bs, g = pair.bs, pair.gdim
+        # the held dofs of the pairs' nodes (every rank's; not the whole model's)
+        nodes = np.unique(np.concatenate(pair.comm.allgather(np.concatenate(
+            [pair.slave_global, pair.master_nodes.ravel()]))))
+        candidates = (bs * nodes[:, None] + np.arange(g)).ravel()
+        mine = self.held.indices.astype(np.int64)
+        held = np.concatenate(pair.comm.allgather(mine[np.isin(mine, candidates)]))
         touching = pair.weights > 1e-14  # the master nodes the slave node's rows bind
         axes = np.zeros((len(pair.slave), g), dtype=bool)
         for k in range(g):
@@ -921,7 +936,7 @@ class FrictionalPair(PairContact):
         m = self.pair.gdim - 1
         self.s = arrays["s"].reshape(-1, m).copy()
         self.lam_t = arrays["lam_t"].reshape(-1, m).copy()
-        self.spring = arrays["spring"].copy()
+        self.spring = arrays.get("spring", np.zeros(len(self.lam))).copy()
         self.committed = arrays["committed"].reshape(-1, m).copy()
 
     def solve(self) -> SolveResult:
@@ -983,8 +998,9 @@ class FrictionalPair(PairContact):
             self.slip = (self.slip & ~holding & ~resting | sliding | closing) & ~opening
             self.active = (self.active & ~opening) | closing
             self.spring = np.where(self.active & self.slip, spring, 0.0)
+            # (3D directions compared to 1e-9: a cycle of directions repeats them only so)
             key = self.pair.keys(self.active) + self.pair.keys(self.active & self.slip) + \
-                tuple(np.concatenate(comm.allgather(self.s[self.active].ravel())))
+                tuple(np.concatenate(comm.allgather(np.round(self.s[self.active], 9).ravel())))
             if key in seen and changes:
                 raise SolveError(f"the frictional statuses cycle (iteration {k})")
             seen.add(key)
@@ -996,19 +1012,21 @@ class FrictionalPair(PairContact):
         """3D: each slipping node's spring against slip across s (0 in 2D).
 
         The nodes `kept` turned to their tangential force (`s` updated in place), and
-        each one's spring k = f λ_n/(−Δg_t·s). A node that barely slides (below 1e-6 of
-        the largest slip) gets no spring: k = f λ_n/slip would amplify round-off in u into
-        the residual.
+        each one's spring k = f λ_n/|Δg_t| (the linearization of −f λ_n Δg_t/|Δg_t| across
+        the slip at the fixed point, where −Δg_t·s = |Δg_t|; a slip that has turned away
+        from −s still gets its spring, which turns it back). A node that barely slides
+        (below 1e-6 of the largest slip) gets no spring: k = f λ_n/slip would amplify
+        round-off in u into the residual.
         """
         spring = np.zeros(len(s))
         if s.shape[1] == 1:  # 2D: the direction is a sense, kept until the node sticks
             return spring
         s[kept] = self.lam_t[kept] / np.linalg.norm(self.lam_t[kept], axis=1)[:, None]
-        along = -np.einsum("ij,ij->i", dg, s)
-        floor = 1e-6 * self.pair.comm.allreduce(float(np.where(kept, along, 0.0).max(
+        slid = np.linalg.norm(dg, axis=1)
+        floor = 1e-6 * self.pair.comm.allreduce(float(np.where(kept, slid, 0.0).max(
             initial=0.0)), op=MPI.MAX)
-        moving = kept & (along > max(1e-12 * self.pair.length, floor))
-        spring[moving] = self.f[moving] * self.lam[moving] / along[moving]
+        moving = kept & (slid > max(1e-12 * self.pair.length, floor))
+        spring[moving] = self.f[moving] * self.lam[moving] / slid[moving]
         return spring
 
     def _across(self) -> np.ndarray:

@@ -81,8 +81,6 @@ def sphere_on_body(comm: MPI.Comm, R1: float, a: float, *, R2: float | None = No
         block: the block's size in R1.
         fine: a/h near the origin.
         growth: the elements' growth per unit distance beyond 1.5 a.
-        half: the half y ≥ 0 (a tangential load along x keeps its symmetry) instead of
-            the quarter.
         both_sides: the half discs on both sides of the axis (plane strain under a
             tangential load: no ``upper_axis``, ``lower_axis``).
 
