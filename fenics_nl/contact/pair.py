@@ -389,6 +389,10 @@ def _nodal_areas(V, facets, weight) -> np.ndarray:
     return out
 
 
+class _Unsettled(SolveError):
+    """A linear pair's loop whose u, moved at its end, fails Newton's check."""
+
+
 @dataclass
 class PairState:
     """The pair after a solve: each owned slave node's status, force λ and pressure."""
@@ -451,9 +455,19 @@ class PairContact:
         # factorization counts them) and the last solve's force scale (its first
         # residual's, or `force_scale`)
         self.free_motions, self._load = None, 0.0
+        # inside a linear pair's loop: every row's value (gaps, slips) and the forces' change
+        # u has not been moved by yet (`_begin`, `_settle`)
+        self._values: np.ndarray | None = None
+        self._moved: np.ndarray | None = None
+        self._reference = 0.0
 
     def solve(self) -> SolveResult:
         """The active-set loop from the current set (warm start) to a set that repeats.
+
+        With one factorization (`linear`) the loop moves the forces only, each iteration's
+        gaps read off S (`_begin`); u is moved once when the set has settled (`_settle`),
+        and checked: if it fails the check (a residual not linear in u), the loop is run
+        again from its start, each set a saddle point.
 
         Returns:
             The result, its iterations the Newton iterations summed, its
@@ -462,10 +476,24 @@ class PairContact:
         Raises:
             SolveError: the set did not settle within `max_iterations`.
         """
+        start = self.u.x.array.copy(), self.checkpoint_arrays()
+        try:
+            return self._loop()
+        except _Unsettled as err:
+            self.u.x.array[:] = start[0]
+            self.u.x.scatter_forward()
+            self.restore_arrays(start[1])
+            log.warning("contact pair: %s: each set is solved as a saddle point", err)
+            self.condensed = None
+            return self._loop()
+
+    def _loop(self) -> SolveResult:
+        """`solve`'s loop."""
         t0, work, its, history, seen = time.perf_counter(), WorkCounts(), 0, [], set()
         comm, length = self.pair.comm, self.pair.length
         if self.finite_sliding:
             self.pair.follow(self.u)
+        self._begin(work)
         for k in range(1, self.max_iterations + 1):
             its += self.equilibrium(self.active, work)
             moved, open_gap = 0, 0.0
@@ -473,7 +501,7 @@ class PairContact:
                 moved = self.pair.follow(self.u)
                 open_gap = comm.allreduce(float(np.abs(self.pair.gaps(self.u)[
                     self.active]).max(initial=0.0)), op=MPI.MAX)
-            g = self.pair.gaps(self.u)
+            g = self._gaps()
             leave = self.active & (self.lam < 0)
             join = ~self.active & (g < -1e-12 * length)
             changes = comm.allreduce(int(leave.sum() + join.sum()))
@@ -481,6 +509,7 @@ class PairContact:
                             "leave": comm.allreduce(int(leave.sum())),
                             "join": comm.allreduce(int(join.sum())), "moved": moved})
             if changes == 0 and open_gap <= 1e-10 * length:
+                self._settle(work)
                 self._held()
                 self.history = history
                 return SolveResult(True, "converged", its, [], work,
@@ -606,7 +635,7 @@ class PairContact:
         comm = self.pair.comm
         if self.condensed is not None and self._condensed(
                 np.flatnonzero(every_rank(comm, self.active)), np.zeros(self.condensed.n),
-                lambda: every_rank(comm, self.pair.gaps(self.u) + c * self.lam), work,
+                lambda: every_rank(comm, self._gaps() + c * self.lam), work,
                 every_rank(comm, c)):
             return 1
         which = np.flatnonzero(self.active)
@@ -649,6 +678,9 @@ class PairContact:
         c = self.condensed
         saved = self.u.x.array.copy(), self._rows()
         try:
+            if self._values is not None:  # inside `solve`: the forces move, u later
+                self._defer(unknown, known, conditions, work, compliance, frame)
+                return True
             r = self._out_of_balance(work)
             before = saved[1]
             reference = self.scale if self.scale is not None else max(
@@ -678,10 +710,104 @@ class PairContact:
         except (SolveError, np.linalg.LinAlgError, PETSc.Error) as err:
             self.u.x.array[:] = saved[0]
             self._set_rows(saved[1])
+            self._values = None
             log.warning("contact pair: %s: each set is solved as a saddle point", err)
             self.free_motions = c.free_motions
             self.condensed = None
             return False
+
+    def _begin(self, work: WorkCounts) -> None:
+        """A linear pair's loop begins: u_0 for the loads now, every row's value kept.
+
+        One back-substitution if the loads moved since the last solve (R(u) − Bᵀλ ≠ 0);
+        then the rows' values (the gaps B u + γ and the tangential B_t u) are kept, and
+        each iteration moves them by S's columns, Δ(Bu) = S Δλ, instead of moving u
+        (`_defer`): the loop reads them (`_gaps`, `_tangential`) and `_settle` moves u
+        once at its end. A singular K is said and left to the saddle point.
+        """
+        self._values = None
+        c = self.condensed
+        if c is None:
+            return
+        try:
+            r = self._out_of_balance(work)
+            forces = self._rows()
+            self._reference = self.scale if self.scale is not None else max(
+                r.norm(), float(np.linalg.norm(forces)))
+            if r.norm() > self.rel * self._reference:  # the loads moved: the new u_0 (+ W λ)
+                self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
+                self.u.x.scatter_forward()
+                work.linear_solves += 1
+        except (SolveError, PETSc.Error) as err:  # K singular: nothing moved
+            self.free_motions = c.free_motions
+            log.warning("contact pair: %s: each set is solved as a saddle point", err)
+            self.condensed = None
+            return
+        self._values, self._moved = self._block_values(), np.zeros(len(forces))
+
+    def _defer(self, unknown, known, conditions, work, compliance, frame) -> None:
+        """The statuses' forces on the kept factorization; the rows' values moved by S."""
+        c, before = self.condensed, self._rows()
+        if frame is None:
+            after = c.solve(before, unknown, known, conditions(), work, compliance)
+        else:
+            after = frame @ c.solve(frame.T @ before, unknown, known, conditions(), work,
+                                    compliance, frame)
+        change = after - before
+        rows = np.flatnonzero(change)
+        if len(rows):
+            self._values += c.S[:, [c.column[int(k)] for k in rows]] @ change[rows]
+        self._moved += change
+        self._set_rows(after)
+
+    def _settle(self, work: WorkCounts) -> None:
+        """u moved by the loop's change of the forces (one back-substitution), and checked.
+
+        As a Newton solve checks its answer: R(u) − Bᵀλ = 0, and the rows' values at u
+        those the loop read off S (to 1e-12 of the bodies' size).
+
+        Raises:
+            _Unsettled: they are not (a residual not linear in u).
+        """
+        if self._values is None:
+            return
+        c, predicted, moved = self.condensed, self._values, self._moved
+        self._values = self._moved = None
+        c.move(self.u.x.petsc_vec, np.zeros_like(moved), moved, work)
+        self.u.x.scatter_forward()
+        norm = self._out_of_balance(work).norm()
+        reference = self._reference if self.scale is not None else max(
+            self._reference, float(np.linalg.norm(self._rows())))
+        off = float(np.abs(self._block_values() - predicted).max(initial=0.0))
+        if not (norm <= self.rel * reference and off <= 1e-12 * self.pair.length):
+            raise _Unsettled(f"the condensed solve left |R| = {norm:.2e} and its rows "
+                             f"{off:.2e} off (a residual not linear in u)")
+        self.free_motions, self._load = c.free_motions, reference
+
+    def _block_values(self) -> np.ndarray:
+        """Every row's value at u (every rank's): the gaps, then each tangential block's."""
+        comm = self.pair.comm
+        out = [every_rank(comm, self.pair.gaps(self.u))]
+        for M in self.condensed.blocks[1:]:
+            v = M.createVecLeft()
+            M.mult(self.u.x.petsc_vec, v)
+            out.append(every_rank(comm, v.array))
+        return np.concatenate(out)
+
+    def _gaps(self) -> np.ndarray:
+        """This rank's gaps: at u, or (inside a linear pair's loop) those S gives."""
+        if self._values is None:
+            return self.pair.gaps(self.u)
+        start = self.condensed.start
+        return self._values[start:start + len(self.lam)].copy()
+
+    def _tangential(self) -> np.ndarray:
+        """This rank's relative tangential displacements (nodes × tangents), as `_gaps`."""
+        if self._values is None:
+            return self.pair.tangential(self.u)
+        n, start, local = self.condensed.n, self.condensed.start, len(self.lam)
+        return np.column_stack([self._values[k * n + start:k * n + start + local]
+                                for k in range(1, self.pair.gdim)])
 
     def _out_of_balance(self, work: WorkCounts) -> PETSc.Vec:
         """R(u) − (the contact forces) with the supports' values set in u (their rows 0)."""
@@ -939,7 +1065,7 @@ class FrictionalPair(PairContact):
         self.spring = arrays.get("spring", np.zeros(len(self.lam))).copy()
         self.committed = arrays["committed"].reshape(-1, m).copy()
 
-    def solve(self) -> SolveResult:
+    def _loop(self) -> SolveResult:
         """The active-set loop with friction, from the current statuses (warm start).
 
         Returns:
@@ -953,10 +1079,11 @@ class FrictionalPair(PairContact):
         lam_n, seen = self.lam.copy(), set()
         tol_u = 1e-12 * self.pair.length  # a slip of round-off
         rubs = self.f > 0  # a pair without friction: its nodes slip freely, for good
+        self._begin(work)
         for k in range(1, self.max_iterations + 1):
             its += self._equilibrium(lam_n, work)
-            g = self.pair.gaps(self.u)
-            dg = self.pair.tangential(self.u) - self.committed
+            g = self._gaps()
+            dg = self._tangential() - self.committed
             slid = np.linalg.norm(dg, axis=1)
             size = np.linalg.norm(self.lam_t, axis=1)
             sensed = np.any(self.s != 0, axis=1)
@@ -986,6 +1113,7 @@ class FrictionalPair(PairContact):
                             "slip": comm.allreduce(int((self.active & self.slip).sum())),
                             "changes": changes, "drift": drift})
             if changes == 0 and drift <= 1e-9 * max(scale, 1e-300):
+                self._settle(work)
                 self._held()
                 self.history = history
                 return SolveResult(True, "converged", its, [], work, time.perf_counter() - t0,
@@ -993,8 +1121,7 @@ class FrictionalPair(PairContact):
             self.s = np.where(closing[:, None], 0.0, s)
             # a node that lands sticks, if it does, where it landed (not where it was at
             # the step's start, when it was open)
-            self.committed = np.where(closing[:, None], self.pair.tangential(self.u),
-                                      self.committed)
+            self.committed = np.where(closing[:, None], self._tangential(), self.committed)
             self.slip = (self.slip & ~holding & ~resting | sliding | closing) & ~opening
             self.active = (self.active & ~opening) | closing
             self.spring = np.where(self.active & self.slip, spring, 0.0)
@@ -1084,8 +1211,8 @@ class FrictionalPair(PairContact):
             compliance[2 * n + sprung] = 1.0 / spring[sprung]
 
         def conditions():  # the gaps, and the slips since the last committed state
-            dg = self.pair.tangential(self.u) - self.committed
-            rows = np.concatenate([every_rank(comm, self.pair.gaps(self.u)),
+            dg = self._tangential() - self.committed
+            rows = np.concatenate([every_rank(comm, self._gaps()),
                                    *(every_rank(comm, d) for d in dg.T)])
             if frame is None:
                 return rows
