@@ -105,14 +105,21 @@ def say(msg):
 
 
 def two_ranks(fine: float) -> dict:
-    """This script's `--case` on 2 ranks: the finest mesh's run."""
+    """This script's `--case` on 2 ranks: the finest mesh's run, the faster of two.
+
+    (The 1-rank time is taken warm, after the coarser meshes' runs in this process; the
+    first 2-rank process has measured up to 2.6 times its second's.)
+    """
+    runs = []
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "two.json"
         mpiexec = Path(sys.executable).parent / "mpiexec"
-        subprocess.run([str(mpiexec), "-n", "2", sys.executable, __file__, "--case",
-                        str(fine), "--out", str(out)], check=True,
-                       env=os.environ | {"OPENBLAS_NUM_THREADS": "1"})
-        return json.loads(out.read_text())
+        for _ in range(2):
+            subprocess.run([str(mpiexec), "-n", "2", sys.executable, __file__, "--case",
+                            str(fine), "--out", str(out)], check=True,
+                           env=os.environ | {"OPENBLAS_NUM_THREADS": "1"})
+            runs.append(json.loads(out.read_text()))
+    return min(runs, key=lambda r: r["solve_time_s"])
 
 
 def peer(quick: bool) -> dict | None:

@@ -178,8 +178,9 @@ residual = sum(ufl.inner(law.stress(eps), eps_v) * dx(group)
 # is linear (`linear=True`): $K$ is factorized once for the run and the saddle point solved
 # by its Schur complement on the active rows, $S_{AA} = B_A K^{-1} B_A^T$, a dense system of
 # the nodes in contact; $K^{-1} b_j$ is solved once per node, the first time it is active
-# (`contact.condensed`). An active-set iteration is then a small dense solve, a load step
-# one back-substitution besides the new columns.
+# (`contact.condensed`). An active-set iteration is then a small dense solve and, in the
+# loop written out below (it reads the gaps at u), one back-substitution to move u;
+# `PairContact.solve` reads them off $S$ instead and moves u once a step.
 
 pair = ContactPair(V, tagged("shaft_surface"), tagged("bore"))
 contact = PairContact(residual, u, bcs, pair, force_scale=args.E_housing * c, linear=True)

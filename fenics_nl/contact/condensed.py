@@ -12,9 +12,10 @@ the supports take no multiplier). The gaps of the active nodes close when
 
 a dense system of the active nodes only. So K is factorized once for the whole run; a
 column w_j is solved the first time node j becomes active (in one block with the others
-new at that iteration) and B w_j, a column of S, kept; an active-set iteration is then a
-small dense solve and one back-substitution (u moved by Σ w_j Δλ_j), and a load step one
-more (the new u_0). The rigid obstacle's row
+new at that iteration) and B w_j, a column of S (every row's), kept; an active-set
+iteration is then a small dense solve, every row's gap moved by S's columns (Δ(Bu) = S Δλ,
+`PairContact._defer`); u itself is moved once the set has settled, one back-substitution
+(Σ w_j Δλ_j), and a load step needs one more (the new u_0). The rigid obstacle's row
 update (`solvers.row_update`) does the same with Dirichlet rows.
 
 The rows come in blocks (the normal gaps B; with friction also the tangential slips B_t):
