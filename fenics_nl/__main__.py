@@ -109,11 +109,13 @@ def main(argv=None) -> int:
         cli.on_failure(lambda failed: write_outputs(problem, failed, args.png, args.plot))
         out = solve_case(problem, checkpoint=args.checkpoint,
                          checkpoint_every=args.checkpoint_every, restart=args.restart)
-        if args.output and "restarted_after_load_factor" in out:
+        restarted = [(k.removeprefix("restarted_after_").replace("_", " "), v)
+                     for k, v in out.items() if k.startswith("restarted_after_")]
+        if args.output and restarted:
             out["warnings"].append(
-                "restarted: this --output time series begins after load factor "
-                f"{out['restarted_after_load_factor']:.6g}, where the restart took the run "
-                "up; the steps before are in the first run's folder")
+                f"restarted: this --output time series begins after {restarted[0][0]} "
+                f"{restarted[0][1]:.6g}, where the restart took the run up; the steps "
+                "before are in the first run's folder")
         # before the first step: the problem, then the solver (its forms compiled)
         out["setup_time_s"] = built + out.pop("solver_setup_time_s")
         return out, write_outputs(problem, out, args.png, args.plot)

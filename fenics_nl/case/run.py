@@ -43,15 +43,19 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     setup = time.perf_counter() - t0
     saving = case_checkpoints(problem, checkpoint, checkpoint_every) if checkpoint else None
     resumed = case_checkpoints(problem, restart).restore() if restart else None
+    # the step the restart goes on from (before `_solve` extends resumed.steps)
+    last = resumed.steps[-1] if resumed is not None and resumed.steps else None
     if resumed is not None:
-        last = resumed.steps[-1] if resumed.steps else None
         where = "" if last is None else (f", time {last['time']:.6g}" if "time" in last else
                                          f", load factor {last['load_factor']:.6g}")
         say(f"restarted from {restart}: {len(resumed.steps)} converged steps{where}")
     out = _solve(problem, solver, saving, resumed)
     out["solver_setup_time_s"] = setup
-    if resumed is not None and resumed.steps:
-        out["restarted_after_load_factor"] = resumed.steps[-1]["load_factor"]
+    if last is not None:
+        if "time" in last:  # in time, the load factor may stay the same step after step
+            out["restarted_after_time"] = last["time"]
+        else:
+            out["restarted_after_load_factor"] = last["load_factor"]
     return out
 
 

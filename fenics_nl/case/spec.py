@@ -521,7 +521,10 @@ def read_case(path: str | Path) -> Case:
     conditions = _conditions(r, data, dim, law, model)
     factors, adaptive, arc = _loading(r, data)
     pairs = _pairs(r, data)
-    time_axis = _time_axis(r, data, law, any(p["wear"] for p in pairs))
+    tables = data.get("contact", [])  # wear given (even wrong: said once, where it is)
+    wearing = isinstance(tables, list) and any(isinstance(t, dict) and "wear" in t
+                                               for t in tables)
+    time_axis = _time_axis(r, data, law, wearing)
     if law == "norton" and formulation != "mixed" and model not in (None, "plane_stress"):
         r.fail("mesh.formulation", 'norton needs "mixed": its flow is incompressible and '
                                    "grows without bound, and P2 displacements alone lock "
@@ -600,15 +603,15 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
         f = r.get(t, "friction", where, float, default=0.0, minimum=0.0)
         wear = r.get(t, "wear", where, float, default=0.0, minimum=0.0)
         speed = r.get(t, "speed", where, float, default=None, positive=True)
-        if wear and speed is None:
+        if wear and "speed" not in t:
             r.fail(f"{where}.speed", "missing: wear = k slides the slave over the master at "
                                      "this speed (distance per unit time: Archard's "
                                      "ds = speed dt)")
-        if speed is not None and not wear:
+        if speed is not None and not wear and "wear" not in t:
             r.fail(f"{where}.speed", "only with wear = k (the sliding that wears)")
         if wear and f:
             r.fail(f"{where}.wear", "with friction: not built (the wear's compliance is in "
-                                    "the frictionless loop); friction = 0 here")
+                                    "the frictionless loop): give friction = 0, or no wear")
         if slave is not None and slave == master:
             r.fail(f"{where}.master", f"{master!r} is the slave group too: a pair is two "
                                       "surfaces")
@@ -945,8 +948,8 @@ def _time_axis(r: _Reader, data: dict, law: str | None, wearing: bool = False
                                                              "stationary")}
         table["adaptive"] = False
     elif law is not None and not viscous:
-        r.fail("loading.time", f"only with a rate-dependent law ({', '.join(VISCOUS)}): "
-                               f"{law} has no time; give steps")
+        r.fail("loading.time", f"only with a rate-dependent law ({', '.join(VISCOUS)}) or "
+                               f"a [[contact]] pair's wear: {law} has no time; give steps")
     where = "loading.time"
     if not isinstance(table, dict):
         r.fail(where, "must be a table, e.g. { end = 100.0, steps = 20 }")
