@@ -18,6 +18,7 @@ from pathlib import Path
 
 from fenics_nl.materials import laws
 from fenics_nl.materials.creep import NortonCreep, PerzynaViscoplasticity
+from fenics_nl.materials.drucker_prager import FITS, DruckerPrager
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
 from fenics_nl.materials.plasticity import J2Plasticity
@@ -40,11 +41,15 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
-                         # | j2-finite | at1 | at2 | norton | perzyna
+                         # | j2-finite | drucker-prager | at1 | at2 | norton | perzyna
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
                          # plane stress: linear-elastic, saint-venant-kirchhoff, j2, norton, perzyna
+# drucker-prager (soils; stresses positive in tension): E, nu, c (cohesion), phi (friction
+# angle, degrees), optionally psi (dilatancy angle, default phi: associated) and fit
+# ("compression": the cone through Mohr-Coulomb's compression meridian, or "plane_strain");
+# perfect plasticity; not plane stress, not mixed
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
@@ -164,7 +169,8 @@ KEYS = [
     ("mesh", "formulation", "`displacement`, or `mixed`: Taylor–Hood u–p (degree ≥ 2, not "
      "plane stress), no locking as ν → 0.5, ν = 0.5 allowed", "displacement", "—"),
     ("material", "law", "`linear-elastic`, `power-law`, `saint-venant-kirchhoff`, "
-     "`neo-hookean`, `j2`, `j2-finite`, `at1`, `at2`, `norton` or `perzyna`", "required",
+     "`neo-hookean`, `j2`, `j2-finite`, `drucker-prager`, `at1`, `at2`, `norton` or "
+     "`perzyna`", "required",
      "—"),
     ("material", "group", "[[material]] only: the cell group (a physical group of the mesh's "
      "cells) this law holds on; one table per group, every cell in one", "required there",
@@ -184,6 +190,13 @@ KEYS = [
     ("material", "H", "j2, j2-finite, perzyna: the linear isotropic hardening modulus", "0",
      "stress"),
     ("material", "C", "j2: the kinematic hardening modulus", "0", "stress"),
+    ("material", "c", "drucker-prager: the cohesion", "required there", "stress"),
+    ("material", "phi", "drucker-prager: the friction angle φ, in (0, 90)", "required there",
+     "degrees"),
+    ("material", "psi", "drucker-prager: the dilatancy angle ψ, in [0, φ] (φ: associated "
+     "flow; below: not associated, the tangent not symmetric)", "phi", "degrees"),
+    ("material", "fit", "drucker-prager: the cone through Mohr–Coulomb's `compression` "
+     "meridian, or with its `plane_strain` collapse load", "compression", "—"),
     ("material", "saturation", "j2-finite: Voce's saturation stress, σ_y = σ0 + H p + "
      "(saturation − σ0)(1 − e^(−delta p))", "none", "stress"),
     ("material", "delta", "j2-finite: Voce's rate", "0", "—"),
@@ -274,6 +287,7 @@ LAWS: dict[str, type[laws.Material]] = {
     "neo-hookean": laws.NeoHookean,
     "j2": J2Plasticity,
     "j2-finite": FiniteJ2Plasticity,
+    "drucker-prager": DruckerPrager,
     "at1": AT1,
     "at2": AT2,
     "norton": NortonCreep,
@@ -285,10 +299,11 @@ VISCOUS = ("norton", "perzyna")  # rate-dependent: driven in time ([loading] tim
 # plasticity; a broken cell of a damage law keeps 1e-6 of its stiffness (a body cut in two
 # by a crack would otherwise have a singular tangent)
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
+            "drucker-prager": {"psi": None, "fit": "compression"},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 STATE_FREE = ("linear-elastic", "power-law", "saint-venant-kirchhoff", "neo-hookean")
-WORDS = {"split": SPLITS}  # parameters that are words, and their choices
+WORDS = {"split": SPLITS, "fit": FITS}  # parameters that are words, and their choices
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "bfgs", "snes")
 LINEAR = ("lu", "gamg")
@@ -525,6 +540,9 @@ def read_case(path: str | Path) -> Case:
     wearing = isinstance(tables, list) and any(isinstance(t, dict) and "wear" in t
                                                for t in tables)
     time_axis = _time_axis(r, data, law, wearing)
+    if law == "drucker-prager" and formulation == "mixed":
+        r.fail("mesh.formulation", 'drucker-prager takes the displacement formulation (its '
+                                   "flow dilates: the mixed form's volumetric split is J2's)")
     if law == "norton" and formulation != "mixed" and model not in (None, "plane_stress"):
         r.fail("mesh.formulation", 'norton needs "mixed": its flow is incompressible and '
                                    "grows without bound, and P2 displacements alone lock "
@@ -753,7 +771,8 @@ def _one_material(r: _Reader, m: dict, where: str, model: str | None):
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"{where}.{name}" if name in parameters else where, rest or name)
-    if law in ("neo-hookean", "power-law", "j2-finite") and model == "plane_stress":
+    if law in ("neo-hookean", "power-law", "j2-finite", "drucker-prager") and \
+            model == "plane_stress":
         r.fail(f"{where}.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
     return law, parameters

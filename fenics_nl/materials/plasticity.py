@@ -33,7 +33,8 @@ from fenics_nl.expression import Expression
 from fenics_nl.materials import kinematics
 from fenics_nl.materials.laws import Isotropic, LinearElastic, SmallStrain, check_range
 
-__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "cell_max",
+__all__ = ["J2Plasticity", "PlasticState", "QuadratureStateOutputs", "SmallStrainPlasticity",
+           "cell_max",
            "hookes_tangent", "per_cell", "quadrature_spaces", "store_at_points"]
 
 YIELD_TOLERANCE = 1e-10  # f > 1e-10 σ0 is plastic
@@ -236,30 +237,18 @@ class QuadratureStateOutputs(StateAtPoints):
         return max(least, Q.mesh.comm.allreduce(float(yielded.max(initial=least)),
                                                 op=MPI.MAX))
 
-@dataclass(frozen=True, eq=False)
-class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
-    """J2 plasticity: yield stress σ0 > 0, isotropic hardening H ≥ 0, kinematic C ≥ 0.
 
-    H = C = 0 is perfect plasticity (the defaults of H and C). Models: 3D, plane strain,
-    axisymmetric (3x3 strains); plane stress through `materials.plane_stress`, with the
-    out-of-plane strain an unknown at the quadrature points (a 2x2 strain is refused).
+class SmallStrainPlasticity(QuadratureStateOutputs):
+    """A small-strain plastic law by its return map: the state (ε_p, p) at the points.
+
+    The subclass gives `return_map(ε)` → (ε_p, p, Δp) in UFL from the committed state (and
+    has a `state: PlasticState`, E and ν); σ = Hooke's stress of ε − ε_p(ε), whose UFL
+    derivative through the return map is the consistent tangent (not symmetric when the
+    flow is not associated). J2 (`J2Plasticity`) and the soils' laws
+    (`materials.drucker_prager`).
     """
 
-    sigma0: float = 1.0
-    H: float = 0.0
-    C: float = 0.0
-    state: PlasticState = field(default_factory=PlasticState, init=False, repr=False,
-                                compare=False)
-
     path_dependent = True
-
-    def __post_init__(self):
-        super().__post_init__()
-        check_range("sigma0", self.sigma0, 0.0, math.inf)
-        for name in ("H", "C"):
-            value = float(getattr(self, name))
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be >= 0 and finite, got {getattr(self, name)!r}")
 
     def modified_newton_tangent(self, u, model: str, dx):
         """The course's choice for plasticity: Hooke's tangent (E, ν), factorized once.
@@ -369,9 +358,67 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
 
     def _bound(self) -> PlasticState:
         if self.state.eps_p is None:
-            raise ValueError("J2Plasticity has no state: call bind(mesh, quadrature degree) "
-                             "before writing a form with it")
+            raise ValueError(f"{type(self).__name__} has no state: call bind(mesh, "
+                             "quadrature degree) before writing a form with it")
         return self.state
+
+    def stress(self, eps):
+        """σ: Hooke's stress at the return-mapped state, C : (ε − ε_p(ε)).
+
+        Its UFL derivative through the return map is the consistent tangent. With an
+        associated flow (J2) it is ∂ψ/∂ε of the step's condensed energy ψ: the return map
+        minimizes ψ over the state, so the state's variation
+        drops out of dψ/dε (the envelope theorem): σ is ∂ψ_e/∂ε_e at ε_e = ε − ε_p(ε), the
+        same stress without the terms that cancel, and its derivative through the return map
+        is the consistent tangent. Against differentiating `energy` itself, the kernels
+        assemble the tangent and the residual faster (compared once, on
+        benchmarks/plasticity_peer.py's cylinder: no benchmark keeps that comparison); the
+        answers agree to round-off.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+
+        Returns:
+            σ (UFL, 3x3).
+        """
+        eps_p, _, _ = self.return_map(eps)
+        return LinearElastic(self.E, self.nu).stress(eps - eps_p)
+
+    def commit_strain(self, strain) -> None:
+        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
+
+        Args:
+            strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
+        """
+        st = self._bound()
+        if st.commit is None:  # compiled once
+            eps_p, p, _ = self.return_map(strain)
+            st.commit = (Expression(eps_p, st.points), Expression(p, st.points))
+        store_at_points((st.eps_p, st.p), st.commit)
+
+
+@dataclass(frozen=True, eq=False)
+class J2Plasticity(SmallStrainPlasticity, Isotropic, SmallStrain):
+    """J2 plasticity: yield stress σ0 > 0, isotropic hardening H ≥ 0, kinematic C ≥ 0.
+
+    H = C = 0 is perfect plasticity (the defaults of H and C). Models: 3D, plane strain,
+    axisymmetric (3x3 strains); plane stress through `materials.plane_stress`, with the
+    out-of-plane strain an unknown at the quadrature points (a 2x2 strain is refused).
+    """
+
+    sigma0: float = 1.0
+    H: float = 0.0
+    C: float = 0.0
+    state: PlasticState = field(default_factory=PlasticState, init=False, repr=False,
+                                compare=False)
+
+    def __post_init__(self):
+        super().__post_init__()
+        check_range("sigma0", self.sigma0, 0.0, math.inf)
+        for name in ("H", "C"):
+            value = float(getattr(self, name))
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be >= 0 and finite, got {getattr(self, name)!r}")
 
     def return_map(self, eps):
         """(ε_p, p, Δp) at the strain ε from the committed state (UFL, radial return).
@@ -399,26 +446,6 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         # the direction only where it is defined (q > 0 there): no 0/0 in the elastic branch
         n = ufl.conditional(plastic, 1.5 * xi / q, ufl.zero(3, 3))
         return eps_p_n + dp * n, p_n + dp, dp
-
-    def stress(self, eps):
-        """σ = ∂ψ/∂ε, as the derivative of the elastic energy at the return-mapped state.
-
-        The return map minimizes the step's energy ψ over the state, so the state's variation
-        drops out of dψ/dε (the envelope theorem): σ is ∂ψ_e/∂ε_e at ε_e = ε − ε_p(ε), the
-        same stress without the terms that cancel, and its derivative through the return map
-        is the consistent tangent. Against differentiating `energy` itself, the kernels
-        assemble the tangent and the residual faster (compared once, on
-        benchmarks/plasticity_peer.py's cylinder: no benchmark keeps that comparison); the
-        answers agree to round-off.
-
-        Args:
-            eps: the small strain ε (UFL, 3x3).
-
-        Returns:
-            σ (UFL, 3x3).
-        """
-        eps_p, _, _ = self.return_map(eps)
-        return LinearElastic(self.E, self.nu).stress(eps - eps_p)
 
     def energy(self, eps):
         """ψ(ε): the step's condensed energy at the return-mapped state.
@@ -450,18 +477,6 @@ class J2Plasticity(QuadratureStateOutputs, Isotropic, SmallStrain):
         rest = (self.mu * ufl.inner(d, d) + 0.5 * self.H * p**2
                 + self.C / 3.0 * ufl.inner(eps_p, eps_p) + self.sigma0 * dp)
         return rest, ufl.tr(eps), self.kappa
-
-    def commit_strain(self, strain) -> None:
-        """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
-
-        Args:
-            strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
-        """
-        st = self._bound()
-        if st.commit is None:  # compiled once
-            eps_p, p, _ = self.return_map(strain)
-            st.commit = (Expression(eps_p, st.points), Expression(p, st.points))
-        store_at_points((st.eps_p, st.p), st.commit)
 
 
 def cell_max(at_points, name: str):
