@@ -748,13 +748,21 @@ def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
     return groups[0][1], groups[0][2], groups
 
 
+def _parameters(law) -> list:
+    """A law's parameters a [material] table gives.
+
+    Its init fields: not its state, nor what another table gives ([initial_stress]).
+    """
+    return [f for f in fields(law) if f.init and f.metadata.get("case", True)]
+
+
 def _one_material(r: _Reader, m: dict, where: str, model: str | None):
     law = r.get(m, "law", where, str, required=True, choices=tuple(LAWS))
     if law is None:  # still name a misspelt key (lawe = ...) beside the missing law
-        every = {f.name for cls in LAWS.values() for f in fields(cls) if f.init}
+        every = {f.name for cls in LAWS.values() for f in _parameters(cls)}
         r.unknown(m, where, ("law", *sorted(every)))
         return None, {}
-    params = [f for f in fields(LAWS[law]) if f.init]  # the parameters, not the state
+    params = _parameters(LAWS[law])
     accepted = tuple(f.name for f in params)
     r.unknown(m, where, ("law", *accepted))
     parameters = {}

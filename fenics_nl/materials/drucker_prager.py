@@ -24,10 +24,11 @@ committed plastic strain,
 * on the cone: Δγ = f_tr / (G + K η η̄), s = (1 − G Δγ / √J2_tr) s_tr, p = p_tr − K η̄ Δγ,
   Δε_p = Δγ (s_tr / (2 √J2_tr) + η̄ I / 3);
 * at the apex, if the cone's return would pass it (√J2_tr < G Δγ): s = 0, p = ξ c / η,
-  Δε_p = dev ε_e,tr + (p_tr − p) / (3K) I.
+  Δε_p = s_tr / (2G) + (p_tr − p) / (3K) I.
 
-σ is Hooke's stress of ε − ε_p(ε), and its UFL derivative through the return map the
-consistent tangent. The cumulated plastic strain p̄ grows by √(2/3) |Δε_p|, as J2's.
+σ = σ_0 + C : (ε − ε_p(ε)), σ_0 the initial stress (in situ; 0 by default), and its UFL
+derivative through the return map the consistent tangent. The cumulated plastic strain
+p̄ grows by √(2/3) |Δε_p|, as J2's.
 """
 
 from __future__ import annotations
@@ -78,6 +79,9 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
     phi: float = 30.0
     psi: float | None = None
     fit: str = "compression"
+    # the stress at ε = 0 (in situ: the ground's before any work), 3x3 in the model's
+    # components; None: 0. Not a case file's material key: its [initial_stress] table
+    initial_stress: tuple | None = field(default=None, metadata={"case": False})
     state: PlasticState = field(default_factory=PlasticState, init=False, repr=False,
                                 compare=False)
 
@@ -93,6 +97,19 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
             raise ValueError(f"psi must be in [0, phi = {self.phi}] degrees (the dilatancy "
                              f"angle), got {self.psi!r}")
         cone(self.phi, self.fit)  # the fit is known
+        if self.initial_stress is not None:
+            s0 = [[float(x) for x in row] for row in self.initial_stress]
+            if len(s0) != 3 or any(len(row) != 3 for row in s0) or any(
+                    s0[i][j] != s0[j][i] for i in range(3) for j in range(3)):
+                raise ValueError("initial_stress must be a symmetric 3x3 stress, got "
+                                 f"{self.initial_stress!r}")
+
+    @property
+    def sigma_0(self):
+        """The initial stress as a UFL tensor (0 if none)."""
+        if self.initial_stress is None:
+            return ufl.zero(3, 3)
+        return ufl.as_matrix([[float(x) for x in row] for row in self.initial_stress])
 
     @property
     def dilatancy(self) -> float:
@@ -135,7 +152,16 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
                              "return map's, not a derivative")
         eps_p, _, _ = self.return_map(eps)
         return (LinearElastic(self.E, self.nu).energy(eps - eps_p)
+                + ufl.inner(self.sigma_0, eps - eps_p)
                 + self.apex * ufl.tr(eps_p - self._bound().eps_p))
+
+    def stress(self, eps):
+        """σ = σ_0 + C : (ε − ε_p(ε)) (UFL, 3x3): the initial stress and Hooke's of the rest.
+
+        Args:
+            eps: the small strain ε (UFL, 3x3).
+        """
+        return self.sigma_0 + super().stress(eps)
 
     def return_map(self, eps):
         """(ε_p, p̄, Δp̄) at the strain ε from the committed state (UFL; module docstring).
@@ -152,8 +178,8 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         eta_bar, _ = cone(self.dilatancy, self.fit)
         G, K = self.mu, self.kappa
         eps_e = eps - st.eps_p
-        e_dev = ufl.dev(eps_e)
-        s_tr, p_tr = 2 * G * e_dev, K * ufl.tr(eps_e)
+        s_tr = ufl.dev(self.sigma_0) + 2 * G * ufl.dev(eps_e)
+        p_tr = ufl.tr(self.sigma_0) / 3 + K * ufl.tr(eps_e)
         root_j2 = ufl.sqrt(0.5 * ufl.inner(s_tr, s_tr))
         f = root_j2 + eta * p_tr - xi * self.c
         # a point left on the cone by the last step has f = 0 up to round-off: it starts
@@ -166,7 +192,7 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         # the flow direction only where it is defined (√J2_tr > 0 on the cone)
         cone_flow = dgamma * (s_tr / (2 * ufl.conditional(on_cone, root_j2, 1.0))
                               + eta_bar / 3 * identity)
-        apex_flow = e_dev + (p_tr - xi * self.c / eta) / (3 * K) * identity
+        apex_flow = s_tr / (2 * G) + (p_tr - xi * self.c / eta) / (3 * K) * identity
         d_eps_p = ufl.conditional(on_cone, cone_flow,
                                   ufl.conditional(at_apex, apex_flow, ufl.zero(3, 3)))
         d_p = ufl.conditional(plastic, ufl.sqrt(2.0 / 3.0 * ufl.inner(d_eps_p, d_eps_p)
