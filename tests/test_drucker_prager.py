@@ -9,6 +9,7 @@ associated flow.
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +23,8 @@ from fenics_nl.materials import kinematics
 from fenics_nl.materials.drucker_prager import DruckerPrager, cone
 from fenics_nl.solvers.loading import solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
 
 E, NU, C, PHI = 5000.0, 0.3, 1.0, 30.0
 
@@ -229,3 +232,75 @@ def test_a_triaxial_case_file_fails_at_the_mohr_coulomb_peak(tmp_path, demo):
         (tmp_path / "bad.toml").write_text(TRIAXIAL.replace(*change))
         proc = demo.run(["-m fenics_nl", "check", tmp_path / "bad.toml"], check=False)
         assert proc.returncode == 2 and said in proc.stderr, proc.stderr
+
+
+CAVITY = """[mesh]
+file = "thick_cylinder.geo"
+model = "plane_strain"
+degree = 2
+
+[material]
+law = "drucker-prager"
+E = 5000.0
+nu = 0.3
+c = 1000.0
+phi = 30.0
+
+[initial_stress]
+stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]
+
+[[boundary]]
+group = "symmetry_x"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "symmetry_y"
+displacement = ["free", 0.0]
+
+[[boundary]]
+group = "outer"
+pressure = { from = 10.0, to = 10.0 }
+
+[[boundary]]
+group = "inner"
+pressure = { from = 10.0, to = 2.0 }
+
+[loading]
+steps = 2
+
+[[probe]]
+name = "wall"
+point = [10.0, 0.0]
+"""
+
+
+def test_a_cavity_in_an_in_situ_stress_unloads_as_lame_says(tmp_path, demo):
+    # a ring a = 10 < r < 20 (cases/thick_cylinder.geo, P2) under the in-situ stress
+    # σ0 = −10 I, its outer pressure held at 10 ({ from = 10, to = 10 }) and its cavity's
+    # lowered from 10 to 2 ({ from = 10, to = 2 }); the cohesion keeps it elastic. The
+    # change is Lamé's for an inner pressure of −8: the wall moves in by 8 u(a)/p, to 1e-4
+    # (the curved P2 ring's own error: the elastic thick_cylinder case is −5e-5), and its
+    # stress is σ0 + Lamé's (σ_r = −2, σ_θ = −23.33, σ_z = −11.6) within 1 % (measured
+    # −0.85 %, −0.49 %, −0.34 %: a P2 stress at the boundary point, as the elastic
+    # thick_cylinder case's σ_eq, bounded 1 % there); at load factor 0 the in-situ stress
+    # is in equilibrium (checked: the run would refuse it otherwise)
+    from fenics_nl.theory import vessels
+
+    (tmp_path / "thick_cylinder.geo").write_text(
+        (CASES / "thick_cylinder.geo").read_text())
+    (tmp_path / "cavity.toml").write_text(CAVITY)
+    d = demo.case(tmp_path / "cavity.toml")
+    wall = d["probes"]["wall"]
+    u_a = -8.0 * vessels.elastic_inner_compliance("cylinder", 10.0, 20.0, 5000.0, 0.3)
+    assert wall["displacement"][0] == pytest.approx(u_a, rel=1e-4)
+    sr, st, sz = vessels.elastic_stresses("cylinder", 10.0, 20.0, -8.0, 10.0, nu=0.3)
+    sigma = np.array(wall["stress"])
+    assert np.diag(sigma) == pytest.approx([-10 + sr, -10 + st, -10 + sz], rel=1e-2)
+    # without the outer pressure at load factor 0, the in-situ stress pulls the ring in
+    # as if it were a load: refused, one line
+    (tmp_path / "loose.toml").write_text(CAVITY.replace("{ from = 10.0, to = 10.0 }",
+                                                        "{ from = 0.0, to = 10.0 }"))
+    proc = demo.run(["-m fenics_nl", "run", tmp_path / "loose.toml"], check=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.startswith("error: initial_stress: not in equilibrium with the loads "
+                                  "at load factor 0"), proc.stderr

@@ -84,6 +84,7 @@ class CaseProblem:
         if idle:
             raise CaseError(idle)
         self.bcs, self._prescribed = self._dirichlet()
+        self._initial_equilibrium()
         self.contact = self._contact()
         self.supports, self.held = self._supports()
         self.solver = None  # make_solver(): compiling the forms is for a run, not a check
@@ -196,14 +197,49 @@ class CaseProblem:
         for c in self.case.conditions:
             ds = self.ds(tag[c.group])
             if c.kind == "traction":
-                T = ufl.as_vector(c.value)
-                loads -= self.t * ufl.dot(T, v) * w * ds
+                T = self._ramped(ufl.as_vector(c.value), c.start and ufl.as_vector(c.start))
+                loads -= ufl.dot(T, v) * w * ds
             elif c.kind == "pressure":
-                loads += self.t * c.value * ufl.dot(self._pressure_direction(c), v) * w * ds
+                loads += self._ramped(c.value, c.start) * ufl.dot(
+                    self._pressure_direction(c), v) * w * ds
         self._loads = loads
         if isinstance(self.material, ByGroup):  # each law on its cells
             return self.material.work(self.u, v, self.model, self.dx) + loads
         return self.fields.internal_work(self.material, self.model) * self.dx + loads
+
+    def _ramped(self, value, start):
+        """A load at the load factor t: t × value, or start + t (value − start) ({ from, to })."""
+        return self.t * value if start is None else start + self.t * (value - start)
+
+    def _initial_equilibrium(self) -> None:
+        """Refuse an initial stress out of balance with the loads at 0 and the supports.
+
+        R(u = 0) at load factor 0 must vanish (to 1e-9 of the initial stress's own nodal
+        forces, the supports' rows left out), or the first step would carry the imbalance
+        as if it were a load. At construction u is 0.
+        """
+        if self.case.initial_stress is None:
+            return
+        from dolfinx.fem import petsc
+        from petsc4py import PETSc
+
+        saved = float(self.t.value)
+        self.t.value = 0.0
+        own = ufl.inner(self.material.sigma_0, kinematics.small_strain(
+            self.fields.v, self.model)) * self.weight * self.dx
+        norms = []
+        for form in (self.residual, own):
+            b = petsc.assemble_vector(fem.form(form))
+            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+            petsc.set_bc(b, self.bcs, alpha=0.0)
+            norms.append(b.norm())
+        self.t.value = saved
+        if norms[0] > 1e-9 * max(norms[1], 1e-300):
+            raise CaseError([f"initial_stress: not in equilibrium with the loads at load "
+                             f"factor 0 and the supports: they leave {norms[0]:.3g} of its "
+                             f"own nodal forces {norms[1]:.3g} unbalanced (give each loaded "
+                             "group its in-situ traction at 0, e.g. pressure = { from = "
+                             "p0, to = ... })"])
 
     def load_potential(self):
         """The dead loads' potential, −(their work); 0 without loads.
@@ -233,8 +269,9 @@ class CaseProblem:
         total = 0.0
         for c in self.case.conditions:
             if c.kind in ("traction", "pressure"):
-                # hypot: no overflow warning for a huge component
-                size = math.hypot(*c.value) if c.kind == "traction" else abs(c.value)
+                # hypot: no overflow warning for a huge component; { from, to }: the larger
+                size = max(math.hypot(*v) if c.kind == "traction" else abs(v)
+                           for v in (c.value, c.start) if v is not None)
                 total += size * areas[c.group]
                 if not total < FLOAT_RANGE:  # inf and NaN too
                     raise CaseError([f"{c.key}: the load it gives (its size {size:.3g} × the "
@@ -265,7 +302,8 @@ class CaseProblem:
                 continue
             held = self._held_everywhere(c.group)
             if c.kind == "traction":
-                idle = [i for i, v in enumerate(c.value) if v and i in held]
+                idle = [i for i, v in enumerate(c.value) if (v or (c.start and c.start[i]))
+                        and i in held]
             else:
                 _, normal = self.mean_normal(c.group)
                 flat = [i for i, n in enumerate(normal) if abs(n) > 1 - 1e-9]

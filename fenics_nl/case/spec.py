@@ -49,7 +49,9 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # drucker-prager (soils; stresses positive in tension): E, nu, c (cohesion), phi (friction
 # angle, degrees), optionally psi (dilatancy angle, default phi: associated) and fit
 # ("compression": the cone through Mohr-Coulomb's compression meridian, or "plane_strain");
-# perfect plasticity; not plane stress, not mixed
+# perfect plasticity; not plane stress, not mixed. Its in-situ stress, uniform:
+# [initial_stress]
+# stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]  # as the probes say it
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
@@ -89,6 +91,8 @@ traction = [0.0, -1.0]        # force per unit area (per unit length in 2D), ref
 group = "inner"
 pressure = 1.0                # normal pressure, positive pushing on the body; dead (along the
 follower = false              # undeformed normal) unless follower = true (finite strain only)
+# pressure = { from = 10.0, to = 1.0 }   # or a load from one value (load factor 0) to
+                              # another (1): a cavity's support lowered from the in-situ stress
 
 [[boundary]]                  # one contact group: rigid, frictionless, may separate
 group = "top"                 # flat, its outward normal along an axis
@@ -214,7 +218,12 @@ KEYS = [
      "length of a 2D model's boundary, per unit thickness), dead; scaled by the load factor",
      "—", "force / area"),
     ("boundary", "pressure", "normal pressure, positive pushing on the body; scaled by the "
-     "load factor", "—", "stress"),
+     "load factor, or `{ from = A, to = B }`: A at load factor 0, B at 1 (a traction too, "
+     "with vectors)", "—", "stress"),
+    ("initial_stress", "stress", "drucker-prager: the stress at zero strain (in situ), "
+     "uniform, 3 rows of 3 in the model's components ((x, y, z); axisymmetric (r, z, θ)); "
+     "in equilibrium with the loads at load factor 0 and the supports (checked)", "0",
+     "stress"),
     ("boundary", "follower", "the pressure follows the deformed normal (finite strain)",
      "false", "—"),
     ("boundary", "contact", "one rigid frictionless obstacle: `{ obstacle = \"plane\", point, "
@@ -328,6 +337,7 @@ class Condition:
     value: object  # components (None = free), a vector, a pressure, or the obstacle table
     follower: bool = False
     key: str = ""  # where it is in the file, for messages
+    start: object = None  # a load's value at load factor 0 ({ from, to }); None: 0
 
 
 @dataclass
@@ -367,6 +377,7 @@ class Case:
     # stationary, and factor (the load factor against time, [[t, f], ...])
     groups: list[tuple[str, str, dict]] | None = None  # [[material]]: (group, law, parameters)
     pairs: list[dict] = field(default_factory=list)  # [[contact]]: slave, master, friction, key
+    initial_stress: list | None = None  # [initial_stress] stress, 3x3 (model's components)
 
     @property
     def law_name(self) -> str:
@@ -387,8 +398,13 @@ class Case:
         return 3 if self.model == "3d" else 2
 
     def material(self) -> laws.Material:
-        """The material law with its parameters (validated by the law)."""
-        return LAWS[self.law](**self.parameters)
+        """The material law with its parameters (validated by the law).
+
+        With its initial stress, if the case gives one.
+        """
+        extra = {} if self.initial_stress is None else {
+            "initial_stress": tuple(map(tuple, self.initial_stress))}
+        return LAWS[self.law](**self.parameters, **extra)
 
 
 class _Reader:
@@ -488,8 +504,8 @@ def read_case(path: str | Path) -> Case:
     except tomllib.TOMLDecodeError as err:
         raise CaseError([f"{path}: not valid TOML: {err}"]) from None
     r = _Reader()
-    r.unknown(data, "case", ("mesh", "material", "boundary", "contact", "loading", "solver",
-                             "probe"))
+    r.unknown(data, "case", ("mesh", "material", "initial_stress", "boundary", "contact",
+                             "loading", "solver", "probe"))
 
     m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation",
                                "refine_near"))
@@ -582,7 +598,8 @@ def read_case(path: str | Path) -> Case:
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
-                refine_near, time_axis, groups, pairs)
+                refine_near, time_axis, groups, pairs,
+                _initial_stress(r, data, law, model, groups))
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
@@ -786,6 +803,71 @@ def _one_material(r: _Reader, m: dict, where: str, model: str | None):
     return law, parameters
 
 
+INITIAL = ("drucker-prager",)  # the laws that take an initial (in-situ) stress
+
+
+def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | None:
+    """[initial_stress] stress = 3x3, in the model's components (as the probes report it).
+
+    Uniform; the soils' laws (`INITIAL`) in one [material]. Its equilibrium with the loads
+    at load factor 0 and the supports is the problem's to check (it has the mesh).
+    """
+    t = data.get("initial_stress")
+    if t is None:
+        return None
+    where = "initial_stress"
+    if not isinstance(t, dict):
+        r.fail(where, "must be a table: stress = [[...], [...], [...]]")
+        return None
+    for k in ("unit_weight", "K0", "surface"):
+        if k in t:
+            r.fail(f"{where}.{k}", "a geostatic stress (the ground's weight) is not built "
+                                   "yet: give a uniform stress = [[...], [...], [...]]")
+    r.unknown({k: v for k, v in t.items() if k not in ("unit_weight", "K0", "surface")},
+              where, ("stress",))
+    if groups is not None or (law is not None and law not in INITIAL):
+        r.fail(where, f"taken by {', '.join(INITIAL)} in one [material] (the soils' laws), "
+                      f"not {law if groups is None else '[[material]] groups'}")
+    if model == "plane_stress":
+        r.fail(where, "not in plane stress")
+    rows = t.get("stress")
+    if rows is None:
+        r.fail(f"{where}.stress", "missing: 3 rows of 3 components, (x, y, z); axisymmetric "
+                                  "(r, z, θ)")
+        return None
+    if not (isinstance(rows, list) and len(rows) == 3):
+        r.fail(f"{where}.stress", f"must be 3 rows of 3 components, got {rows!r}")
+        return None
+    stress = [r.vector(row, f"{where}.stress", 3) for row in rows]
+    if any(row is None for row in stress):
+        return None
+    if any(stress[i][j] != stress[j][i] for i in range(3) for j in range(3)):
+        r.fail(f"{where}.stress", "must be symmetric")
+    return stress
+
+
+def _ramp(r: _Reader, table: dict, key: str, dim: int | None):
+    """A load `{ from = A, to = B }`: (A, B), a vector each (traction) or a number (pressure).
+
+    It moves from A at load factor 0 to B at 1 (an in-situ stress's pressure on a cavity
+    lowered to its support's). (None, None) if wrong (said).
+    """
+    r.unknown(table, key, ("from", "to"))
+    ends = []
+    for end in ("from", "to"):
+        if end not in table:
+            r.fail(f"{key}.{end}", "missing (a load { from = A, to = B } moves from A to B "
+                                   "with the load factor)")
+            ends.append(None)
+        elif dim is None:
+            ends.append(r.get(table, end, key, float))
+        else:
+            ends.append(r.vector(table[end], f"{key}.{end}", dim))
+    if None in ends:
+        return None, None
+    return tuple(ends)
+
+
 def _conditions(r: _Reader, data: dict, dim: int, law: str | None, model: str | None
                 ) -> list[Condition]:
     tables = data.get("boundary", [])
@@ -815,16 +897,22 @@ def _conditions(r: _Reader, data: dict, dim: int, law: str | None, model: str | 
         if follower and kind == "pressure" and model == "plane_stress":
             r.fail(f"{where}.follower", "not in plane stress (the thickness change is not "
                                         "modelled): use plane_strain or 3d")
+        start = None  # a load's value at load factor 0, if it moves { from, to }
         if kind == "displacement":
             value = r.vector(t[kind], key, dim, free=True)
+        elif kind in ("traction", "pressure") and isinstance(t[kind], dict):
+            start, value = _ramp(r, t[kind], key, dim if kind == "traction" else None)
         elif kind == "traction":
             value = r.vector(t[kind], key, dim)
         elif kind == "pressure":
             value = r.get(t, "pressure", where, float)
         else:
             value = _obstacle(r, t[kind], key, dim)
+        if start is not None and follower:
+            r.fail(f"{where}.follower", "not with { from, to } (a dead load from one value "
+                                        "to another)")
         if group is not None and value is not None:
-            out.append(Condition(group, kind, value, bool(follower), key))
+            out.append(Condition(group, kind, value, bool(follower), key, start))
     contact = [c for c in out if c.kind == "contact"]
     if len(contact) > 1:
         r.fail(contact[1].key, "one contact group per case (the active-set loop takes one "
