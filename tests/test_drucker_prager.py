@@ -304,3 +304,79 @@ def test_a_cavity_in_an_in_situ_stress_unloads_as_lame_says(tmp_path, demo):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     assert proc.stderr.startswith("error: initial_stress: not in equilibrium with the loads "
                                   "at load factor 0"), proc.stderr
+
+
+COLUMN_GEO = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, -4, 0, 2, 4};
+Physical Curve("bottom") = Curve In BoundingBox{-0.1, -4.1, -0.1, 2.1, -3.9, 0.1};
+Physical Curve("top") = Curve In BoundingBox{-0.1, -0.1, -0.1, 2.1, 0.1, 0.1};
+Physical Curve("left") = Curve In BoundingBox{-0.1, -4.1, -0.1, 0.1, 0.1, 0.1};
+Physical Curve("right") = Curve In BoundingBox{1.9, -4.1, -0.1, 2.1, 0.1, 0.1};
+Physical Surface("soil") = {1};
+Mesh.MeshSizeMax = 0.5;
+"""
+
+COLUMN = """[mesh]
+file = "column.geo"
+model = "plane_strain"
+
+[material]
+law = "drucker-prager"
+E = 5000.0
+nu = 0.3
+c = 1000.0
+phi = 30.0
+
+[initial_stress]
+unit_weight = 18.0
+K0 = 0.5
+surface = 0.0
+
+[[boundary]]
+group = "left"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "right"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "bottom"
+displacement = [0.0, 0.0]
+
+[[boundary]]
+group = "top"
+pressure = { from = 0.0, to = 50.0 }
+
+[loading]
+steps = 1
+
+[[probe]]
+name = "depth"
+point = [1.0, -3.0]
+"""
+
+
+def test_a_geostatic_column_under_a_surcharge_is_oedometric(tmp_path, demo):
+    # a soil column 4 deep between rollers, its geostatic stress (γ = 18, K0 = 0.5, the
+    # surface at 0) and its weight in equilibrium from the start; a surcharge q = 50 on
+    # the surface settles it as an oedometer, u = −q H / M (M = E(1 − ν)/((1 + ν)(1 − 2ν))),
+    # and the stress at 3 deep is the geostatic one plus the oedometer's (ν/(1 − ν) q
+    # across): P1 is exact for both (to 1e-9). The same column without its side rollers is
+    # refused: the in-situ stress K0 γ depth pushes the sides out (one line)
+    (tmp_path / "column.geo").write_text(COLUMN_GEO)
+    (tmp_path / "column.toml").write_text(COLUMN)
+    d = demo.case(tmp_path / "column.toml")
+    E_, nu, q, g, K0 = 5000.0, 0.3, 50.0, 18.0, 0.5
+    M = E_ * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    depth = d["probes"]["depth"]
+    assert depth["displacement"][1] == pytest.approx(-q * 1.0 / M, rel=1e-9)  # 1 above the base
+    sigma = np.diag(depth["stress"])
+    across = -K0 * g * 3.0 - nu / (1 - nu) * q
+    assert sigma == pytest.approx([across, -g * 3.0 - q, across], rel=1e-9)
+    assert d["reactions"]["bottom"][1] == pytest.approx((g * 4.0 + q) * 2.0, rel=1e-9)
+    (tmp_path / "loose.toml").write_text(COLUMN.replace(
+        'group = "right"\ndisplacement = [0.0, "free"]', 'group = "right"\ntraction = [0.0, 0.0]'))
+    proc = demo.run(["-m fenics_nl", "run", tmp_path / "loose.toml"], check=False)
+    assert proc.returncode == 2 and "initial_stress: not in equilibrium" in proc.stderr, \
+        proc.stderr

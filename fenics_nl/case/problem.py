@@ -202,10 +202,22 @@ class CaseProblem:
             elif c.kind == "pressure":
                 loads += self._ramped(c.value, c.start) * ufl.dot(
                     self._pressure_direction(c), v) * w * ds
+        gravity = self._gravity()
+        if gravity is not None:  # a geostatic initial stress: the ground's weight, held
+            loads -= ufl.dot(gravity, v) * w * self.dx
         self._loads = loads
         if isinstance(self.material, ByGroup):  # each law on its cells
             return self.material.work(self.u, v, self.model, self.dx) + loads
         return self.fields.internal_work(self.material, self.model) * self.dx + loads
+
+    def _gravity(self):
+        """The body force of a geostatic initial stress, −γ along the last axis (or None)."""
+        s0 = self.case.initial_stress
+        if not isinstance(s0, dict):
+            return None
+        dim = self.mesh.geometry.dim
+        return ufl.as_vector([-s0["unit_weight"] if i == dim - 1 else 0.0
+                              for i in range(dim)])
 
     def _ramped(self, value, start):
         """A load at the load factor t: t × value, or start + t (value − start) ({ from, to })."""
@@ -225,8 +237,8 @@ class CaseProblem:
 
         saved = float(self.t.value)
         self.t.value = 0.0
-        own = ufl.inner(self.material.sigma_0, kinematics.small_strain(
-            self.fields.v, self.model)) * self.weight * self.dx
+        eps_v = kinematics.small_strain(self.fields.v, self.model)
+        own = ufl.inner(self.material.initial(eps_v), eps_v) * self.weight * self.dx
         norms = []
         for form in (self.residual, own):
             b = petsc.assemble_vector(fem.form(form))
@@ -278,6 +290,9 @@ class CaseProblem:
                                      f"group's area) is beyond {FLOAT_RANGE:.0e}: its square "
                                      "(in norms and energies) overflows floating point; use "
                                      "other units"])
+        if isinstance(self.case.initial_stress, dict):  # the ground's weight
+            total += self.case.initial_stress["unit_weight"] * self.mesh.comm.allreduce(
+                fem.assemble_scalar(fem.form(self.weight * self.dx)))
         return total or None
 
     def _idle_loads(self, areas: dict[str, float]) -> list[str]:

@@ -52,6 +52,7 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # perfect plasticity; not plane stress, not mixed. Its in-situ stress, uniform:
 # [initial_stress]
 # stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]  # as the probes say it
+# or geostatic, with the ground's weight (held): unit_weight = 18.0, K0 = 0.5, surface = 0.0
 # j2-finite: J2 at finite strain (F = Fe Fp, Hencky, the exponential map): E, nu, sigma0,
 # optionally H (linear hardening) and saturation, delta (Voce: sigma_y = sigma0 + H p +
 # (saturation - sigma0)(1 - exp(-delta p))); not plane stress
@@ -224,6 +225,11 @@ KEYS = [
      "uniform, 3 rows of 3 in the model's components ((x, y, z); axisymmetric (r, z, θ)); "
      "in equilibrium with the loads at load factor 0 and the supports (checked)", "0",
      "stress"),
+    ("initial_stress", "unit_weight", "or geostatic: the ground's unit weight γ; the "
+     "vertical stress −γ × the depth below `surface` (on y in 2D, z in 3D), `K0` times it "
+     "across, and the weight a body force, held from the start", "—", "force / volume"),
+    ("initial_stress", "K0", "geostatic: the horizontal over the vertical stress", "—", "—"),
+    ("initial_stress", "surface", "geostatic: the ground surface's height", "—", "length"),
     ("boundary", "follower", "the pressure follows the deformed normal (finite strain)",
      "false", "—"),
     ("boundary", "contact", "one rigid frictionless obstacle: `{ obstacle = \"plane\", point, "
@@ -377,7 +383,8 @@ class Case:
     # stationary, and factor (the load factor against time, [[t, f], ...])
     groups: list[tuple[str, str, dict]] | None = None  # [[material]]: (group, law, parameters)
     pairs: list[dict] = field(default_factory=list)  # [[contact]]: slave, master, friction, key
-    initial_stress: list | None = None  # [initial_stress] stress, 3x3 (model's components)
+    # [initial_stress]: stress 3x3 (the model's components), or {unit_weight, K0, surface}
+    initial_stress: list | dict | None = None
 
     @property
     def law_name(self) -> str:
@@ -402,8 +409,9 @@ class Case:
 
         With its initial stress, if the case gives one.
         """
-        extra = {} if self.initial_stress is None else {
-            "initial_stress": tuple(map(tuple, self.initial_stress))}
+        s0 = self.initial_stress
+        extra = {} if s0 is None else {"initial_stress": dict(s0) if isinstance(s0, dict)
+                                       else tuple(map(tuple, s0))}
         return LAWS[self.law](**self.parameters, **extra)
 
 
@@ -804,13 +812,17 @@ def _one_material(r: _Reader, m: dict, where: str, model: str | None):
 
 
 INITIAL = ("drucker-prager",)  # the laws that take an initial (in-situ) stress
+GEOSTATIC = ("unit_weight", "K0", "surface")  # the ground's weight and stress ratio
 
 
-def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | None:
-    """[initial_stress] stress = 3x3, in the model's components (as the probes report it).
+def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | dict | None:
+    """[initial_stress]: a uniform stress, or a geostatic one with the ground's weight.
 
-    Uniform; the soils' laws (`INITIAL`) in one [material]. Its equilibrium with the loads
-    at load factor 0 and the supports is the problem's to check (it has the mesh).
+    stress = 3x3 in the model's components (as the probes report it); or unit_weight, K0,
+    surface: the vertical stress −γ times the depth below the surface, on the mesh's last
+    axis, K0 times it across, and the ground's weight as a body force, held. The soils'
+    laws (`INITIAL`) in one [material]. Its equilibrium with the loads at load factor 0 and
+    the supports is the problem's to check (it has the mesh).
     """
     t = data.get("initial_stress")
     if t is None:
@@ -819,21 +831,22 @@ def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | None:
     if not isinstance(t, dict):
         r.fail(where, "must be a table: stress = [[...], [...], [...]]")
         return None
-    for k in ("unit_weight", "K0", "surface"):
-        if k in t:
-            r.fail(f"{where}.{k}", "a geostatic stress (the ground's weight) is not built "
-                                   "yet: give a uniform stress = [[...], [...], [...]]")
-    r.unknown({k: v for k, v in t.items() if k not in ("unit_weight", "K0", "surface")},
-              where, ("stress",))
+    r.unknown(t, where, ("stress", *GEOSTATIC))
     if groups is not None or (law is not None and law not in INITIAL):
         r.fail(where, f"taken by {', '.join(INITIAL)} in one [material] (the soils' laws), "
                       f"not {law if groups is None else '[[material]] groups'}")
     if model == "plane_stress":
         r.fail(where, "not in plane stress")
     rows = t.get("stress")
+    if any(k in t for k in GEOSTATIC):
+        if rows is not None:
+            r.fail(f"{where}.stress", "or unit_weight, K0, surface: not both")
+        out = {k: r.get(t, k, where, float, required=True, positive=k != "surface")
+               for k in GEOSTATIC}
+        return None if None in out.values() else out
     if rows is None:
         r.fail(f"{where}.stress", "missing: 3 rows of 3 components, (x, y, z); axisymmetric "
-                                  "(r, z, θ)")
+                                  "(r, z, θ); or a geostatic unit_weight, K0, surface")
         return None
     if not (isinstance(rows, list) and len(rows) == 3):
         r.fail(f"{where}.stress", f"must be 3 rows of 3 components, got {rows!r}")

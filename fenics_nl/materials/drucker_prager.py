@@ -79,9 +79,10 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
     phi: float = 30.0
     psi: float | None = None
     fit: str = "compression"
-    # the stress at ε = 0 (in situ: the ground's before any work), 3x3 in the model's
-    # components; None: 0. Not a case file's material key: its [initial_stress] table
-    initial_stress: tuple | None = field(default=None, metadata={"case": False})
+    # the stress at ε = 0 (in situ: the ground's before any work): 3x3 in the model's
+    # components (uniform), or geostatic {"unit_weight", "K0", "surface"}; None: 0. Not a
+    # case file's material key: its [initial_stress] table
+    initial_stress: tuple | dict | None = field(default=None, metadata={"case": False})
     state: PlasticState = field(default_factory=PlasticState, init=False, repr=False,
                                 compare=False)
 
@@ -97,19 +98,36 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
             raise ValueError(f"psi must be in [0, phi = {self.phi}] degrees (the dilatancy "
                              f"angle), got {self.psi!r}")
         cone(self.phi, self.fit)  # the fit is known
-        if self.initial_stress is not None:
-            s0 = [[float(x) for x in row] for row in self.initial_stress]
-            if len(s0) != 3 or any(len(row) != 3 for row in s0) or any(
-                    s0[i][j] != s0[j][i] for i in range(3) for j in range(3)):
-                raise ValueError("initial_stress must be a symmetric 3x3 stress, got "
-                                 f"{self.initial_stress!r}")
+        s0 = self.initial_stress
+        if isinstance(s0, dict):
+            if set(s0) != {"unit_weight", "K0", "surface"} or not (
+                    s0["unit_weight"] > 0 and s0["K0"] > 0 and math.isfinite(s0["surface"])):
+                raise ValueError("initial_stress (geostatic) takes unit_weight > 0, K0 > 0 "
+                                 f"and a finite surface, got {s0!r}")
+        elif s0 is not None:
+            rows = [[float(x) for x in row] for row in s0]
+            if len(rows) != 3 or any(len(row) != 3 for row in rows) or any(
+                    rows[i][j] != rows[j][i] for i in range(3) for j in range(3)):
+                raise ValueError(f"initial_stress must be a symmetric 3x3 stress, got {s0!r}")
 
-    @property
-    def sigma_0(self):
-        """The initial stress as a UFL tensor (0 if none)."""
-        if self.initial_stress is None:
+    def initial(self, like):
+        """σ_0, the initial stress (UFL, 3x3; 0 if none) on the domain of `like`.
+
+        Geostatic: the vertical axis is the mesh's last (y in 2D and axisymmetric, z in
+        3D); σ_v = −γ (surface − height), the others K0 σ_v, no shear.
+        """
+        s0 = self.initial_stress
+        if s0 is None:
             return ufl.zero(3, 3)
-        return ufl.as_matrix([[float(x) for x in row] for row in self.initial_stress])
+        if not isinstance(s0, dict):
+            return ufl.as_matrix([[float(x) for x in row] for row in s0])
+        from ufl.domain import extract_unique_domain
+
+        x = ufl.SpatialCoordinate(extract_unique_domain(like))
+        up = x.ufl_shape[0] - 1
+        vertical = -s0["unit_weight"] * (s0["surface"] - x[up])
+        return ufl.diag(ufl.as_vector([vertical if i == up else s0["K0"] * vertical
+                                       for i in range(3)]))
 
     @property
     def dilatancy(self) -> float:
@@ -152,7 +170,7 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
                              "return map's, not a derivative")
         eps_p, _, _ = self.return_map(eps)
         return (LinearElastic(self.E, self.nu).energy(eps - eps_p)
-                + ufl.inner(self.sigma_0, eps - eps_p)
+                + ufl.inner(self.initial(eps), eps - eps_p)
                 + self.apex * ufl.tr(eps_p - self._bound().eps_p))
 
     def stress(self, eps):
@@ -161,7 +179,7 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         Args:
             eps: the small strain ε (UFL, 3x3).
         """
-        return self.sigma_0 + super().stress(eps)
+        return self.initial(eps) + super().stress(eps)
 
     def return_map(self, eps):
         """(ε_p, p̄, Δp̄) at the strain ε from the committed state (UFL; module docstring).
@@ -178,8 +196,9 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         eta_bar, _ = cone(self.dilatancy, self.fit)
         G, K = self.mu, self.kappa
         eps_e = eps - st.eps_p
-        s_tr = ufl.dev(self.sigma_0) + 2 * G * ufl.dev(eps_e)
-        p_tr = ufl.tr(self.sigma_0) / 3 + K * ufl.tr(eps_e)
+        sigma_0 = self.initial(eps)
+        s_tr = ufl.dev(sigma_0) + 2 * G * ufl.dev(eps_e)
+        p_tr = ufl.tr(sigma_0) / 3 + K * ufl.tr(eps_e)
         root_j2 = ufl.sqrt(0.5 * ufl.inner(s_tr, s_tr))
         f = root_j2 + eta * p_tr - xi * self.c
         # a point left on the cone by the last step has f = 0 up to round-off: it starts
