@@ -33,7 +33,8 @@ class Cube:
     """The unit cube, u_i = 0 on x_i = 0; the top z = 1 moved by `top` (u_z) and the
     sides x = 1, y = 1 under the pressure `confining` (or moved by `side`: u = side x)."""
 
-    def __init__(self, law, confining=0.0, pulled=False, comm=MPI.COMM_WORLD):
+    def __init__(self, law, confining=0.0, pulled=False, comm=MPI.COMM_WORLD,
+                 confined=(0, 1)):
         self.mesh = m = mesh.create_unit_cube(comm, 1, 1, 1)
         V = fem.functionspace(m, ("Lagrange", 1, (3,)))
         self.u, v = fem.Function(V), ufl.TestFunction(V)
@@ -42,8 +43,8 @@ class Cube:
         dx = kinematics.quadrature_measure("dx", m, 2)
         sides = [mesh.locate_entities_boundary(m, 2, lambda x, i=i: np.isclose(x[i], 1))
                  for i in range(3)]
-        tags = mesh.meshtags(m, 2, np.concatenate(sides[:2]),
-                             np.ones(sum(len(s) for s in sides[:2]), dtype=np.int32))
+        loaded = np.unique(np.concatenate([sides[i] for i in confined]))
+        tags = mesh.meshtags(m, 2, loaded.astype(np.int32), np.ones(len(loaded), np.int32))
         ds = ufl.Measure("ds", m, subdomain_data=tags)
         n = ufl.FacetNormal(m)
         self.residual = (law.internal_work(self.u, v) * dx
@@ -52,7 +53,10 @@ class Cube:
                 for i in range(3)]
         self.moved = [boundary.component(V, i, sides[i], 0.0)
                       for i in range(0 if pulled else 2, 3)]
-        bcs = [boundary.component(V, i, f) for i, f in enumerate(zero)] + self.moved
+        # a side neither confined nor moved is held: plane strain across it
+        held = [boundary.component(V, i, sides[i]) for i in (0, 1)
+                if i not in confined and not pulled]
+        bcs = [boundary.component(V, i, f) for i, f in enumerate(zero)] + self.moved + held
         self.solver = NewtonSolver(self.residual, self.u, bcs, rtol=1e-13, atol=1e-13,
                                    force_scale=C, max_it=20, prefix=f"cube{id(self)}_")
         self.sigma = [fem.form(law.stress(kinematics.small_strain(self.u))[i, i] * dx)
@@ -145,6 +149,23 @@ def test_the_triaxial_path_on_two_ranks_gives_the_serial_answer():
     assert runs[0] == pytest.approx(runs[1], rel=1e-12)
 
 
+def test_the_plane_strain_cone_fails_as_mohr_coulomb_in_plane_strain():
+    # the cube held across y (plane strain), confined along x at 2c, pushed along z: with
+    # the plane-strain fit and associated flow the plateau is Mohr–Coulomb's, σ1 = (2c cosφ
+    # + σ3 (1 + sinφ)) / (1 − sinφ) (compression positive; σ_yy the intermediate stress),
+    # reached once the flow is steady, ε_yy^p no longer changing: −8e-4 at 3 times the
+    # peak's elastic strain, 7e-12 at 12 times; at 30 times to 1e-9 (the fit's own claim,
+    # on the return map)
+    law = DruckerPrager(E, NU, c=C, phi=PHI, fit="plane_strain")
+    cube = Cube(law, confining=2.0 * C, confined=(0,))
+    s = math.sin(math.radians(PHI))
+    major = (2 * C * math.cos(math.radians(PHI)) + 2.0 * C * (1 + s)) / (1 - s)
+    sigma = cube.go(-np.geomspace(0.5, 30.0, 8) * major / E)
+    assert -sigma[-1][2] == pytest.approx(major, rel=1e-9)
+    assert sigma[-1][0] == pytest.approx(-2.0 * C, rel=1e-9)
+    assert sigma[-1][2] < sigma[-1][1] < sigma[-1][0]  # σ_yy the intermediate one
+
+
 @pytest.mark.parametrize("kwargs,message", [
     ({"c": 0.0}, "c must be > 0"), ({"phi": 0.0}, "phi must be in"),
     ({"phi": 90.0}, "phi must be in"), ({"psi": 40.0}, r"psi must be in \[0, phi = 30"),
@@ -228,7 +249,9 @@ def test_a_triaxial_case_file_fails_at_the_mohr_coulomb_peak(tmp_path, demo):
     for change, said in ((('model = "3d"', 'model = "3d"\nformulation = "mixed"\ndegree = 2'),
                           'mesh.formulation: drucker-prager takes the displacement'),
                          (("psi = 10.0", "psi = 40.0"),
-                          "material.psi: must be in [0, phi = 30.0]")):
+                          "material.psi: must be in [0, phi = 30.0]"),
+                         (("[loading]", '[solver]\nlinear_solver = "gamg"\n\n[loading]'),
+                          "solver.linear_solver: gamg is CG")):
         (tmp_path / "bad.toml").write_text(TRIAXIAL.replace(*change))
         proc = demo.run(["-m fenics_nl", "check", tmp_path / "bad.toml"], check=False)
         assert proc.returncode == 2 and said in proc.stderr, proc.stderr
@@ -379,4 +402,11 @@ def test_a_geostatic_column_under_a_surcharge_is_oedometric(tmp_path, demo):
         'group = "right"\ndisplacement = [0.0, "free"]', 'group = "right"\ntraction = [0.0, 0.0]'))
     proc = demo.run(["-m fenics_nl", "run", tmp_path / "loose.toml"], check=False)
     assert proc.returncode == 2 and "initial_stress: not in equilibrium" in proc.stderr, \
+        proc.stderr
+    # K0 = 0.3 below the active limit of φ = 20°, c = 5: the in-situ stress is outside the
+    # cone below about 2 m (f = 5.9 at the base): refused, not projected by the first step
+    (tmp_path / "weak.toml").write_text(COLUMN.replace("c = 1000.0", "c = 5.0").replace(
+        "phi = 30.0", "phi = 20.0").replace("K0 = 0.5", "K0 = 0.3"))
+    proc = demo.run(["-m fenics_nl", "run", tmp_path / "weak.toml"], check=False)
+    assert proc.returncode == 2 and "initial_stress: outside the yield cone" in proc.stderr, \
         proc.stderr

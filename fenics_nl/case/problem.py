@@ -219,6 +219,41 @@ class CaseProblem:
         return ufl.as_vector([-s0["unit_weight"] if i == dim - 1 else 0.0
                               for i in range(dim)])
 
+    def _initial_admissible(self) -> None:
+        """Refuse an initial stress outside the yield cone at a quadrature point.
+
+        The first step would project it onto the cone, as if a load had done so.
+        """
+        from mpi4py import MPI
+
+        from fenics_nl.expression import Expression
+
+        law, Q = self.material, self.material.quadrature_space()
+        s0 = self.case.initial_stress
+        n = Q.dofmap.index_map.size_local
+        if isinstance(s0, dict):  # geostatic: at each quadrature point
+            f = fem.Function(Q)
+            eps_v = kinematics.small_strain(self.fields.v, self.model)
+            f.interpolate(Expression(law.yield_function(law.initial(eps_v)),
+                                     Q.element.interpolation_points))
+            values = f.x.array[:n]
+        else:  # uniform: one value
+            sigma = np.array(s0, dtype=float)
+            dev = sigma - np.trace(sigma) / 3 * np.eye(3)
+            eta, xi = law.cone_constants
+            values = np.array([math.sqrt(0.5 * np.sum(dev * dev)) + eta * np.trace(sigma) / 3
+                               - xi * law.c])
+        worst = self.mesh.comm.allreduce(float(values.max(initial=-np.inf)), op=MPI.MAX)
+        scale = law.c * law.cone_constants[1]
+        if worst > 1e-9 * scale:
+            outside = self.mesh.comm.allreduce(int((values > 1e-9 * scale).sum()))
+            where = (f"at {outside} quadrature point(s)" if isinstance(s0, dict) else
+                     "(uniform: everywhere)")
+            raise CaseError([f"initial_stress: outside the yield cone {where} (the largest "
+                             f"f = {worst:.3g}, ξ c = {scale:.3g}): the "
+                             "ground could not stand in it (a K0 below the active limit, a "
+                             "surface below the mesh's top?)"])
+
     def _ramped(self, value, start):
         """A load at the load factor t: t × value, or start + t (value − start) ({ from, to })."""
         return self.t * value if start is None else start + self.t * (value - start)
@@ -243,9 +278,11 @@ class CaseProblem:
         for form in (self.residual, own):
             b = petsc.assemble_vector(fem.form(form))
             b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            petsc.set_bc(b, self.bcs, alpha=0.0)
-            norms.append(b.norm())
+            if form is self.residual:  # (σ0's own forces with the supports' rows: a scale
+                petsc.set_bc(b, self.bcs, alpha=0.0)  # that is not round-off when they
+            norms.append(b.norm())  # hold all of them)
         self.t.value = saved
+        self._initial_admissible()
         if norms[0] > 1e-9 * max(norms[1], 1e-300):
             raise CaseError([f"initial_stress: not in equilibrium with the loads at load "
                              f"factor 0 and the supports: they leave {norms[0]:.3g} of its "

@@ -592,6 +592,17 @@ def read_case(path: str | Path) -> Case:
             r.fail(key, message)
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
+    psi, phi = parameters.get("psi"), parameters.get("phi")
+    if law == "drucker-prager" and psi is not None and phi is not None and psi < phi:
+        # a tangent that is not symmetric: MUMPS's LU takes it, CG does not
+        if linear == "gamg":
+            r.fail("solver.linear_solver", f"gamg is CG: psi = {psi} < phi = {phi} makes the "
+                                           "tangent not symmetric; use lu")
+        for c in conditions:
+            if c.kind == "contact":
+                r.fail(c.key, f"psi = {psi} < phi = {phi} (a tangent not symmetric) with a "
+                              "rigid obstacle: not built (its solves reuse a factorization "
+                              "under CG)")
     if pairs:
         _pair_limits(r, pairs, model, degree, formulation, law, newton, linear, conditions,
                      arc)

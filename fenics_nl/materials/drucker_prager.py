@@ -140,6 +140,11 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         return self.dilatancy == self.phi
 
     @property
+    def cone_constants(self) -> tuple[float, float]:
+        """(η, ξ) of the yield cone."""
+        return cone(self.phi, self.fit)
+
+    @property
     def apex(self) -> float:
         """The mean stress p = ξ c / η at the cone's apex (tension: the most it bears)."""
         eta, xi = cone(self.phi, self.fit)
@@ -201,9 +206,9 @@ class DruckerPrager(SmallStrainPlasticity, Isotropic, SmallStrain):
         p_tr = ufl.tr(sigma_0) / 3 + K * ufl.tr(eps_e)
         root_j2 = ufl.sqrt(0.5 * ufl.inner(s_tr, s_tr))
         f = root_j2 + eta * p_tr - xi * self.c
-        # a point left on the cone by the last step has f = 0 up to round-off: it starts
-        # the next step elastic (as J2's)
-        plastic = ufl.gt(f, YIELD_TOLERANCE * xi * self.c)
+        # a point left on the cone by the last step has f = 0 up to round-off (of the
+        # terms f is made of): it starts the next step elastic (as J2's)
+        plastic = ufl.gt(f, YIELD_TOLERANCE * (xi * self.c + eta * abs(p_tr)))
         dgamma = f / (G + K * eta * eta_bar)
         on_cone = ufl.And(plastic, ufl.ge(root_j2, G * dgamma))
         at_apex = ufl.And(plastic, ufl.lt(root_j2, G * dgamma))
