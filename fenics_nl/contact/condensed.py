@@ -184,12 +184,20 @@ class CondensedSaddle:
                 gap, a spring across a slip).
             frame: Q, an orthonormal sparse matrix (rows × rows) whose columns are new
                 rows in the blocks' (a 3D slipping node's tangential rows turned along and
-                across its slip), or None. With it every argument and the answer are the
-                new rows' (forces Qᵀλ, conditions Qᵀr) and S is QᵀSQ.
+                across its slip), or None. With it `unknown`, `known`, `residual` and
+                `compliance` are the new rows' (forces Qᵀλ, conditions Qᵀr; S is QᵀSQ);
+                `before` and the answer stay the blocks' rows'.
 
         Returns:
             Every row's new force (0 outside `unknown` and the given ones).
         """
+        if frame is None:
+            return self._solve(before, unknown, known, residual, work, compliance)
+        return frame @ self._solve(frame.T @ before, unknown, known, residual, work,
+                                   compliance, frame)
+
+    def _solve(self, before, unknown, known, residual, work, compliance=None, frame=None):
+        """`solve` with every force and condition the frame's rows' (`before` too)."""
         after = known.copy()
         loaded = np.flatnonzero(before)
         rows = np.union1d(np.union1d(unknown, np.flatnonzero(known)), loaded)

@@ -665,47 +665,26 @@ class PairContact:
                    compliance=None, frame=None) -> bool:
         """The statuses' equilibrium on the kept factorization; False if it cannot be.
 
-        First the equilibrium with the forces now (a back-substitution, only if the loads
-        moved since: R(u) − Bᵀλ ≠ 0), then the forces of the `unknown` rows that zero their
-        `conditions()` (gaps, slips) with the `known` ones given, u moved by their columns.
-        Checked, as a Newton solve checks its answer: R(u) − Bᵀλ = 0 and the conditions met
-        to 1e-12 of the bodies' size. K singular (a body held by the contact alone) or a
-        residual not linear in u fails the check: the state is put back, said, and from
-        then on each set is a saddle point factorized (False). With a `frame` Q (rows
-        turned, `CondensedSaddle.solve`), `unknown`, `known`, `compliance` and
-        `conditions()` are the turned rows'.
+        The forces of the `unknown` rows that zero their `conditions()` (gaps, slips) with
+        the `known` ones given (`_defer`). Inside `solve`'s loop u moves at its end; called
+        on its own (`equilibrium`), the load's back-substitution first (`_begin`) and u
+        moved and checked after (`_settle`). K singular (a body held by the contact alone)
+        or a residual not linear in u fails: the state is put back, said, and from then on
+        each set is a saddle point factorized (False). With a `frame` Q (rows turned,
+        `CondensedSaddle.solve`), `unknown`, `known`, `compliance` and `conditions()` are
+        the turned rows'.
         """
         c = self.condensed
         saved = self.u.x.array.copy(), self._rows()
+        alone = self._values is None
+        if alone:
+            self._begin(work)
+            if self.condensed is None:  # (K singular: said by `_begin`)
+                return False
         try:
-            if self._values is not None:  # inside `solve`: the forces move, u later
-                self._defer(unknown, known, conditions, work, compliance, frame)
-                return True
-            r = self._out_of_balance(work)
-            before = saved[1]
-            reference = self.scale if self.scale is not None else max(
-                r.norm(), float(np.linalg.norm(before)))
-            if r.norm() > self.rel * reference:  # the loads moved: the new u_0 (+ W λ)
-                self.u.x.petsc_vec.axpy(-1.0, c.back_solve(r, work))
-                self.u.x.scatter_forward()
-                work.linear_solves += 1
-            if frame is None:
-                after = c.solve(before, unknown, known, conditions(), work, compliance)
-            else:
-                after = frame @ c.solve(frame.T @ before, unknown, known, conditions(), work,
-                                        compliance, frame)
-            c.move(self.u.x.petsc_vec, before, after, work)
-            self.u.x.scatter_forward()
-            self._set_rows(after)
-            norm = self._out_of_balance(work).norm()
-            if self.scale is None:
-                reference = max(reference, float(np.linalg.norm(after)))
-            left = np.abs(conditions()[unknown]).max(initial=0.0)
-            if not (norm <= self.rel * reference and left <= 1e-12 * self.pair.length):
-                raise SolveError(f"the condensed solve left |R| = {norm:.2e} and conditions "
-                                 f"{left:.2e} (K singular, a body held by the contact "
-                                 "alone; or a residual not linear in u)")
-            self.free_motions, self._load = c.free_motions, reference
+            self._defer(unknown, known, conditions, work, compliance, frame)
+            if alone:
+                self._settle(work)
             return True
         except (SolveError, np.linalg.LinAlgError, PETSc.Error) as err:
             self.u.x.array[:] = saved[0]
@@ -748,11 +727,7 @@ class PairContact:
     def _defer(self, unknown, known, conditions, work, compliance, frame) -> None:
         """The statuses' forces on the kept factorization; the rows' values moved by S."""
         c, before = self.condensed, self._rows()
-        if frame is None:
-            after = c.solve(before, unknown, known, conditions(), work, compliance)
-        else:
-            after = frame @ c.solve(frame.T @ before, unknown, known, conditions(), work,
-                                    compliance, frame)
+        after = c.solve(before, unknown, known, conditions(), work, compliance, frame)
         change = after - before
         rows = np.flatnonzero(change)
         if len(rows):
@@ -781,7 +756,8 @@ class PairContact:
         off = float(np.abs(self._block_values() - predicted).max(initial=0.0))
         if not (norm <= self.rel * reference and off <= 1e-12 * self.pair.length):
             raise _Unsettled(f"the condensed solve left |R| = {norm:.2e} and its rows "
-                             f"{off:.2e} off (a residual not linear in u)")
+                             f"{off:.2e} off (K singular, a body held by the contact "
+                             "alone; or a residual not linear in u)")
         self.free_motions, self._load = c.free_motions, reference
 
     def _block_values(self) -> np.ndarray:
@@ -1332,7 +1308,6 @@ class ArchardWear:
         self.contact = contact
         self.k = k[contact.pair.part] if k.ndim else k
         self.depth = np.zeros(len(contact.pair.slave))  # each owned slave node's wear
-        self.volume = 0.0  # the worn volume so far (every rank's)
         self.distance = 0.0
 
     def slide(self, ds) -> SolveResult:
@@ -1357,9 +1332,13 @@ class ArchardWear:
         dh = c * np.where(contact.active, contact.lam, 0.0)
         self.depth += dh
         pair.open(dh)  # the worn slave surface moves away from the master
-        self.volume += pair.total(dh * pair.areas)
         self.distance = self.distance + ds  # (one per pair if ds is)
         return result
+
+    @property
+    def volume(self) -> float:
+        """The worn volume so far, Σ h_s A_s (every rank's)."""
+        return float(self.volumes().sum())
 
     def volumes(self) -> np.ndarray:
         """The worn volume of each pair (`ContactPair.part`; every rank's)."""
@@ -1369,8 +1348,8 @@ class ArchardWear:
                          for k in range(parts)])
 
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
-        """The wear so far: each owned slave node's depth, the volume and the distance."""
-        return {"depth": self.depth.copy(), "volume": np.array([self.volume]),
+        """The wear so far: each owned slave node's depth and the distance."""
+        return {"depth": self.depth.copy(),
                 "distance": np.atleast_1d(self.distance).astype(float)}
 
     def restore_arrays(self, arrays: dict[str, np.ndarray]) -> None:
@@ -1378,6 +1357,5 @@ class ArchardWear:
         pair = self.contact.pair
         pair.open(arrays["depth"] - self.depth)
         self.depth = arrays["depth"].copy()
-        self.volume = float(arrays["volume"][0])
         distance = arrays["distance"].copy()
         self.distance = distance if np.ndim(self.distance) else float(distance[0])
