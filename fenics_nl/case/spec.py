@@ -604,7 +604,7 @@ def read_case(path: str | Path) -> Case:
                               "rigid obstacle: not built (its solves reuse a factorization "
                               "under CG)")
     if pairs:
-        _pair_limits(r, pairs, model, degree, formulation, law, newton, linear, conditions,
+        _pair_limits(r, pairs, degree, formulation, law, newton, linear, conditions,
                      arc)
     probes = _probes(r, data, dim)
     if arc is not None and arc["stop"] is not None and model is not None:
@@ -677,7 +677,7 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
     return out
 
 
-def _pair_limits(r: _Reader, pairs, model, degree, formulation, law, newton, linear,
+def _pair_limits(r: _Reader, pairs, degree, formulation, law, newton, linear,
                  conditions, arc) -> None:
     """What a case with [[contact]] pairs cannot take, each said (`contact.pair`'s reach)."""
     if degree is not None and degree != 1:
