@@ -1,0 +1,178 @@
+"""Mohr–Coulomb plasticity of soils, returned exactly to its planes, edges and apex.
+
+Stresses are positive in tension; σ1 ≥ σ2 ≥ σ3 are the principal stresses. The yield
+function and the flow potential (de Souza Neto, Perić & Owen, *Computational Methods for
+Plasticity*, 2008, §8.2: the same planes, written here for our sign) are
+
+    f = (σ1 − σ3) + (σ1 + σ3) sinφ − 2c cosφ,      g = (σ1 − σ3) + (σ1 + σ3) sinψ,
+
+a hexagonal pyramid about the hydrostatic axis with its apex at p = c cotφ. A triaxial
+compression test fails at q = 6c cosφ/(3 − sinφ) + 6 p' sinφ/(3 − sinφ) (p' = −p), where
+Drucker–Prager's compression cone touches it.
+
+The return (perfect plasticity) is the multi-surface one in principal stresses: from the
+sorted trial stresses, onto the main plane (f = 0 with σ1 ≥ σ2 ≥ σ3 kept); if that breaks
+the order, onto the edge it crosses (σ1 = σ2 or σ2 = σ3: the two planes that meet there,
+two multipliers); if the edge's point passes the apex, the apex. Each is a linear system
+of constant coefficients (the elastic moduli, φ and ψ), solved once in Python: the return
+is a closed form of the trial principal stresses, written in UFL, and its UFL derivative the
+consistent tangent (not symmetric when ψ < φ). The principal directions do not turn: the
+plastic strain is C⁻¹ : (σ_tr − σ) and shares them.
+
+Models: plane strain and axisymmetric, whose third direction (z, or the hoop) is principal;
+the in-plane pair is a 2x2 eigenproblem in closed form. 3D (a 3x3 eigen-decomposition, not
+in UFL) is not built: Drucker–Prager is.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+
+from fenics_nl.materials.plasticity import YIELD_TOLERANCE
+from fenics_nl.materials.soil import SoilPlasticity
+
+__all__ = ["MohrCoulomb"]
+
+# the planes of the sorted principal stresses (σ1, σ2, σ3), by the pair they join: "13"
+# the main plane, "23" (σ2 in σ1's place) crossed at the edge σ1 = σ2, "12" (σ2 in σ3's
+# place) at the edge σ2 = σ3
+PLANES = {"13": (0, 2), "23": (1, 2), "12": (0, 1)}
+
+
+def plane(pair: str, sine: float) -> np.ndarray:
+    """The normal of a plane (σ_i − σ_j) + (σ_i + σ_j) sin a in principal stresses."""
+    i, j = PLANES[pair]
+    k = np.zeros(3)
+    k[i], k[j] = 1.0 + sine, -(1.0 - sine)
+    return k
+
+
+@dataclass(frozen=True, eq=False)
+class MohrCoulomb(SoilPlasticity):
+    """Mohr–Coulomb plasticity (perfect): cohesion c > 0, angles φ and ψ in degrees.
+
+    0 < φ < 90°, 0 ≤ ψ ≤ φ (ψ = None: φ, associated). Models: plane strain and
+    axisymmetric (module docstring).
+    """
+
+    @property
+    def yield_scale(self) -> float:
+        """2c cosφ, f's constant term (the tolerances' scale)."""
+        return 2.0 * self.c * math.cos(math.radians(self.phi))
+
+    @property
+    def apex(self) -> float:
+        """The mean stress p = c cotφ at the pyramid's apex (tension: the most it bears)."""
+        return self.c / math.tan(math.radians(self.phi))
+
+    def yield_function(self, sigma):
+        """f(σ) = (σ1 − σ3) + (σ1 + σ3) sinφ − 2c cosφ (UFL): ≤ 0 inside.
+
+        Args:
+            sigma: a stress (UFL, 3x3) whose third direction is principal.
+        """
+        s1, _, s3 = principal(sigma)[0]
+        sine = math.sin(math.radians(self.phi))
+        return (s1 - s3) + (s1 + s3) * sine - self.yield_scale
+
+    def return_map(self, eps):
+        """(ε_p, p̄, Δp̄) at the strain ε from the committed state (UFL; module docstring).
+
+        Args:
+            eps: the small strain ε (UFL, 3x3) of a plane-strain or axisymmetric model.
+
+        Returns:
+            (plastic strain ε_p, cumulated plastic strain p̄, its increment), UFL.
+        """
+        self.require_3x3(eps)
+        from ufl.domain import extract_unique_domain
+
+        if extract_unique_domain(eps).geometric_dimension == 3:
+            raise ValueError("MohrCoulomb takes the plane-strain and axisymmetric models (their "
+                             "third direction is principal); in 3D use DruckerPrager")
+        sigma_tr = self.trial(eps)
+        (s1, s2, s3), back = principal(sigma_tr)
+        s = ufl.as_vector([s1, s2, s3])
+        sphi, spsi = (math.sin(math.radians(a)) for a in (self.phi, self.dilatancy))
+        f = ufl.dot(ufl.as_vector(plane("13", sphi)), s) - self.yield_scale
+        # a point left on the surface by the last step starts the next one elastic (as
+        # Drucker–Prager's: round-off of the terms f is made of)
+        plastic = ufl.gt(f, YIELD_TOLERANCE * (self.yield_scale + sphi * abs(s1 + s3)))
+        main = self._returned(s, ("13",), sphi, spsi)
+        ordered = ufl.And(ufl.ge(main[0], main[1]), ufl.ge(main[1], main[2]))
+        # the edge the main return crosses first: σ1 = σ2 if σ1 − σ2 closes before σ2 − σ3
+        first_12 = ufl.lt((1 - spsi) * (s1 - s2), (1 + spsi) * (s2 - s3))
+        edge = [ufl.conditional(first_12, a, b) for a, b in zip(
+            self._returned(s, ("13", "23"), sphi, spsi),
+            self._returned(s, ("13", "12"), sphi, spsi), strict=True)]
+        below_apex = ufl.ge(edge[0], edge[2])
+        d_sigma = [ufl.conditional(plastic, ufl.conditional(
+            ordered, s[i] - main[i], ufl.conditional(below_apex, s[i] - edge[i],
+                                                     s[i] - self.apex)), 0.0)
+                   for i in range(3)]
+        d_sigma = back(d_sigma)
+        G, K = self.mu, self.kappa
+        d_eps_p = ufl.dev(d_sigma) / (2 * G) + ufl.tr(d_sigma) / (9 * K) * ufl.Identity(3)
+        return (self._bound().eps_p + d_eps_p, *self.cumulated(d_eps_p, plastic))
+
+    def _returned(self, s, pairs, sphi, spsi):
+        """The sorted principal stresses returned onto the planes `pairs` (UFL, 3 values).
+
+        σ = σ_tr − D Σ Δγ_a n_a with k_b · σ = 2c cosφ on each plane b: the multipliers
+        solve M Δγ = k · σ_tr − 2c cosφ, M_ba = k_b · D n_a (constants, solved here).
+        """
+        lam, G = self.kappa - 2.0 * self.mu / 3.0, self.mu
+        D = 2.0 * G * np.eye(3) + lam * np.ones((3, 3))
+        k = np.array([plane(p, sphi) for p in pairs])
+        n = np.array([plane(p, spsi) for p in pairs])
+        L = D @ n.T @ np.linalg.inv(k @ D @ n.T)  # Δσ = L (k σ_tr − 2c cosφ)
+        f = [ufl.dot(ufl.as_vector(kb), s) - self.yield_scale for kb in k]
+        return [s[i] - sum(float(L[i, b]) * f[b] for b in range(len(pairs)))
+                for i in range(3)]
+
+
+def principal(sigma):
+    """The sorted principal values of a stress whose third direction is principal (UFL).
+
+    The in-plane pair is m ± R, R = √(((σ_xx − σ_yy)/2)² + σ_xy²); σ_zz (the third)
+    takes its rank among them.
+
+    Args:
+        sigma: a stress (UFL, 3x3) with σ_xz = σ_yz = 0.
+
+    Returns:
+        ((σ1, σ2, σ3), back): `back` turns three values along the sorted directions into
+        the 3x3 tensor with the stress's principal directions (UFL).
+    """
+    a, b, xy, z = sigma[0, 0], sigma[1, 1], sigma[0, 1], sigma[2, 2]
+    m, half = (a + b) / 2, (a - b) / 2
+    square = half * half + xy * xy
+    # R's root has no derivative at 0 (an in-plane pair that coincides): below round-off
+    # of the stress it is taken as that round-off, a constant
+    tiny = (1e-14 * (abs(a) + abs(b) + abs(xy))) ** 2 + 1e-300
+    big = ufl.gt(square, tiny)
+    R = ufl.sqrt(ufl.conditional(big, square, tiny))
+    hi, lo = m + R, m - R
+    z_first, z_last = ufl.ge(z, hi), ufl.lt(z, lo)
+    s1 = ufl.conditional(z_first, z, hi)
+    s3 = ufl.conditional(z_last, z, lo)
+    s2 = ufl.conditional(z_first, hi, ufl.conditional(z_last, lo, z))
+
+    def back(values):
+        v1, v2, v3 = values
+        v_hi = ufl.conditional(z_first, v2, v1)
+        v_lo = ufl.conditional(z_last, v2, v3)
+        v_z = ufl.conditional(z_first, v1, ufl.conditional(z_last, v3, v2))
+        # the in-plane pair along the pair's directions: its mean, and its half-difference
+        # along (σ − m I) / R (0 where the pair coincides: no direction, no difference)
+        ratio = ufl.conditional(big, (v_hi - v_lo) / (2 * R), 0.0)
+        mean = (v_hi + v_lo) / 2
+        return ufl.as_matrix([[mean + ratio * half, ratio * xy, 0],
+                              [ratio * xy, mean - ratio * half, 0],
+                              [0, 0, v_z]])
+
+    return (s1, s2, s3), back

@@ -1,0 +1,167 @@
+"""Mohr–Coulomb plasticity (issue 59): a homogeneous square against the exact return paths.
+
+The unit square held by rollers on x = 0 and y = 0 is a homogeneous point of the
+axisymmetric model (x the radius: σ_θθ = σ_rr, a triaxial test) or of the plane-strain one
+(σ_zz the intermediate stress). Each path ends on a different part of the pyramid: a
+triaxial compression on the edge σ1 = σ2, an extension on the edge σ2 = σ3, a plane-strain
+compression on the main plane, an equal pull at the apex. The tangent is consistent
+(Taylor's slope 2) on the plane and on an edge, with and without associated flow.
+"""
+
+import math
+
+import numpy as np
+import pytest
+import ufl
+from conftest import taylor_remainders
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from fenics_nl.domain import boundary
+from fenics_nl.materials import kinematics
+from fenics_nl.materials.mohr_coulomb import MohrCoulomb
+from fenics_nl.solvers.loading import solve_incrementally
+from fenics_nl.solvers.newton import NewtonSolver
+
+E, NU, C, PHI = 5000.0, 0.3, 1.0, 30.0
+SIN = math.sin(math.radians(PHI))
+COS = math.cos(math.radians(PHI))
+
+
+class Square:
+    """The unit square, u_x = 0 on x = 0, u_y = 0 on y = 0; the top y = 1 moved by `top`
+    (u_y) and the side x = 1 under the pressure `confining` (or moved: u = e x on both)."""
+
+    def __init__(self, law, model, confining=0.0, pulled=False, comm=MPI.COMM_WORLD):
+        self.mesh = m = mesh.create_unit_square(comm, 1, 1)
+        V = fem.functionspace(m, ("Lagrange", 1, (2,)))
+        self.u, v = fem.Function(V), ufl.TestFunction(V)
+        law.bind(m, 2)
+        self.law, self.model = law, model
+        w = kinematics.measure_weight(m, model)
+        dx = kinematics.quadrature_measure("dx", m, 2)
+        sides = [mesh.locate_entities_boundary(m, 1, lambda x, i=i: np.isclose(x[i], 1))
+                 for i in range(2)]
+        tags = mesh.meshtags(m, 1, sides[0].astype(np.int32),
+                             np.ones(len(sides[0]), np.int32))
+        ds = ufl.Measure("ds", m, subdomain_data=tags)
+        n = ufl.FacetNormal(m)
+        self.residual = (law.internal_work(self.u, v, model) * dx
+                         + confining * ufl.dot(n, v) * w * ds(1))
+        zero = [mesh.locate_entities_boundary(m, 1, lambda x, i=i: np.isclose(x[i], 0))
+                for i in range(2)]
+        self.moved = [boundary.component(V, i, sides[i], 0.0)
+                      for i in range(0 if pulled else 1, 2)]
+        bcs = [boundary.component(V, i, f) for i, f in enumerate(zero)] + self.moved
+        self.solver = NewtonSolver(self.residual, self.u, bcs, rtol=1e-13, atol=1e-13,
+                                   force_scale=C, max_it=20, prefix=f"square{id(self)}_")
+        sigma = law.stress(kinematics.small_strain(self.u, model))
+        self.sigma = [fem.form(sigma[i, i] * dx) for i in range(3)]
+        self.eps_p = [fem.form(law.plastic_strain[i, i] * dx) for i in range(3)]
+
+    def go(self, values):
+        """The stresses (σ_xx, σ_yy, σ_zz) after each displacement of the top (a step each)."""
+        out, previous = [], 0.0
+        for d in values:
+            def load(t, a=previous, b=d):
+                for bc in self.moved:
+                    bc.g.x.array[:] = a + t * (b - a)
+
+            solve_incrementally(self.solver, load, 1, adaptive=False, predictor=False,
+                                commit=lambda: self.law.commit(self.u, self.model))
+            out.append([self.total(f) for f in self.sigma])
+            previous = d
+        return np.array(out)
+
+    def total(self, form):
+        return self.mesh.comm.allreduce(fem.assemble_scalar(form))
+
+
+def triaxial_peak(confining: float) -> float:
+    """q = σ_r − σ_a (compression positive) at a triaxial compression's failure: Mohr–Coulomb
+    with σ1 = σ2 = −confining, q = 6c cosφ/(3 − sinφ) + 6 p' sinφ/(3 − sinφ), p' = σ_r + q/3."""
+    A, B = 6 * C * COS / (3 - SIN), 6 * SIN / (3 - SIN)
+    return (A + B * confining) / (1 - B / 3)
+
+
+def taylor_slopes(square, scale):
+    """Taylor's slopes of the residual at the committed plastic state, a step further on."""
+    _, slopes = taylor_remainders(square.residual, square.u, scale, seed=2)
+    return slopes
+
+
+@pytest.mark.parametrize("psi", [30.0, 10.0], ids=["associated", "non-associated"])
+def test_triaxial_compression_fails_on_the_compression_edge(psi):
+    # axisymmetric, confined at 2c, pushed down to 3 times the peak's elastic strain: the
+    # plateau is Mohr–Coulomb's peak (the edge σ1 = σ2 = −2c), σ_θθ = σ_rr; the flow along
+    # the edge's two planes: tr Δε_p / Δε_p,zz = −2 sinψ / (1 − sinψ)
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=psi)
+    square = Square(law, "axisymmetric", confining=2.0 * C)
+    q = triaxial_peak(2.0 * C)
+    sigma = square.go(-np.linspace(0.5, 3.0, 6) * q / E)
+    assert abs(sigma[0][1] + 2.0 * C) < q  # elastic at first
+    for s in sigma[-3:]:
+        assert s[0] == pytest.approx(-2.0 * C, rel=1e-10)
+        assert s[2] == pytest.approx(-2.0 * C, rel=1e-10)
+        assert s[0] - s[1] == pytest.approx(q, rel=1e-10)
+    e = [square.total(f) for f in square.eps_p]
+    spsi = math.sin(math.radians(psi))
+    assert e[0] == pytest.approx(e[2], rel=1e-10)
+    assert sum(e) / e[1] == pytest.approx(-2 * spsi / (1 - spsi), rel=1e-10, abs=1e-12)
+    square.moved[0].g.x.array[:] *= 1.1  # a plastic step on the edge
+    square.solver.solve()
+    assert np.all(taylor_slopes(square, 0.05 * q / E) > 1.9)
+
+
+def test_triaxial_extension_fails_on_the_extension_edge():
+    # axisymmetric, confined at 4c, the top pulled up: the axial stress becomes the major
+    # one, σ2 = σ3 = −4c (the edge σ2 = σ3): σ1 (1 + sinφ) = 2c cosφ + σ3 (1 − sinφ)
+    law = MohrCoulomb(E, NU, c=C, phi=PHI)
+    square = Square(law, "axisymmetric", confining=4.0 * C)
+    major = (2 * C * COS - 4.0 * C * (1 - SIN)) / (1 + SIN)
+    rise = (major + 4.0 * C) / E  # beyond the elastic range
+    sigma = square.go(np.linspace(0.5, 3.0, 6) * rise)
+    for s in sigma[-3:]:
+        assert s[1] == pytest.approx(major, rel=1e-10)
+        assert s[0] == pytest.approx(-4.0 * C, rel=1e-10)
+        assert s[2] == pytest.approx(-4.0 * C, rel=1e-10)
+
+
+@pytest.mark.parametrize("psi", [30.0, 0.0], ids=["associated", "non-dilatant"])
+def test_plane_strain_compression_fails_on_the_main_plane(psi):
+    # plane strain, confined along x at 2c, pushed along y: σ_zz the intermediate stress,
+    # the plateau σ_yy (1 − sinφ) = −2c cosφ + σ_xx (1 + sinφ) on the main plane
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=psi)
+    square = Square(law, "plane_strain", confining=2.0 * C)
+    major = (2 * C * COS + 2.0 * C * (1 + SIN)) / (1 - SIN)  # compression positive
+    sigma = square.go(-np.linspace(0.5, 6.0, 6) * major / E)
+    s = sigma[-1]
+    assert -s[1] == pytest.approx(major, rel=1e-10)
+    assert s[0] == pytest.approx(-2.0 * C, rel=1e-10)
+    assert s[1] < s[2] < s[0]
+    assert square.total(square.eps_p[2]) == pytest.approx(0.0, abs=1e-14)  # n_2 = 0
+    square.moved[0].g.x.array[:] *= 1.1
+    square.solver.solve()
+    assert np.all(taylor_slopes(square, 0.05 * major / E) > 1.9)
+
+
+def test_pulled_equally_the_square_reaches_the_apex():
+    # axisymmetric, u = e x on both sides: σ = p I stops at the apex p = c cotφ
+    law = MohrCoulomb(E, NU, c=C, phi=PHI)
+    square = Square(law, "axisymmetric", pulled=True)
+    apex = C / math.tan(math.radians(PHI))
+    assert law.apex == pytest.approx(apex, rel=1e-14)
+    e = apex / (3 * law.kappa)
+    sigma = square.go(e * np.array([0.5, 1.5, 3.0]))
+    assert sigma[0] == pytest.approx(3 * law.kappa * 0.5 * e * np.ones(3), rel=1e-10)
+    for s in sigma[1:]:
+        assert s == pytest.approx(apex * np.ones(3), rel=1e-10)
+
+
+def test_three_dimensions_are_refused_in_one_line():
+    m = mesh.create_unit_cube(MPI.COMM_WORLD, 1, 1, 1)
+    law = MohrCoulomb(E, NU, c=C, phi=PHI)
+    law.bind(m, 2)
+    u = fem.Function(fem.functionspace(m, ("Lagrange", 1, (3,))))
+    with pytest.raises(ValueError, match="plane-strain and axisymmetric models"):
+        law.stress(kinematics.small_strain(u))
