@@ -408,5 +408,5 @@ def test_a_geostatic_column_under_a_surcharge_is_oedometric(tmp_path, demo):
     (tmp_path / "weak.toml").write_text(COLUMN.replace("c = 1000.0", "c = 5.0").replace(
         "phi = 30.0", "phi = 20.0").replace("K0 = 0.5", "K0 = 0.3"))
     proc = demo.run(["-m fenics_nl", "run", tmp_path / "weak.toml"], check=False)
-    assert proc.returncode == 2 and "initial_stress: outside the yield cone" in proc.stderr, \
+    assert proc.returncode == 2 and "initial_stress: outside the yield surface" in proc.stderr, \
         proc.stderr

@@ -220,37 +220,32 @@ class CaseProblem:
                               for i in range(dim)])
 
     def _initial_admissible(self) -> None:
-        """Refuse an initial stress outside the yield cone at a quadrature point.
+        """Refuse an initial stress outside the yield surface at a quadrature point.
 
-        The first step would project it onto the cone, as if a load had done so.
+        The first step would project it onto the surface, as if a load had done so.
         """
         from mpi4py import MPI
 
         from fenics_nl.expression import Expression
 
         law, Q = self.material, self.material.quadrature_space()
-        s0 = self.case.initial_stress
-        n = Q.dofmap.index_map.size_local
-        if isinstance(s0, dict):  # geostatic: at each quadrature point
-            f = fem.Function(Q)
-            eps_v = kinematics.small_strain(self.fields.v, self.model)
-            f.interpolate(Expression(law.yield_function(law.initial(eps_v)),
-                                     Q.element.interpolation_points))
-            values = f.x.array[:n]
-        else:  # uniform: one value
-            sigma = np.array(s0, dtype=float)
-            dev = sigma - np.trace(sigma) / 3 * np.eye(3)
-            eta, xi = law.cone_constants
-            values = np.array([math.sqrt(0.5 * np.sum(dev * dev)) + eta * np.trace(sigma) / 3
-                               - xi * law.c])
+        eps_v = kinematics.small_strain(self.fields.v, self.model)
+        f = law.yield_function(law.initial(eps_v))
+        geostatic = isinstance(self.case.initial_stress, dict)
+        if geostatic:  # at each point
+            at_points = fem.Function(Q)
+            at_points.interpolate(Expression(f, Q.element.interpolation_points))
+            values = at_points.x.array[:Q.dofmap.index_map.size_local]
+        else:  # uniform: one value (UFL evaluates a constant expression)
+            values = np.array([float(f(()))])
         worst = self.mesh.comm.allreduce(float(values.max(initial=-np.inf)), op=MPI.MAX)
-        scale = law.c * law.cone_constants[1]
+        scale = law.yield_scale
         if worst > 1e-9 * scale:
             outside = self.mesh.comm.allreduce(int((values > 1e-9 * scale).sum()))
-            where = (f"at {outside} quadrature point(s)" if isinstance(s0, dict) else
-                     "(uniform: everywhere)")
-            raise CaseError([f"initial_stress: outside the yield cone {where} (the largest "
-                             f"f = {worst:.3g}, ξ c = {scale:.3g}): the "
+            where = (f"at {outside} quadrature point(s)" if geostatic
+                     else "(uniform: everywhere)")
+            raise CaseError([f"initial_stress: outside the yield surface {where} (the "
+                             f"largest f = {worst:.3g}, against {scale:.3g}): the "
                              "ground could not stand in it (a K0 below the active limit, a "
                              "surface below the mesh's top?)"])
 

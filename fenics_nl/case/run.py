@@ -332,6 +332,8 @@ def step_record(problem: CaseProblem, t: float, result, at: float | None = None)
                 "damage_iterations": d.last.damage_iterations,
                 "dissipated_energy": d.dissipated_energy(),
                 "largest_damage": global_max(problem.mesh.comm, d.alpha.x.array)}
+    if hasattr(problem.material, "plastic_zone"):  # the largest p̄, the plastic share
+        rec |= problem.material.plastic_zone(problem.dx)
     if problem.contact is not None:
         c = problem.solver.contact
         rec["active_set_iterations"] = result.active_set_iterations

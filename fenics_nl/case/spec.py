@@ -21,6 +21,7 @@ from fenics_nl.materials.creep import NortonCreep, PerzynaViscoplasticity
 from fenics_nl.materials.drucker_prager import FITS, DruckerPrager
 from fenics_nl.materials.finite_plasticity import FiniteJ2Plasticity
 from fenics_nl.materials.gradient_damage import AT1, AT2, SPLITS
+from fenics_nl.materials.mohr_coulomb import MohrCoulomb
 from fenics_nl.materials.plasticity import J2Plasticity
 from fenics_nl.vocabulary import canonical, renamed
 
@@ -41,15 +42,17 @@ formulation = "mixed"    # optional: displacement (default) | mixed (Taylor–Ho
 
 [material]
 law = "linear-elastic"   # linear-elastic | power-law | saint-venant-kirchhoff | neo-hookean | j2
-                         # | j2-finite | drucker-prager | at1 | at2 | norton | perzyna
+                         # | j2-finite | drucker-prager | mohr-coulomb | at1 | at2 | norton
+                         # | perzyna
 E = 1000.0               # and the law's parameters: nu; power-law also sigma0, n; j2 (von
 nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isotropic) and C
                          # (kinematic hardening modulus), each 0 by default (perfect plasticity);
                          # plane stress: linear-elastic, saint-venant-kirchhoff, j2, norton, perzyna
-# drucker-prager (soils; stresses positive in tension): E, nu, c (cohesion), phi (friction
-# angle, degrees), optionally psi (dilatancy angle, default phi: associated) and fit
-# ("compression": the cone through Mohr-Coulomb's compression meridian, or "plane_strain");
-# perfect plasticity; not plane stress, not mixed. Its in-situ stress, uniform:
+# drucker-prager, mohr-coulomb (soils; stresses positive in tension): E, nu, c (cohesion),
+# phi (friction angle, degrees), optionally psi (dilatancy angle, default phi: associated);
+# drucker-prager optionally fit ("compression": the cone through Mohr-Coulomb's compression
+# meridian, or "plane_strain"); perfect plasticity; not plane stress, not mixed;
+# mohr-coulomb in plane strain and axisymmetric only. Their in-situ stress, uniform:
 # [initial_stress]
 # stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]  # as the probes say it
 # or geostatic, with the ground's weight (held): unit_weight = 18.0, K0 = 0.5, surface = 0.0
@@ -174,7 +177,8 @@ KEYS = [
     ("mesh", "formulation", "`displacement`, or `mixed`: Taylor–Hood u–p (degree ≥ 2, not "
      "plane stress), no locking as ν → 0.5, ν = 0.5 allowed", "displacement", "—"),
     ("material", "law", "`linear-elastic`, `power-law`, `saint-venant-kirchhoff`, "
-     "`neo-hookean`, `j2`, `j2-finite`, `drucker-prager`, `at1`, `at2`, `norton` or "
+     "`neo-hookean`, `j2`, `j2-finite`, `drucker-prager`, `mohr-coulomb`, `at1`, `at2`, "
+     "`norton` or "
      "`perzyna`", "required",
      "—"),
     ("material", "group", "[[material]] only: the cell group (a physical group of the mesh's "
@@ -195,10 +199,12 @@ KEYS = [
     ("material", "H", "j2, j2-finite, perzyna: the linear isotropic hardening modulus", "0",
      "stress"),
     ("material", "C", "j2: the kinematic hardening modulus", "0", "stress"),
-    ("material", "c", "drucker-prager: the cohesion", "required there", "stress"),
-    ("material", "phi", "drucker-prager: the friction angle φ, in (0, 90)", "required there",
-     "degrees"),
-    ("material", "psi", "drucker-prager: the dilatancy angle ψ, in [0, φ] (φ: associated "
+    ("material", "c", "drucker-prager, mohr-coulomb: the cohesion", "required there",
+     "stress"),
+    ("material", "phi", "drucker-prager, mohr-coulomb: the friction angle φ, in (0, 90)",
+     "required there", "degrees"),
+    ("material", "psi", "drucker-prager, mohr-coulomb: the dilatancy angle ψ, in [0, φ] (φ: "
+     "associated "
      "flow; below: not associated, the tangent not symmetric)", "phi", "degrees"),
     ("material", "fit", "drucker-prager: the cone through Mohr–Coulomb's `compression` "
      "meridian, or with its `plane_strain` collapse load", "compression", "—"),
@@ -221,7 +227,8 @@ KEYS = [
     ("boundary", "pressure", "normal pressure, positive pushing on the body; scaled by the "
      "load factor, or `{ from = A, to = B }`: A at load factor 0, B at 1 (a traction too, "
      "with vectors)", "—", "stress"),
-    ("initial_stress", "stress", "drucker-prager: the stress at zero strain (in situ), "
+    ("initial_stress", "stress", "drucker-prager, mohr-coulomb: the stress at zero strain "
+     "(in situ), "
      "uniform, 3 rows of 3 in the model's components ((x, y, z); axisymmetric (r, z, θ)); "
      "in equilibrium with the loads at load factor 0 and the supports (checked)", "0",
      "stress"),
@@ -303,18 +310,21 @@ LAWS: dict[str, type[laws.Material]] = {
     "j2": J2Plasticity,
     "j2-finite": FiniteJ2Plasticity,
     "drucker-prager": DruckerPrager,
+    "mohr-coulomb": MohrCoulomb,
     "at1": AT1,
     "at2": AT2,
     "norton": NortonCreep,
     "perzyna": PerzynaViscoplasticity,
 }
 DAMAGE = ("at1", "at2")
+SOILS = ("drucker-prager", "mohr-coulomb")
 VISCOUS = ("norton", "perzyna")  # rate-dependent: driven in time ([loading] time)
 # parameters a case may leave out, and their values: J2 without hardening is perfect
 # plasticity; a broken cell of a damage law keeps 1e-6 of its stiffness (a body cut in two
 # by a crack would otherwise have a singular tangent)
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
             "drucker-prager": {"psi": None, "fit": "compression"},
+            "mohr-coulomb": {"psi": None},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 STATE_FREE = ("linear-elastic", "power-law", "saint-venant-kirchhoff", "neo-hookean")
@@ -564,8 +574,8 @@ def read_case(path: str | Path) -> Case:
     wearing = isinstance(tables, list) and any(isinstance(t, dict) and "wear" in t
                                                for t in tables)
     time_axis = _time_axis(r, data, law, wearing)
-    if law == "drucker-prager" and formulation == "mixed":
-        r.fail("mesh.formulation", 'drucker-prager takes the displacement formulation (its '
+    if law in SOILS and formulation == "mixed":
+        r.fail("mesh.formulation", f'{law} takes the displacement formulation (its '
                                    "flow dilates: the mixed form's volumetric split is J2's)")
     if law == "norton" and formulation != "mixed" and model not in (None, "plane_stress"):
         r.fail("mesh.formulation", 'norton needs "mixed": its flow is incompressible and '
@@ -593,7 +603,7 @@ def read_case(path: str | Path) -> Case:
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
     psi, phi = parameters.get("psi"), parameters.get("phi")
-    if law == "drucker-prager" and psi is not None and phi is not None and psi < phi:
+    if law in SOILS and psi is not None and phi is not None and psi < phi:
         # a tangent that is not symmetric: MUMPS's LU takes it, CG does not
         if linear == "gamg":
             r.fail("solver.linear_solver", f"gamg is CG: psi = {psi} < phi = {phi} makes the "
@@ -815,14 +825,18 @@ def _one_material(r: _Reader, m: dict, where: str, model: str | None):
         except ValueError as err:  # the law's range check: "nu must be in (-1, 0.5], ..."
             name, _, rest = str(err).partition(" ")
             r.fail(f"{where}.{name}" if name in parameters else where, rest or name)
-    if law in ("neo-hookean", "power-law", "j2-finite", "drucker-prager") and \
+    if law in ("neo-hookean", "power-law", "j2-finite", *SOILS) and \
             model == "plane_stress":
         r.fail(f"{where}.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
+    if law == "mohr-coulomb" and model == "3d":
+        r.fail(f"{where}.law", "mohr-coulomb takes plane_strain and axisymmetric models (its "
+                               "return needs the third direction principal); in 3D use "
+                               "drucker-prager")
     return law, parameters
 
 
-INITIAL = ("drucker-prager",)  # the laws that take an initial (in-situ) stress
+INITIAL = SOILS  # the laws that take an initial (in-situ) stress
 GEOSTATIC = ("unit_weight", "K0", "surface")  # the ground's weight and stress ratio
 
 
