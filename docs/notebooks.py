@@ -35,6 +35,7 @@ SMALL = {
     "pressure_vessel.py": [],
     "creep_vessel.py": [],
     "bearing.py": [],
+    "excavation.py": [],
     "upsetting.py": [],
     "snap_through.py": [],
     "damage_bar.py": [],
@@ -44,7 +45,7 @@ SMALL = {
 }
 # the pictures each page shows (the demo's own --png and --plot)
 PICTURES = {"newton_scalar.py": ["--plot"], "damage_bar.py": ["--plot"], "crack.py": ["--plot"],
-            "indentation_identification.py": ["--plot"]}
+            "indentation_identification.py": ["--plot"], "excavation.py": ["--plot"]}
 
 _RESULTS_CELL = ("import json\nfrom fenics_nl.io import cli\n"
                  "print(json.dumps(cli.notebook_results()))")

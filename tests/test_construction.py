@@ -8,6 +8,8 @@ stage is taken in (exactly for an elastic ground, within a stated tolerance for 
 one).
 """
 
+import itertools
+
 import numpy as np
 import pytest
 import ufl
@@ -123,3 +125,30 @@ def test_stages_on_two_ranks_give_the_serial_answer():
     points = [[1.0, -1.0], [2.25, 0.0], [2.5, -3.0]]  # the dug floor, the wall's head, foot
     values = [Probes(u.function_space.mesh, points).continuous(u) for u in (u2, u1)]
     assert np.array(values[0]) == pytest.approx(np.array(values[1]), rel=1e-9, abs=1e-15)
+
+
+def test_the_excavation_demo_ends_each_stage_with_the_weight_present(demo):
+    # demos/excavation.py's defaults (9280 unknowns): the ground at rest in equilibrium
+    # (|R(0)| 1.7e-14 of its weight), each stage's reaction the weight present (1e-14); the
+    # wall's stage is linear (its concrete stress-free, the soil's stress released: one
+    # Newton iteration a step after the first); each lift deepens the heave, the wall's
+    # deflection and the plastic zone
+    d = demo.json("excavation.py")
+    assert d["at_rest_residual"] < 1e-12 and d["max_reaction_error"] < 1e-12
+    stages = d["stages"]
+    assert [s["stage"] for s in stages] == ["wall", "lift 1", "lift 2", "lift 3"]
+    assert stages[0]["plastic_volume_fraction"] == 0.0
+    for before, after in itertools.pairwise(stages[1:]):
+        for key in ("floor_heave", "max_wall_deflection", "plastic_volume_fraction"):
+            assert after[key] > before[key] > 0, key
+
+
+@pytest.mark.mpi
+def test_the_excavation_demo_on_two_ranks_gives_the_serial_answer(demo):
+    s, p = demo.json("excavation.py"), demo.json("excavation.py", ranks=2)
+    assert p["ranks"] == 2
+    for a, b in zip(s["stages"], p["stages"], strict=True):
+        for key in ("reaction", "floor_heave", "max_wall_deflection", "max_wall_moment",
+                    "plastic_volume_fraction"):
+            assert b[key] == pytest.approx(a[key], rel=1e-8), key
+        assert b["newton_iterations"] == a["newton_iterations"]

@@ -56,7 +56,7 @@ def test_newton_scalar_divergence_is_a_result(tmp_path, demo):
                                   "indentation.py", "buckling_beam.py",
                                   "pressure_vessel.py", "snap_through.py",
                                   "bracket.py", "indentation_identification.py",
-                                  "creep_vessel.py", "bearing.py"])
+                                  "creep_vessel.py", "bearing.py", "excavation.py"])
 def test_help_describes_the_demo_and_states_defaults_once(demo, name):
     text = demo.run([name, "--help"]).stdout
     assert "(default: None)" not in text and len(text.split("\n\n")[1]) > 40
@@ -66,7 +66,8 @@ def test_help_describes_the_demo_and_states_defaults_once(demo, name):
               "indentation_identification.py": "-punch_axisymmetric_elim_",
               "buckling_beam.py":
               "-beam_buckling_", "bracket.py": "-bracket_elim_",
-              "snap_through.py": "-arch_continuation_", "creep_vessel.py": "-creep_ksp_view"
+              "snap_through.py": "-arch_continuation_", "creep_vessel.py": "-creep_ksp_view",
+              "excavation.py": "-excavation_"
               }.get(name)
     if prefix:  # the PETSc options prefixes are documented
         assert prefix in " ".join(text.split())
