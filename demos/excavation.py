@@ -253,7 +253,10 @@ say(f"excavation R = {R:g} m, wall {t_w:g} x {H_w:g} m, {args.lifts} lifts of "
 # The supports' vertical reaction against the weight present; the wall's deflection
 # $u_r$ on its axis and its bending moment $M = \int (r - r_m)\,\sigma_{zz}\,dr$ across its
 # thickness (per unit length of its circumference; 3 Gauss points), at 40 depths; the
-# surface's settlement $u_z$ outside the wall; the plastic zone of the soil present.
+# surface's settlement $u_z$ outside the wall; the plastic zone of the soil present. (The
+# floor heaves and the surface outside rises with it: the ground's elastic rebound as the
+# dug weight leaves. One Young's modulus for the whole depth overstates it; a stiffness
+# growing with depth, or a stiffer response to unloading, would keep the surface down.)
 
 # +
 depths = np.linspace(-0.98 * H_w, -0.02 * H_w, 40)
