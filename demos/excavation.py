@@ -19,13 +19,15 @@
 # is in equilibrium, then released as the stage's progress $s$ goes from 0 to 1
 # (`fenics_nl.construction`):
 #
-# $$ R(u; v) = \sum_p \int \chi_p\,\sigma_p : \varepsilon(v) - \sum_p \int \chi_p\,\gamma_p\,
-#    b \cdot v + (1 - s) \int \lambda\,(\sigma_{left} : \varepsilon(v) - \gamma_{left}\,b
-#    \cdot v), $$
+# $$ R(u; v) = \sum_p \int \chi_p\,\sigma_p : \varepsilon(v) - \sum_p \int \chi_p
+#    (1 - \alpha (1 - s))\,\gamma_p\, b \cdot v + (1 - s) \int \lambda\,(\sigma_{left} :
+#    \varepsilon(v) - \gamma_{left}\,b \cdot v), $$
 #
-# $\chi_p$ the part's presence, $\lambda$ the cells leaving in this stage, $b = (0, -1)$
-# (all times $2\pi r$). At each stage's end the supports carry the weight of what is
-# present, to round-off (Kratos' check of its staged excavation): the run checks it.
+# $\chi_p$ the part's presence, $\alpha$ the cells arriving and $\lambda$ those leaving in
+# this stage, $b = (0, -1)$ (all times $2\pi r$). The run checks that each stage starts in
+# equilibrium ($R = 0$ at $s = 0$: what is frozen balances what left) and that at its end
+# the supports carry the weight of what is present, to round-off (Kratos' check of its
+# staged excavation).
 #
 # ## Implementation
 
@@ -238,10 +240,18 @@ residual = (sum(parts.present[p] * ufl.inner(sigma[p], eps_v) for p in sigma)
 ground_weight = args.unit_weight * math.pi * width ** 2 * depth
 solver = NewtonSolver(residual, u, supports, rtol=1e-10, atol=1e-10, force_scale=ground_weight,
                       max_it=40, prefix="excavation_")
-start = fem.petsc.assemble_vector(fem.form(residual))  # the ground at rest: R(0) = 0
-start.ghostUpdate(addv=1, mode=1)
-fem.petsc.set_bc(start, supports, alpha=0.0)
-at_rest = start.norm() / ground_weight
+residual_form = fem.form(residual)
+
+
+def out_of_balance(bcs):
+    """|R(u)| without the supports' rows, over the ground's weight (collective)."""
+    b = fem.petsc.assemble_vector(residual_form)
+    b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
+    fem.petsc.set_bc(b, bcs, alpha=0.0)
+    return b.norm() / ground_weight
+
+
+at_rest = out_of_balance(supports)  # the ground at rest: R(0) = 0
 dofs = output.dofs(V)
 say(f"excavation R = {R:g} m, wall {t_w:g} x {H_w:g} m, {args.lifts} lifts of "
     f"{args.lift_depth:g} m; {dofs} unknowns; the ground at rest: |R(0)| = {at_rest:.1e} "
@@ -276,11 +286,15 @@ def measured(name, path):
     """What a stage ends with (collective)."""
     reaction = boundary.reactions(residual, u, {"bottom": tagged("bottom")})["bottom"][1]
     present = comm.allreduce(fem.assemble_scalar(present_weight))
+    # (DG2's Legendre points are the degree-4 quadrature's: the arrival strain, a
+    # quadrature function, is read where it is)
     s_zz = np.array(across.discontinuous("s_zz", sigma["wall"][1, 1], 2)).reshape(-1, 3)
     moment = (s_zz * (0.5 * t_w * gauss[0]) * (0.5 * t_w * gauss[1])).sum(axis=1)
     deflection = np.array(axis_line.continuous(u))[:, 0]
     settlement = np.array(surface.continuous(u))[:, 1]
-    n = soil.cumulated_plastic_strain.function_space.dofmap.index_map.size_local
+    p_in_soil = soil.cumulated_plastic_strain_per_cell()  # (the soil present only: the
+    p_in_soil.x.array[:] *= parts.present["soil"].x.array  # dug cells keep theirs)
+    n = msh.topology.index_map(msh.topology.dim).size_local
     return {"stage": name, "steps": len(path.results), "newton_iterations": path.iterations,
             "step_cuts": path.failures, "reaction": reaction, "weight_present": present,
             "reaction_error": reaction / present - 1,
@@ -288,10 +302,11 @@ def measured(name, path):
             "surface_settlement": settlement.tolist(),
             "max_wall_deflection": float(np.abs(deflection).max()),
             "max_wall_moment": float(np.abs(moment).max()),
-            "max_settlement": float(-settlement.min()),
+            "max_settlement": float(max(-settlement.min(), 0.0)),
+            "max_surface_rise": float(max(settlement.max(), 0.0)),
             "floor_heave": floor.continuous(u)[0][1],
             "max_cumulated_plastic_strain": comm.allreduce(float(
-                soil.cumulated_plastic_strain.x.array[:n].max(initial=0.0)), op=MPI.MAX),
+                p_in_soil.x.array[:n].max(initial=0.0)), op=MPI.MAX),
             "plastic_volume_fraction": comm.allreduce(fem.assemble_scalar(yielded))
             / comm.allreduce(fem.assemble_scalar(in_soil))}
 
@@ -313,6 +328,10 @@ records, t0 = [], time.perf_counter()
 for name, remove, add in stages:
     parts.begin(name, remove=remove, add=add, stresses=sigma, strain=eps)
     solver.set_bcs(supports + parts.held(u))
+    at_start = out_of_balance(solver.bcs)  # 0: the frozen forces hold what left
+    if at_start > 1e-10:
+        raise SolveError(f"stage {name!r} does not start in equilibrium: |R| = "
+                         f"{at_start:.2e} of the ground's weight")
 
     def progress(s):
         parts.progress.value = s
@@ -324,13 +343,14 @@ for name, remove, add in stages:
         raise SolveError(f"stage {name!r} failed at s = {float(parts.progress.value):.3g} "
                          f"(the ground cannot stand the dig, or refine --steps): {err}") from err
     parts.end()
-    records.append(measured(name, path))
+    records.append(measured(name, path) | {"start_residual": at_start})
     cli.converged_step({"stage": name, **{k: records[-1][k] for k in (
         "newton_iterations", "reaction_error", "max_wall_deflection", "max_settlement")}})
     r = records[-1]
     say(f"{name}: {r['newton_iterations']} Newton iterations in {r['steps']} steps; the wall "
         f"deflects {1e3 * r['max_wall_deflection']:.3g} mm, the surface settles "
-        f"{1e3 * r['max_settlement']:.3g} mm, the floor heaves {1e3 * r['floor_heave']:.3g} "
+        f"{1e3 * r['max_settlement']:.3g} mm and rises {1e3 * r['max_surface_rise']:.3g} mm, "
+        f"the floor heaves {1e3 * r['floor_heave']:.3g} "
         f"mm; reaction / weight present − 1 = {r['reaction_error']:.1e}")
 solve_time = comm.allreduce(time.perf_counter() - t0, op=MPI.MAX)
 worst = max(abs(r["reaction_error"]) for r in records)

@@ -16,8 +16,10 @@ s, and its strain is measured from the state it arrives in (`arrival_strain`: st
 when it arrives). The degrees of freedom no present cell touches are held where they are
 (`held`): the removed soil's nodes, a wall's before it is built.
 
-At the end of a stage the vertical reactions are the weight of what is present, to
-round-off: the internal forces of any cell are self-equilibrated.
+The residual is 0 at a stage's start (the frozen forces balance what the leaving cells
+did), and at its end the vertical reactions are the weight of what is present, to
+round-off (the internal forces of any cell are self-equilibrated: a check that the stage
+converged and was released whole, not of the frozen stress itself).
 """
 
 from __future__ import annotations
@@ -68,6 +70,7 @@ class Construction:
         for p, tags in parts.items():
             gone = set((absent or {}).get(p, ()))
             self._set(self.present[p], [t for t in tags if t not in gone], 1.0)
+        self._one_part_a_cell()
 
     def _cells(self, tags) -> np.ndarray:
         found = [self.cell_tags.find(t) for t in tags]
@@ -123,6 +126,14 @@ class Construction:
             self._set(self.present[p], tags, 1.0)
             self._set(self.arriving, tags, 1.0)
             self._store(self.arrival_strain, strain, self._cells(tags))
+        self._one_part_a_cell()
+
+    def _one_part_a_cell(self) -> None:
+        """Refuse two parts present in one cell (their stiffness and weight would add)."""
+        if max((sum(f.x.array for f in self.present.values())).max(initial=0.0), 0.0) > 1.0:
+            raise ValueError("two parts are present in one cell: a cell group in two parts "
+                             "must be absent from one of them (absent=) until a stage "
+                             "removes it from the other")
 
     def _freeze(self, part, tags, stress) -> None:
         cells = self._cells(tags)
@@ -154,7 +165,7 @@ class Construction:
             u: the displacement (its present values are held).
 
         Returns:
-            A list of one DirichletBC (or none if every dof is touched).
+            A list of one DirichletBC (on no dof if every dof is touched).
         """
         V = self.V
         imap = V.dofmap.index_map

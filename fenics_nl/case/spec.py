@@ -881,6 +881,9 @@ def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | dict |
         return None
     if any(stress[i][j] != stress[j][i] for i in range(3) for j in range(3)):
         r.fail(f"{where}.stress", "must be symmetric")
+    elif law == "mohr-coulomb" and (stress[0][2] != 0 or stress[1][2] != 0):
+        r.fail(f"{where}.stress", "mohr-coulomb's third direction is principal: its shears "
+                                  "with it (rows 1 and 2, column 3) must be 0")
     return stress
 
 

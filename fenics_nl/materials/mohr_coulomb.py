@@ -13,7 +13,9 @@ Drucker–Prager's compression cone touches it.
 The return (perfect plasticity) is the multi-surface one in principal stresses: from the
 sorted trial stresses, onto the main plane (f = 0 with σ1 ≥ σ2 ≥ σ3 kept); if that breaks
 the order, onto the edge it crosses (σ1 = σ2 or σ2 = σ3: the two planes that meet there,
-two multipliers); if the edge's point passes the apex, the apex. Each is a linear system
+two multipliers); if the edge's point passes the apex, the apex (the stress c cotφ I, the
+plastic strain C⁻¹ : (σ_tr − σ), volumetric even when ψ = 0, whose potential has no apex:
+de Souza Neto's choice too). Each is a linear system
 of constant coefficients (the elastic moduli, φ and ψ), solved once in Python: the return
 is a closed form of the trial principal stresses, written in UFL, and its UFL derivative the
 consistent tangent (not symmetric when ψ < φ). The principal directions do not turn: the
@@ -58,6 +60,13 @@ class MohrCoulomb(SoilPlasticity):
     0 < φ < 90°, 0 ≤ ψ ≤ φ (ψ = None: φ, associated). Models: plane strain and
     axisymmetric (module docstring).
     """
+
+    def __post_init__(self):
+        super().__post_init__()
+        s0 = self.initial_stress
+        if s0 is not None and not isinstance(s0, dict) and (s0[0][2] != 0 or s0[1][2] != 0):
+            raise ValueError("initial_stress: Mohr–Coulomb's third direction is principal: "
+                             f"its shears σ_xz, σ_yz must be 0, got {s0!r}")
 
     @property
     def yield_scale(self) -> float:
@@ -104,9 +113,10 @@ class MohrCoulomb(SoilPlasticity):
         plastic = ufl.gt(f, YIELD_TOLERANCE * (self.yield_scale + sphi * abs(s1 + s3)))
         main = self._returned(s, ("13",), sphi, spsi)
         ordered = ufl.And(ufl.ge(main[0], main[1]), ufl.ge(main[1], main[2]))
-        # the edge the main return crosses first: σ1 = σ2 if σ1 − σ2 closes before σ2 − σ3
-        first_12 = ufl.lt((1 - spsi) * (s1 - s2), (1 + spsi) * (s2 - s3))
-        edge = [ufl.conditional(first_12, a, b) for a, b in zip(
+        # the edge the main return crosses first: σ1 = σ2 (planes 13 and 23) if σ1 − σ2
+        # closes before σ2 − σ3, else σ2 = σ3 (planes 13 and 12)
+        edge_12_first = ufl.lt((1 - spsi) * (s1 - s2), (1 + spsi) * (s2 - s3))
+        edge = [ufl.conditional(edge_12_first, a, b) for a, b in zip(
             self._returned(s, ("13", "23"), sphi, spsi),
             self._returned(s, ("13", "12"), sphi, spsi), strict=True)]
         below_apex = ufl.ge(edge[0], edge[2])
@@ -152,7 +162,9 @@ def principal(sigma):
     m, half = (a + b) / 2, (a - b) / 2
     square = half * half + xy * xy
     # R's root has no derivative at 0 (an in-plane pair that coincides): below round-off
-    # of the stress it is taken as that round-off, a constant
+    # of the stress it is taken as that round-off (its tangent there is then elastic in
+    # the in-plane shear: a symmetric state, K0 = 1, converges more slowly, to the same
+    # answer)
     tiny = (1e-14 * (abs(a) + abs(b) + abs(xy))) ** 2 + 1e-300
     big = ufl.gt(square, tiny)
     R = ufl.sqrt(ufl.conditional(big, square, tiny))

@@ -1,6 +1,6 @@
 """Cell fields on a 2D section, beside profiles along lines, with matplotlib (rank 0 draws).
 
-`fields_and_profiles`: each field (DG0) on the section, deformed or not, one panel each,
+`fields_and_profiles`: each field (DG0) on the undeformed section, one panel each,
 then one panel per set of profiles (a quantity along a line after each stage or step, a
 curve each). Fields come from `output.section` (gathered on rank 0), profiles are plain
 arrays the same on every rank.
@@ -37,9 +37,10 @@ def fields_and_profiles(u: fem.Function, fields: dict[str, fem.Function],
             staged construction).
     """
     sections = {label: output.section(u, f) for label, f in fields.items()}
-    drawn = output.section(u, shown)[5] > 0 if shown is not None else None
+    mask = output.section(u, shown) if shown is not None else None  # (collective)
     if u.function_space.mesh.comm.rank != 0:
         return
+    drawn = mask[5] > 0 if mask is not None else None
     plt = figures.pyplot()
     n = len(fields) + len(profiles)
     columns = min(n, 3)

@@ -54,6 +54,9 @@ class Cavity:
     """
 
     def __init__(self, R, p0, p_i, c, phi, psi=None, E=1.0, nu=0.3, b=math.inf):
+        if not (0 < R < b and -c / math.tan(math.radians(phi)) < p_i < p0):
+            raise ValueError(f"a cavity needs 0 < R < b and −c cotφ < p_i < p0, got R = {R}, "
+                             f"b = {b}, p_i = {p_i}, p0 = {p0}")
         self.R, self.p0, self.p_i, self.c, self.E, self.nu, self.b = R, p0, p_i, c, E, nu, b
         s, t = math.sin(math.radians(phi)), math.sin(math.radians(phi if psi is None else psi))
         self.Kp, self.Kpsi = (1 + s) / (1 - s), (1 + t) / (1 - t)
@@ -72,9 +75,9 @@ class Cavity:
         return A, (A - s_rp) * Rp ** 2
 
     def _plastic_radius(self):
-        if math.isinf(self.b):
-            return self.R * (2 * (self.p0 + self.h) / ((self.Kp + 1) * (self.p_i + self.h))
-                             ) ** (1 / (self.Kp - 1))
+        if math.isinf(self.b):  # (below R: the wall has not yielded)
+            return max(self.R, self.R * (2 * (self.p0 + self.h) / (
+                (self.Kp + 1) * (self.p_i + self.h))) ** (1 / (self.Kp - 1)))
 
         def outer_mismatch(Rp):
             A, B = self._ring(Rp)
@@ -82,6 +85,9 @@ class Cavity:
 
         if outer_mismatch(self.R) >= 0:  # the wall has not yielded
             return self.R
+        if outer_mismatch(self.b) < 0:
+            raise ValueError(f"the whole ring r < b = {self.b} is plastic at p_i = "
+                             f"{self.p_i}: no elastic ring is left (the ring's limit load)")
         return brentq(outer_mismatch, self.R, self.b, xtol=1e-14 * self.R, rtol=1e-15)
 
     def stresses(self, r):
