@@ -277,3 +277,66 @@ def test_the_triaxial_path_on_two_ranks_gives_the_serial_answer():
                    confining=2.0 * C, comm=comm).go(top)
             for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
     assert runs[0] == pytest.approx(runs[1], rel=1e-12)
+
+
+def test_random_trial_stresses_return_onto_the_pyramid_along_the_flow():
+    # 200 homogeneous plane-strain states of the fresh law (its trial stress C : ε, the
+    # in-plane axes turned at random), φ = 30°, ψ = 10°: after the return, f ≤ 0 on all six
+    # planes (1e-12 of the stress), σ has the trial's principal directions, and σ_tr − σ
+    # is D Σ Δγ_g n_g over the planes with Δγ_g ≥ 0 (non-negative least squares, residual
+    # 1e-10) — the main plane, either edge or, past it, the apex c cotφ I. Reached: each of
+    # them, and σ_zz taking each rank
+    from scipy.optimize import nnls
+
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=10.0)
+    square = Square(law, "plane_strain")
+    dx = kinematics.quadrature_measure("dx", square.mesh, 2)
+    sigma = law.stress(kinematics.small_strain(square.u, "plane_strain"))
+    forms = [fem.form(sigma[i, j] * dx) for i, j in ((0, 0), (1, 1), (0, 1), (2, 2))]
+    x = square.u.function_space.tabulate_dof_coordinates()[:, :2]
+    lam, G = law.kappa - 2 * law.mu / 3, law.mu
+    D = 2 * G * np.eye(3) + lam * np.ones((3, 3))
+    spsi = math.sin(math.radians(10.0))
+    flows = [np.array([1 + spsi, 0, -(1 - spsi)]), np.array([0, 1 + spsi, -(1 - spsi)]),
+             np.array([1 + spsi, -(1 - spsi), 0])]
+    rng = np.random.default_rng(5)
+    seen, ranks = set(), set()
+    for _ in range(200):
+        # in-plane principal strains at random, or one near 0 (σ_zz then near the in-plane
+        # major stress: the edge σ1 = σ2 of a compression), turned by a random angle
+        a, b = rng.normal(0.0, 2.0 * C / E, 2)
+        if rng.random() < 0.5:
+            a, b = 0.05 * a, -abs(b) * 3
+        angle = rng.uniform(0, np.pi)
+        turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+        plane = turn @ np.diag([a, b]) @ turn.T
+        e = (plane[0, 0], plane[1, 1], plane[0, 1])  # ε_xx, ε_yy, ε_xy
+        square.u.x.array[:] = np.column_stack([e[0] * x[:, 0] + e[2] * x[:, 1],
+                                               e[2] * x[:, 0] + e[1] * x[:, 1]]).ravel()
+        sxx, syy, sxy, szz = (fem.assemble_scalar(f) for f in forms)
+        eps = np.array([[e[0], e[2], 0], [e[2], e[1], 0], [0, 0, 0]])
+        trial = 2 * G * eps + lam * np.trace(eps) * np.eye(3)
+        s = np.array([[sxx, sxy, 0], [sxy, syy, 0], [0, 0, szz]])
+        values, vectors = np.linalg.eigh(trial)
+        order = np.argsort(values)[::-1]  # σ1 ≥ σ2 ≥ σ3
+        along = vectors[:, order]
+        rotated = along.T @ s @ along
+        scale = np.abs(trial).max() + C
+        assert np.abs(rotated - np.diag(np.diag(rotated))).max() < 1e-11 * scale
+        p, t = np.diag(rotated), values[order]
+        f = max(abs(p[i] - p[j]) + (p[i] + p[j]) * SIN for i in range(3) for j in range(3)
+                if i != j) - 2 * C * COS
+        assert f < 1e-11 * scale
+        ranks.add(int(np.argmin(np.abs(t - szz))))
+        if np.allclose(p, t, rtol=0, atol=1e-11 * scale):
+            seen.add("elastic")
+            continue
+        if np.allclose(p, C / math.tan(math.radians(PHI)), rtol=0, atol=1e-11 * scale):
+            seen.add("apex")
+            continue
+        gamma, misfit = nnls(np.column_stack([D @ n for n in flows]), t - p)
+        assert misfit < 1e-10 * scale, (t, p)
+        active = gamma > 1e-12 * gamma.max()
+        seen.add("edge σ1 = σ2" if active[1] else "edge σ2 = σ3" if active[2] else "main plane")
+    assert seen == {"elastic", "main plane", "edge σ1 = σ2", "edge σ2 = σ3", "apex"}, seen
+    assert ranks == {0, 1, 2}
