@@ -340,3 +340,55 @@ def test_random_trial_stresses_return_onto_the_pyramid_along_the_flow():
         seen.add("edge σ1 = σ2" if active[1] else "edge σ2 = σ3" if active[2] else "main plane")
     assert seen == {"elastic", "main plane", "edge σ1 = σ2", "edge σ2 = σ3", "apex"}, seen
     assert ranks == {0, 1, 2}
+
+
+def footing_pressure(n: int, phi: float = 20.0) -> float:
+    """The limit pressure under a rigid smooth strip footing (half-width 1) on a weightless
+    Mohr–Coulomb ground (c = 1, E = 1e4, ν = 0.3, associated): the half model 6 × 4, P2 on
+    a crossed grid of n cells a unit length, the footing pushed down 0.05 in 12 steps (its
+    nodes' u_y; u_x free: smooth); the pressure of the last step (on the plateau)."""
+    m = mesh.create_rectangle(MPI.COMM_WORLD, [[0.0, -4.0], [6.0, 0.0]], [6 * n, 4 * n],
+                              diagonal=mesh.DiagonalType.crossed)
+    V = fem.functionspace(m, ("Lagrange", 2, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    law = MohrCoulomb(1e4, 0.3, c=1.0, phi=phi)
+    law.bind(m, 4)
+    dx = kinematics.quadrature_measure("dx", m, 4)
+    residual = ufl.inner(law.stress(kinematics.small_strain(u, "plane_strain")),
+                         kinematics.small_strain(v, "plane_strain")) * dx
+
+    def edge(where):
+        return mesh.locate_entities_boundary(m, 1, where)
+
+    under = edge(lambda x: np.isclose(x[1], 0.0) & (x[0] <= 1.0 + 1e-12))
+    bottom = edge(lambda x: np.isclose(x[1], -4.0))
+    push = boundary.component(V, 1, under)
+    bcs = [push, boundary.component(V, 0, edge(lambda x: np.isclose(x[0], 0.0))),
+           boundary.component(V, 0, edge(lambda x: np.isclose(x[0], 6.0))),
+           boundary.component(V, 0, bottom), boundary.component(V, 1, bottom)]
+    solver = NewtonSolver(residual, u, bcs, rtol=1e-10, atol=1e-10, force_scale=1.0,
+                          max_it=40, prefix=f"footing{n}_")
+    pressures = []
+
+    def load(t):
+        push.g.x.array[:] = -0.05 * t
+
+    solve_incrementally(solver, load, 12, commit=lambda: law.commit(u, "plane_strain"),
+                        on_step=lambda t, r: pressures.append(-boundary.reactions(
+                            residual, u, {"under": under})["under"][1]))
+    assert pressures[-1] == pytest.approx(pressures[-2], rel=1e-3)  # the plateau
+    return pressures[-1]
+
+
+def test_a_strip_footing_fails_at_prandtls_pressure_as_the_mesh_is_refined():
+    # Prandtl's weightless strip footing, φ = 20°: q = c N_c, N_c = (N_q − 1) cotφ,
+    # N_q = e^(π tanφ) tan²(45° + φ/2) = 14.835. Measured: +7.64 % at 2 cells a unit
+    # length, +3.88 % at 4, +1.96 % at 8 (tested to 4: 25k unknowns take 22 s): from
+    # above and first order in h (the footing's edge is singular), so Richardson's
+    # 2 q(h/2) − q(h) is +0.12 % (+0.04 % from 4 and 8)
+    t = math.tan(math.radians(20.0))
+    n_c = (math.exp(math.pi * t) * math.tan(math.radians(55.0)) ** 2 - 1) / t
+    coarse, fine = footing_pressure(2), footing_pressure(4)
+    assert n_c < fine < coarse
+    assert (coarse - n_c) / (fine - n_c) == pytest.approx(2.0, rel=0.1)  # first order
+    assert 2 * fine - coarse == pytest.approx(n_c, rel=5e-3)
