@@ -46,6 +46,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from fenics_nl.construction import Construction
 from fenics_nl.domain import boundary, meshes
@@ -246,7 +247,7 @@ residual_form = fem.form(residual)
 def out_of_balance(bcs):
     """|R(u)| without the supports' rows, over the ground's weight (collective)."""
     b = fem.petsc.assemble_vector(residual_form)
-    b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     fem.petsc.set_bc(b, bcs, alpha=0.0)
     return b.norm() / ground_weight
 

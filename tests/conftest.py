@@ -280,6 +280,7 @@ def taylor_remainders(residual, w, scale: float, seed: int,
     import ufl
     from dolfinx import fem
     from dolfinx.fem import petsc
+    from petsc4py import PETSc
 
     rng = np.random.default_rng(seed)
     w0 = w.x.array.copy()
@@ -290,7 +291,7 @@ def taylor_remainders(residual, w, scale: float, seed: int,
     def residual_at(h):
         w.x.array[:] = w0 + h * dw.x.array
         b = petsc.assemble_vector(R)
-        b.ghostUpdate(addv=1, mode=1)  # ADD, REVERSE
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         return b
 
     r0 = residual_at(0.0)

@@ -16,6 +16,7 @@ import ufl
 from dolfinx import fem, mesh
 from dolfinx.fem import petsc
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from fenics_nl.construction import Construction
 from fenics_nl.domain import boundary
@@ -80,7 +81,7 @@ def dig(c, steps, comm=MPI.COMM_WORLD):
         # the stage starts in equilibrium: the frozen forces balance what left (the
         # supports' and the held rows out)
         start = petsc.assemble_vector(fem.form(residual))
-        start.ghostUpdate(addv=1, mode=1)
+        start.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         petsc.set_bc(start, solver.bcs, alpha=0.0)
         assert start.norm() < 1e-12 * GAMMA_SOIL * 16.0, (name, start.norm())
         for k in range(1, steps + 1):
