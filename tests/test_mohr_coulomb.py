@@ -279,16 +279,19 @@ def test_the_triaxial_path_on_two_ranks_gives_the_serial_answer():
     assert runs[0] == pytest.approx(runs[1], rel=1e-12)
 
 
-def test_random_trial_stresses_return_onto_the_pyramid_along_the_flow():
-    # 200 homogeneous plane-strain states of the fresh law (its trial stress C : ε, the
-    # in-plane axes turned at random), φ = 30°, ψ = 10°: after the return, f ≤ 0 on all six
-    # planes (1e-12 of the stress), σ has the trial's principal directions, and σ_tr − σ
-    # is D Σ Δγ_g n_g over the planes with Δγ_g ≥ 0 (non-negative least squares, residual
-    # 1e-10) — the main plane, either edge or, past it, the apex c cotφ I. Reached: each of
-    # them, and σ_zz taking each rank
+@pytest.mark.parametrize("tension", [None, 0.6], ids=["pyramid", "tension-cut-off"])
+def test_random_trial_stresses_return_onto_the_surface_along_the_flow(tension):
+    # 300 homogeneous plane-strain states of the fresh law (its trial stress C : ε, the
+    # in-plane axes turned at random), φ = 30°, ψ = 10°, with or without a cut-off t = 0.6
+    # (c cotφ = 1.73): after the return every plane holds (Mohr–Coulomb's six, σ_i ≤ t;
+    # 1e-11 of the stress), σ has the trial's principal directions, and σ_tr − σ is
+    # D Σ Δγ_g n_g over the planes σ is on with Δγ_g ≥ 0 (non-negative least squares,
+    # residual 1e-10: the flow rule's KKT conditions). Reached: the main plane, both edges,
+    # the apex (all three planes) or the cut-off's plane and its edges, and σ_zz at each
+    # rank
     from scipy.optimize import nnls
 
-    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=10.0)
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=10.0, tension=tension)
     square = Square(law, "plane_strain")
     dx = kinematics.quadrature_measure("dx", square.mesh, 2)
     sigma = law.stress(kinematics.small_strain(square.u, "plane_strain"))
@@ -297,13 +300,17 @@ def test_random_trial_stresses_return_onto_the_pyramid_along_the_flow():
     lam, G = law.kappa - 2 * law.mu / 3, law.mu
     D = 2 * G * np.eye(3) + lam * np.ones((3, 3))
     spsi = math.sin(math.radians(10.0))
-    flows = [np.array([1 + spsi, 0, -(1 - spsi)]), np.array([0, 1 + spsi, -(1 - spsi)]),
-             np.array([1 + spsi, -(1 - spsi), 0])]
+    # the flows of the planes: Mohr–Coulomb's main one (σ1, σ3), the one met at the edge
+    # σ1 = σ2 (σ2, σ3), at the edge σ2 = σ3 (σ1, σ2); the cut-off's σ_i ≤ t
+    flows = {"13": [1 + spsi, 0, -(1 - spsi)], "23": [0, 1 + spsi, -(1 - spsi)],
+             "12": [1 + spsi, -(1 - spsi), 0]}
+    if tension is not None:
+        flows |= {"T1": [1, 0, 0], "T2": [0, 1, 0], "T3": [0, 0, 1]}
     rng = np.random.default_rng(5)
     seen, ranks = set(), set()
-    for _ in range(200):
+    for _ in range(300):
         # in-plane principal strains at random, or one near 0 (σ_zz then near the in-plane
-        # major stress: the edge σ1 = σ2 of a compression), turned by a random angle
+        # major stress), turned by a random angle
         a, b = rng.normal(0.0, 2.0 * C / E, 2)
         if rng.random() < 0.5:
             a, b = 0.05 * a, -abs(b) * 3
@@ -327,19 +334,49 @@ def test_random_trial_stresses_return_onto_the_pyramid_along_the_flow():
         f = max(abs(p[i] - p[j]) + (p[i] + p[j]) * SIN for i in range(3) for j in range(3)
                 if i != j) - 2 * C * COS
         assert f < 1e-11 * scale
+        if tension is not None:
+            assert p.max() <= tension + 1e-11 * scale
         ranks.add(int(np.argmin(np.abs(t - szz))))
         if np.allclose(p, t, rtol=0, atol=1e-11 * scale):
             seen.add("elastic")
             continue
-        if np.allclose(p, C / math.tan(math.radians(PHI)), rtol=0, atol=1e-11 * scale):
-            seen.add("apex")
+        if tension is None and np.allclose(p, law.apex, rtol=0, atol=1e-11 * scale):
+            seen.add("apex")  # (its flow is volumetric, not the planes': module docstring)
             continue
-        gamma, misfit = nnls(np.column_stack([D @ n for n in flows]), t - p)
-        assert misfit < 1e-10 * scale, (t, p)
-        active = gamma > 1e-12 * gamma.max()
-        seen.add("edge σ1 = σ2" if active[1] else "edge σ2 = σ3" if active[2] else "main plane")
-    assert seen == {"elastic", "main plane", "edge σ1 = σ2", "edge σ2 = σ3", "apex"}, seen
+        # the planes the stress is on, and the flow along them alone: Δγ ≥ 0 (KKT)
+        bounds = {"13": 2 * C * COS, "23": 2 * C * COS, "12": 2 * C * COS,
+                  "T1": tension, "T2": tension, "T3": tension}
+        normals = {"13": [1 + SIN, 0, -(1 - SIN)], "23": [0, 1 + SIN, -(1 - SIN)],
+                   "12": [1 + SIN, -(1 - SIN), 0], "T1": [1, 0, 0], "T2": [0, 1, 0],
+                   "T3": [0, 0, 1]}
+        on = [g for g in flows if np.dot(normals[g], p) - bounds[g] > -1e-9 * scale]
+        _, misfit = nnls(np.column_stack([D @ np.array(flows[g]) for g in on]), t - p)
+        assert misfit < 1e-10 * scale, (t, p, on)
+        seen.add(" ".join(on))
+    if tension is None:  # the plane, both edges (near the apex: in plane strain at ν = 0.3
+        # a compression along the edge σ1 = σ2 stays elastic), the apex
+        assert {"elastic", "13", "13 23", "13 12", "apex"} <= seen, seen
+    else:  # the plane, the cut-off, their edges and a corner
+        assert {"elastic", "13", "T1", "13 T1", "T1 T2"} <= seen, seen
     assert ranks == {0, 1, 2}
+
+
+def test_the_tension_cut_off_holds_a_pull_and_an_equal_pull():
+    # t = 0.6 < c cotφ = 1.73: pulled along y (x free, plane strain), σ_yy stops at t (the
+    # cut-off's plane; Taylor's slope 2 a step further); pulled equally (axisymmetric), σ
+    # stops at t I (the cut-off's corner) instead of the apex
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, tension=0.6)
+    square = Square(law, "plane_strain")
+    sigma = square.go(np.linspace(0.5, 3.0, 4) * 0.6 / E)
+    assert sigma[0][1] < 0.6 and sigma[-1][1] == pytest.approx(0.6, rel=1e-10)
+    square.moved[0].g.x.array[:] *= 1.1
+    square.solver.solve()
+    assert np.all(taylor_slopes(square, 0.05 * 0.6 / E) > 1.9)
+    pulled = Square(MohrCoulomb(E, NU, c=C, phi=PHI, tension=0.6), "axisymmetric", pulled=True)
+    for s in pulled.go(np.array([1.0, 2.0]) * 0.6 / (3 * law.kappa))[1:]:
+        assert s == pytest.approx(0.6 * np.ones(3), rel=1e-10)
+    with pytest.raises(ValueError, match="tension must be in"):
+        MohrCoulomb(E, NU, c=C, phi=PHI, tension=2.0)
 
 
 def footing_pressure(n: int, phi: float = 20.0) -> float:

@@ -52,7 +52,8 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # phi (friction angle, degrees), optionally psi (dilatancy angle, default phi: associated);
 # drucker-prager optionally fit ("compression": the cone through Mohr-Coulomb's compression
 # meridian, or "plane_strain"); perfect plasticity; not plane stress, not mixed;
-# mohr-coulomb in plane strain and axisymmetric only. Their in-situ stress, uniform:
+# mohr-coulomb in plane strain and axisymmetric only, optionally tension (a cut-off: no
+# principal stress above it). Their in-situ stress, uniform:
 # [initial_stress]
 # stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]  # as the probes say it
 # or geostatic, with the ground's weight (held): unit_weight = 18.0, K0 = 0.5, surface = 0.0
@@ -206,6 +207,8 @@ KEYS = [
     ("material", "psi", "drucker-prager, mohr-coulomb: the dilatancy angle ψ, in [0, φ] (φ: "
      "associated "
      "flow; below: not associated, the tangent not symmetric)", "phi", "degrees"),
+    ("material", "tension", "mohr-coulomb: a tension cut-off t, no principal stress above "
+     "it, in [0, c cotφ]", "none", "stress"),
     ("material", "fit", "drucker-prager: the cone through Mohr–Coulomb's `compression` "
      "meridian, or with its `plane_strain` collapse load", "compression", "—"),
     ("material", "saturation", "j2-finite: Voce's saturation stress, σ_y = σ0 + H p + "
@@ -324,7 +327,7 @@ VISCOUS = ("norton", "perzyna")  # rate-dependent: driven in time ([loading] tim
 # by a crack would otherwise have a singular tangent)
 OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
             "drucker-prager": {"psi": None, "fit": "compression"},
-            "mohr-coulomb": {"psi": None},
+            "mohr-coulomb": {"psi": None, "tension": None},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 STATE_FREE = ("linear-elastic", "power-law", "saint-venant-kirchhoff", "neo-hookean")

@@ -45,10 +45,25 @@ __all__ = ["MohrCoulomb"]
 PLANES = {"13": (0, 2), "23": (1, 2), "12": (0, 1)}
 
 
+# the tension cut-off's planes σ_i ≤ t, by the sorted stress they bound
+CUTS = {"T1": 0, "T2": 1, "T3": 2}
+# the active sets a return with a cut-off tries, in order (the first whose multipliers are
+# ≥ 0 and whose stress breaks no plane): the faces, the edges between them, the corners
+CUT_OFF_SETS = (("13",), ("T1",), ("13", "23"), ("13", "12"), ("13", "T1"), ("T1", "T2"),
+                ("13", "T1", "T2"), ("13", "12", "T1"), ("T1", "T2", "T3"))
+
+
 def plane(pair: str, sine: float) -> np.ndarray:
-    """The normal of a plane (σ_i − σ_j) + (σ_i + σ_j) sin a in principal stresses."""
-    i, j = PLANES[pair]
+    """The normal of a plane in principal stresses: Mohr–Coulomb's or the cut-off's.
+
+    (σ_i − σ_j) + (σ_i + σ_j) sin a for a pair "13", "23", "12"; e_i for the cut-off's
+    σ_i ≤ t ("T1", "T2", "T3": its normal and its flow).
+    """
     k = np.zeros(3)
+    if pair in CUTS:
+        k[CUTS[pair]] = 1.0
+        return k
+    i, j = PLANES[pair]
     k[i], k[j] = 1.0 + sine, -(1.0 - sine)
     return k
 
@@ -58,11 +73,17 @@ class MohrCoulomb(SoilPlasticity):
     """Mohr–Coulomb plasticity (perfect): cohesion c > 0, angles φ and ψ in degrees.
 
     0 < φ < 90°, 0 ≤ ψ ≤ φ (ψ = None: φ, associated). Models: plane strain and
-    axisymmetric (module docstring).
+    axisymmetric (module docstring). `tension`: a cut-off t, no principal stress above it
+    (0 ≤ t ≤ c cotφ; None: none, the pyramid's apex c cotφ the most a point bears).
     """
+
+    tension: float | None = None
 
     def __post_init__(self):
         super().__post_init__()
+        if self.tension is not None and not 0 <= self.tension <= self.apex:
+            raise ValueError(f"tension must be in [0, c cotφ = {self.apex:.6g}] (the cut-off "
+                             f"below the apex), got {self.tension!r}")
         s0 = self.initial_stress
         if s0 is not None and not isinstance(s0, dict) and (s0[0][2] != 0 or s0[1][2] != 0):
             raise ValueError("initial_stress: Mohr–Coulomb's third direction is principal: "
@@ -86,7 +107,10 @@ class MohrCoulomb(SoilPlasticity):
         """
         s1, _, s3 = principal(sigma)[0]
         sine = math.sin(math.radians(self.phi))
-        return (s1 - s3) + (s1 + s3) * sine - self.yield_scale
+        f = (s1 - s3) + (s1 + s3) * sine - self.yield_scale
+        if self.tension is None:
+            return f
+        return ufl.max_value(f, s1 - self.tension)  # (the cut-off's own scale: a stress)
 
     def return_map(self, eps):
         """(ε_p, p̄, Δp̄) at the strain ε from the committed state (UFL; module docstring).
@@ -110,7 +134,14 @@ class MohrCoulomb(SoilPlasticity):
         f = ufl.dot(ufl.as_vector(plane("13", sphi)), s) - self.yield_scale
         # a point left on the surface by the last step starts the next one elastic (as
         # Drucker–Prager's: round-off of the terms f is made of)
-        plastic = ufl.gt(f, YIELD_TOLERANCE * (self.yield_scale + sphi * abs(s1 + s3)))
+        tolerance = YIELD_TOLERANCE * (self.yield_scale + sphi * abs(s1 + s3))
+        plastic = ufl.gt(f, tolerance)
+        if self.tension is not None:
+            plastic = ufl.Or(plastic, ufl.gt(s1 - self.tension, tolerance))
+            d_sigma = [ufl.conditional(plastic, s[i] - returned, 0.0)
+                       for i, returned in enumerate(self._cut_off_return(s, sphi, spsi,
+                                                                         tolerance))]
+            return self._flowed(back(d_sigma), plastic)
         main = self._returned(s, ("13",), sphi, spsi)
         ordered = ufl.And(ufl.ge(main[0], main[1]), ufl.ge(main[1], main[2]))
         # the edge the main return crosses first: σ1 = σ2 (planes 13 and 23) if σ1 − σ2
@@ -124,25 +155,62 @@ class MohrCoulomb(SoilPlasticity):
             ordered, s[i] - main[i], ufl.conditional(below_apex, s[i] - edge[i],
                                                      s[i] - self.apex)), 0.0)
                    for i in range(3)]
-        d_sigma = back(d_sigma)
+        return self._flowed(back(d_sigma), plastic)
+
+    def _flowed(self, d_sigma, plastic):
+        """(ε_p, p̄, Δp̄) of the step's stress correction σ_tr − σ: Δε_p = C⁻¹ : it."""
         G, K = self.mu, self.kappa
         d_eps_p = ufl.dev(d_sigma) / (2 * G) + ufl.tr(d_sigma) / (9 * K) * ufl.Identity(3)
         return (self._bound().eps_p + d_eps_p, *self.cumulated(d_eps_p, plastic))
 
-    def _returned(self, s, pairs, sphi, spsi):
+    def _cut_off_return(self, s, sphi, spsi, tolerance):
+        """The sorted stresses returned with the cut-off (UFL, 3 values).
+
+        The first of `CUT_OFF_SETS` (the main plane, its edges, the cut-off's planes and
+        their corners) whose multipliers are ≥ 0 and whose stress breaks no plane.
+        """
+        every = ("13", "23", "12", "T1", "T2", "T3")
+        chosen = None
+        for planes in reversed(CUT_OFF_SETS):  # the last is the fallback, the first wins
+            stress, gammas = self._returned(s, planes, sphi, spsi, multipliers=True)
+            sigma = ufl.as_vector(stress)
+            admissible = [ufl.le(self._plane_value(sigma, p, sphi), tolerance) for p in every
+                          if p not in planes] + [ufl.ge(g, 0.0) for g in gammas]
+            if chosen is None:
+                chosen = stress
+                continue
+            valid = admissible[0]
+            for condition in admissible[1:]:
+                valid = ufl.And(valid, condition)
+            chosen = [ufl.conditional(valid, a, b) for a, b in zip(stress, chosen,
+                                                                   strict=True)]
+        return chosen
+
+    def _plane_value(self, sigma, pair, sphi):
+        """k · σ − its bound: a plane's value (≤ 0 inside), UFL."""
+        bound = self.tension if pair in CUTS else self.yield_scale
+        return ufl.dot(ufl.as_vector(plane(pair, sphi)), sigma) - bound
+
+    def _returned(self, s, pairs, sphi, spsi, multipliers=False):
         """The sorted principal stresses returned onto the planes `pairs` (UFL, 3 values).
 
-        σ = σ_tr − D Σ Δγ_a n_a with k_b · σ = 2c cosφ on each plane b: the multipliers
-        solve M Δγ = k · σ_tr − 2c cosφ, M_ba = k_b · D n_a (constants, solved here).
+        σ = σ_tr − D Σ Δγ_a n_a with k_b · σ = r_b on each plane b (r = 2c cosφ on
+        Mohr–Coulomb's, t on the cut-off's): the multipliers solve M Δγ = k · σ_tr − r,
+        M_ba = k_b · D n_a (constants, solved here). `multipliers`: also the Δγ_a.
         """
         lam, G = self.kappa - 2.0 * self.mu / 3.0, self.mu
         D = 2.0 * G * np.eye(3) + lam * np.ones((3, 3))
         k = np.array([plane(p, sphi) for p in pairs])
         n = np.array([plane(p, spsi) for p in pairs])
-        L = D @ n.T @ np.linalg.inv(k @ D @ n.T)  # Δσ = L (k σ_tr − 2c cosφ)
-        f = [ufl.dot(ufl.as_vector(kb), s) - self.yield_scale for kb in k]
-        return [s[i] - sum(float(L[i, b]) * f[b] for b in range(len(pairs)))
-                for i in range(3)]
+        inverse = np.linalg.inv(k @ D @ n.T)
+        L = D @ n.T @ inverse  # Δσ = L (k σ_tr − r)
+        f = [self._plane_value(s, p, sphi) for p in pairs]
+        stress = [s[i] - sum(float(L[i, b]) * f[b] for b in range(len(pairs)))
+                  for i in range(3)]
+        if not multipliers:
+            return stress
+        return stress, [sum(float(inverse[a, b]) * f[b] for b in range(len(pairs)))
+                        for a in range(len(pairs))]
 
 
 def principal(sigma):
