@@ -203,12 +203,50 @@ class CaseProblem:
                 loads += self._ramped(c.value, c.start) * ufl.dot(
                     self._pressure_direction(c), v) * w * ds
         gravity = self._gravity()
-        if gravity is not None:  # a geostatic initial stress: the ground's weight, held
-            loads -= ufl.dot(gravity, v) * w * self.dx
+        self.construction = self._construction(data, gravity)
+        if gravity is not None and self.construction is None:  # a geostatic initial
+            loads -= ufl.dot(gravity, v) * w * self.dx  # stress: the ground's weight, held
         self._loads = loads
         if isinstance(self.material, ByGroup):  # each law on its cells
             return self.material.work(self.u, v, self.model, self.dx) + loads
-        return self.fields.internal_work(self.material, self.model) * self.dx + loads
+        internal = self.fields.internal_work(self.material, self.model)
+        if self.construction is None:
+            return internal * self.dx + loads
+        stages = self.construction  # the body present; what a stage digs out, released
+        down = ufl.as_vector([-1.0 if i == self.mesh.geometry.dim - 1 else 0.0
+                              for i in range(self.mesh.geometry.dim)])
+        return (stages.present["body"] * internal - ufl.dot(stages.body_force("body", down), v)
+                * w + stages.released(v, down, kinematics.small_strain(v, self.model)) * w
+                ) * self.dx + loads
+
+    def _construction(self, data, gravity):
+        """The stages' parts (`fenics_nl.construction`): the whole body, its weight γ."""
+        if not self.case.stages:
+            return None
+        from fenics_nl.construction import Construction
+
+        tdim = self.mesh.topology.dim
+        have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == tdim}
+        wrong = [f"stage[{i}].remove: {g!r} is not a cell group of the mesh (it has: "
+                 f"{', '.join(sorted(have)) or 'none'})"
+                 for i, st in enumerate(self.case.stages, start=1) for g in st["remove"]
+                 if g not in have]
+        if wrong:
+            raise CaseError(wrong)
+        self._stage_tags = {g: have[g] for g in have}
+        weight = 0.0 if gravity is None else self.case.initial_stress["unit_weight"]
+        stages = Construction(self.V, data.cell_tags, {"body": sorted(set(have.values()))},
+                              weights={"body": weight}, degree=2 * self.case.degree)
+        stages.present["body"].x.array[:] = 1.0  # every cell, in a group or not
+        return stages
+
+    def begin_stage(self, stage: dict) -> None:
+        """Start `stage` at equilibrium: its groups dug out, their forces frozen (s = 0)."""
+        eps = kinematics.small_strain(self.u, self.model)
+        self.construction.begin(stage["name"],
+                                remove={"body": [self._stage_tags[g] for g in stage["remove"]]},
+                                stresses={"body": self.material.stress(eps)})
+        self.solver.set_bcs(self.bcs + self.construction.held(self.u))
 
     def _gravity(self):
         """The body force of a geostatic initial stress, −γ along the last axis (or None)."""

@@ -38,6 +38,11 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     `checkpoint`: a folder where the state after every `checkpoint_every`-th converged step
     is saved; `restart`: a folder to go on from (the same case, mesh and ranks).
     """
+    if problem.case.stages and (checkpoint or restart):
+        from fenics_nl.case.spec import CaseError
+
+        raise CaseError(["--checkpoint, --restart: not with [[stage]] yet (a stage's frozen "
+                         "forces and the parts present are not in a checkpoint)"])
     t0 = time.perf_counter()
     solver = problem.make_solver()
     setup = time.perf_counter() - t0
@@ -165,6 +170,8 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
                                    steps, case) from err
             work.add(path.work)
             previous = target
+    for stage in case.stages:  # after the loading, at its last load factor
+        _dig(problem, solver, stage, steps, work, commit, show)
     last = steps[-1]
     out = {"case": str(case.path), "model": case.model, "law": case.law_name,
            "dofs": problem.dofs, "ranks": problem.mesh.comm.size, "steps": steps,
@@ -196,6 +203,33 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     if problem.case.pairs:
         out["contact_pairs"] = last["contact_pairs"]
     return out
+
+
+def _dig(problem: CaseProblem, solver, stage: dict, steps: list[dict], work, commit,
+         show) -> None:
+    """One construction stage: its groups dug out, their forces released in its steps."""
+    problem.begin_stage(stage)
+    t = steps[-1]["load_factor"] if steps else 1.0
+
+    def release(s):
+        problem.construction.progress.value = s
+
+    def record(s, result):
+        steps.append(step_record(problem, t, result) | {"stage": stage["name"],
+                                                        "stage_progress": s})
+        cli.converged_step(steps[-1], fields=lambda: fields(problem))
+
+    say(f"stage {stage['name']!r}: {', '.join(stage['remove'])} dug out in "
+        f"{stage['steps']} step(s)")
+    try:
+        path = solve_incrementally(solver, release, stage["steps"], adaptive=True,
+                                   max_step=1.0 / stage["steps"], progress=show,
+                                   commit=commit, on_step=record)
+    except LoadStepError as err:
+        raise SolveError(f"stage {stage['name']!r} stopped at {err.reached:.4g} of its "
+                         f"release: {err}") from err
+    problem.construction.end()
+    work.add(path.work)
 
 
 def _wear_in_time(problem: CaseProblem, solver, converged, steps: list[dict],

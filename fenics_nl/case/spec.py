@@ -159,6 +159,12 @@ max_it = 50              # Newton iterations per step
                          # (r, z, θ)) at a point, every step
 name = "tip"
 point = [10.0, 1.0]
+
+# [[stage]]              # optional: construction stages after the loading, in order (its
+# name = "lift 1"        # steps' JSON names it); remove: the cell groups dug out (their
+# remove = ["soil_1"]    # stiffness and weight leave, their forces on the rest released
+# steps = 10             # over the steps); one [material] of linear-elastic, power-law, j2,
+#                        # drucker-prager or mohr-coulomb; no contact, arc-length or time
 """
 
 # every key of the format: (table, key, meaning, default, unit); the documentation's table
@@ -291,6 +297,13 @@ KEYS = [
     ("probe", "name", "the probe's name in the JSON", "required", "—"),
     ("probe", "point", "where displacement, von Mises and Cauchy stress are reported, every "
      "step", "required", "length"),
+    ("stage", "name", "a construction stage, after the loading, in order: its name in the "
+     "steps' JSON", "required", "—"),
+    ("stage", "remove", "the cell groups it digs out: their stiffness and weight leave, the "
+     "forces they exerted released over its steps (`fenics_nl.construction`)", "required",
+     "—"),
+    ("stage", "steps", "its load steps (the release from 0 to 1; a step that fails is cut "
+     "in half)", "1", "—"),
 ]
 
 
@@ -298,7 +311,7 @@ def key_table() -> str:
     """The format's keys as a Markdown table (the documentation's case page)."""
     lines = ["| key | meaning | default | unit |", "|---|---|---|---|"]
     for table, key, meaning, default, unit in KEYS:
-        many = table in ("boundary", "probe", "contact") or (table, key) == ("material",
+        many = table in ("boundary", "probe", "contact", "stage") or (table, key) == ("material",
                                                                           "group")
         name = f"[[{table}]]" if many else f"[{table}]"
         lines.append(f"| `{name}` `{key}` | {meaning} | {default} | {unit} |")
@@ -398,6 +411,7 @@ class Case:
     pairs: list[dict] = field(default_factory=list)  # [[contact]]: slave, master, friction, key
     # [initial_stress]: stress 3x3 (the model's components), or {unit_weight, K0, surface}
     initial_stress: list | dict | None = None
+    stages: list[dict] = field(default_factory=list)  # [[stage]]: name, remove, steps
 
     @property
     def law_name(self) -> str:
@@ -526,7 +540,7 @@ def read_case(path: str | Path) -> Case:
         raise CaseError([f"{path}: not valid TOML: {err}"]) from None
     r = _Reader()
     r.unknown(data, "case", ("mesh", "material", "initial_stress", "boundary", "contact",
-                             "loading", "solver", "probe"))
+                             "loading", "solver", "probe", "stage"))
 
     m = r.table(data, "mesh", ("file", "size", "model", "degree", "formulation",
                                "refine_near"))
@@ -625,13 +639,59 @@ def read_case(path: str | Path) -> Case:
         names = [t.get("name") for t in tables if isinstance(t, dict)] if isinstance(
             tables, list) else []
         _check_stop(r, arc["stop"], [n for n in names if isinstance(n, str)], model)
+    # (read before the problems are said: each table's own problems among them)
+    initial_stress = _initial_stress(r, data, law, model, groups)
+    stages = _stages(r, data, law, model, groups, formulation, conditions, pairs, arc,
+                     time_axis)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
-                refine_near, time_axis, groups, pairs,
-                _initial_stress(r, data, law, model, groups))
+                refine_near, time_axis, groups, pairs, initial_stress, stages)
+
+
+STAGED = ("linear-elastic", "power-law", "j2", *SOILS)  # the laws a case digs in
+
+
+def _stages(r: _Reader, data: dict, law, model, groups, formulation, conditions, pairs, arc,
+            time_axis) -> list[dict]:
+    """[[stage]]: construction stages after the loading, each digging out cell groups."""
+    tables = data.get("stage", [])
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        r.fail("stage", "must be [[stage]] tables, one per stage")
+        return []
+    out, names = [], set()
+    for i, t in enumerate(tables, start=1):
+        where = f"stage[{i}]"
+        r.unknown(t, where, ("name", "remove", "add", "steps"))
+        name = r.get(t, "name", where, str, required=True)
+        if name in names:
+            r.fail(f"{where}.name", f"{name!r} names an earlier stage too")
+        names.add(name)
+        remove = t.get("remove")
+        if not (isinstance(remove, list) and remove and all(isinstance(g, str) for g in remove)):
+            r.fail(f"{where}.remove", f"must be a list of cell groups, got {remove!r}")
+            remove = None
+        if t.get("add"):
+            r.fail(f"{where}.add", "not built in case files: a part that arrives needs its own "
+                                   "law (demos/excavation.py builds a wall so, with "
+                                   "fenics_nl.construction)")
+        steps = r.get(t, "steps", where, int, default=1, minimum=1)
+        out.append({"name": name, "remove": remove, "steps": steps})
+    if not out:
+        return out
+    reasons = [(groups is not None, "one [material] (not [[material]] groups)"),
+               (law is not None and law not in STAGED, f"the laws {', '.join(STAGED)}"),
+               (formulation == "mixed", "the displacement formulation"),
+               (model == "plane_stress", "plane strain, axisymmetric or 3D models"),
+               (bool(pairs) or any(c.kind == "contact" for c in conditions), "no contact"),
+               (arc is not None, "load steps (not arc-length)"),
+               (time_axis is not None, "no time axis")]
+    for failed, needs in reasons:
+        if failed:
+            r.fail("stage", f"construction stages take {needs}")
+    return out
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
