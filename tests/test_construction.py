@@ -241,3 +241,18 @@ def test_a_case_file_digs_a_pit_in_stages(tmp_path, demo):
         (tmp_path / "bad.toml").write_text(STAGED.replace(*change))
         proc = demo.run(["-m fenics_nl", "run", tmp_path / "bad.toml"], check=False)
         assert proc.returncode == 2 and said in proc.stderr, proc.stderr
+
+
+@pytest.mark.mpi
+def test_a_staged_case_on_two_ranks_gives_the_serial_answer(tmp_path, demo):
+    (tmp_path / "layered.geo").write_text(LAYERED_GEO)
+    (tmp_path / "staged.toml").write_text(STAGED)
+    s = demo.case(tmp_path / "staged.toml")
+    p = demo.case(tmp_path / "staged.toml", ranks=2)
+    assert p["ranks"] == 2
+    assert [x["newton_iterations"] for x in p["steps"]] == [
+        x["newton_iterations"] for x in s["steps"]]
+    for a, b in zip(s["steps"], p["steps"], strict=True):
+        assert b["reactions"]["bottom"] == pytest.approx(a["reactions"]["bottom"], rel=1e-9)
+        assert b["plastic_volume_fraction"] == pytest.approx(a["plastic_volume_fraction"],
+                                                             rel=1e-9, abs=1e-15)
