@@ -46,7 +46,6 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from fenics_nl.construction import Construction
 from fenics_nl.domain import boundary, meshes
@@ -241,18 +240,8 @@ residual = (sum(parts.present[p] * ufl.inner(sigma[p], eps_v) for p in sigma)
 ground_weight = args.unit_weight * math.pi * width ** 2 * depth
 solver = NewtonSolver(residual, u, supports, rtol=1e-10, atol=1e-10, force_scale=ground_weight,
                       max_it=40, prefix="excavation_")
-residual_form = fem.form(residual)
-
-
-def out_of_balance(bcs):
-    """|R(u)| without the supports' rows, over the ground's weight (collective)."""
-    b = fem.petsc.assemble_vector(residual_form)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    fem.petsc.set_bc(b, bcs, alpha=0.0)
-    return b.norm() / ground_weight
-
-
-at_rest = out_of_balance(supports)  # the ground at rest: R(0) = 0
+# the ground at rest: R(0) = 0 (the supports' rows, their reactions, left out)
+at_rest = boundary.out_of_balance(residual, supports) / ground_weight
 dofs = output.dofs(V)
 say(f"excavation R = {R:g} m, wall {t_w:g} x {H_w:g} m, {args.lifts} lifts of "
     f"{args.lift_depth:g} m; {dofs} unknowns; the ground at rest: |R(0)| = {at_rest:.1e} "
@@ -329,7 +318,8 @@ records, t0 = [], time.perf_counter()
 for name, remove, add in stages:
     parts.begin(name, remove=remove, add=add, stresses=sigma, strain=eps)
     solver.set_bcs(supports + parts.held(u))
-    at_start = out_of_balance(solver.bcs)  # 0: the frozen forces hold what left
+    # 0: the frozen forces hold what left
+    at_start = boundary.out_of_balance(residual, solver.bcs) / ground_weight
     if at_start > 1e-10:
         raise SolveError(f"stage {name!r} does not start in equilibrium: |R| = "
                          f"{at_start:.2e} of the ground's weight")

@@ -24,6 +24,7 @@ from fenics_nl.contact.active_set import ActiveSetContact
 from fenics_nl.contact.pair import ArchardWear, ContactPair, FrictionalPair, PairContact
 from fenics_nl.domain import boundary
 from fenics_nl.domain.probes import Probes
+from fenics_nl.errors import SolveError
 from fenics_nl.io import output
 from fenics_nl.materials import kinematics, laws, plane_stress
 from fenics_nl.materials import mixed as mixed_form
@@ -215,9 +216,10 @@ class CaseProblem:
         stages = self.construction  # the body present; what a stage digs out, released
         down = ufl.as_vector([-1.0 if i == self.mesh.geometry.dim - 1 else 0.0
                               for i in range(self.mesh.geometry.dim)])
+        self._released = stages.released(v, down, kinematics.small_strain(v, self.model)
+                                          ) * w * self.dx
         return (stages.present["body"] * internal - ufl.dot(stages.body_force("body", down), v)
-                * w + stages.released(v, down, kinematics.small_strain(v, self.model)) * w
-                ) * self.dx + loads
+                * w) * self.dx + self._released + loads
 
     def _construction(self, data, gravity):
         """The stages' parts (`fenics_nl.construction`): the whole body, its weight γ."""
@@ -247,6 +249,13 @@ class CaseProblem:
                                 remove={"body": [self._stage_tags[g] for g in stage["remove"]]},
                                 stresses={"body": self.material.stress(eps)})
         self.solver.set_bcs(self.bcs + self.construction.held(self.u))
+        # the stage starts in equilibrium: the frozen forces hold what the dug cells did
+        # (to 1e-9 of those forces)
+        left = boundary.out_of_balance(self.residual, self.solver.bcs)
+        frozen = boundary.out_of_balance(self._released, self.solver.bcs)
+        if left > 1e-9 * max(frozen, 1e-300):
+            raise SolveError(f"stage {stage['name']!r} does not start in equilibrium: "
+                             f"{left:.3g} of the dug cells' forces {frozen:.3g} unbalanced")
 
     def _gravity(self):
         """The body force of a geostatic initial stress, −γ along the last axis (or None)."""
@@ -300,20 +309,14 @@ class CaseProblem:
         """
         if self.case.initial_stress is None:
             return
-        from dolfinx.fem import petsc
-        from petsc4py import PETSc
-
         saved = float(self.t.value)
         self.t.value = 0.0
         eps_v = kinematics.small_strain(self.fields.v, self.model)
         own = ufl.inner(self.material.initial(eps_v), eps_v) * self.weight * self.dx
-        norms = []
-        for form in (self.residual, own):
-            b = petsc.assemble_vector(fem.form(form))
-            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
-            if form is self.residual:  # (σ0's own forces with the supports' rows: a scale
-                petsc.set_bc(b, self.bcs, alpha=0.0)  # that is not round-off when they
-            norms.append(b.norm())  # hold all of them)
+        # (σ0's own forces with the supports' rows: a scale that is not round-off when
+        # they hold all of them)
+        norms = [boundary.out_of_balance(self.residual, self.bcs),
+                 boundary.out_of_balance(own)]
         self.t.value = saved
         self._initial_admissible()
         if norms[0] > 1e-9 * max(norms[1], 1e-300):

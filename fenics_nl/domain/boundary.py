@@ -11,7 +11,7 @@ from collections.abc import Callable
 import numpy as np
 from dolfinx import fem, mesh
 
-__all__ = ["component", "fixed", "reactions", "tags_where"]
+__all__ = ["component", "fixed", "out_of_balance", "reactions", "tags_where"]
 
 
 def tags_where(msh: mesh.Mesh, dim: int, marked: dict[int, Callable], *,
@@ -113,3 +113,24 @@ def reactions(residual: fem.Form | object, u: fem.Function, groups: dict[str, np
             total[i] = R[mine].sum()
         out[name] = [float(x) for x in V.mesh.comm.allreduce(total, op=MPI.SUM)]
     return out
+
+
+def out_of_balance(residual, bcs=()) -> float:
+    """‖R‖ at the present unknowns, the rows of `bcs` left out (their reactions). Collective.
+
+    An equilibrium check: an initial stress against the loads at 0, a construction
+    stage's start against the forces it froze.
+
+    Args:
+        residual: R (a UFL form or a compiled one).
+        bcs: the Dirichlet conditions whose rows are not counted.
+    """
+    from dolfinx.fem import petsc
+    from petsc4py import PETSc
+
+    b = petsc.assemble_vector(residual if isinstance(residual, fem.Form) else fem.form(residual))
+    b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+    petsc.set_bc(b, list(bcs), alpha=0.0)
+    norm = b.norm()
+    b.destroy()
+    return norm
