@@ -464,6 +464,14 @@ class _Reader:
         self.unknown(value, name, allowed)
         return value
 
+    def tables(self, data: dict, name: str, each: str = "") -> list[dict]:
+        """The [[name]] tables ([] if none, or if they are not tables: said)."""
+        tables = data.get(name, [])
+        if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+            self.fail(name, f"must be [[{name}]] tables{each}")
+            return []
+        return tables
+
     def unknown(self, table: dict, where: str, allowed: tuple[str, ...]) -> None:
         for k in table:
             if k not in allowed:
@@ -657,10 +665,7 @@ STAGED = ("linear-elastic", "power-law", "j2", *SOILS)  # the laws a case digs i
 def _stages(r: _Reader, data: dict, law, model, groups, formulation, conditions, pairs, arc,
             time_axis) -> list[dict]:
     """[[stage]]: construction stages after the loading, each digging out cell groups."""
-    tables = data.get("stage", [])
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        r.fail("stage", "must be [[stage]] tables, one per stage")
-        return []
+    tables = r.tables(data, "stage", ", one per stage")
     out, names = [], set()
     for i, t in enumerate(tables, start=1):
         where = f"stage[{i}]"
@@ -717,10 +722,7 @@ def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
 
 def _pairs(r: _Reader, data: dict) -> list[dict]:
     """The [[contact]] pairs: slave and master facet groups, Coulomb's f."""
-    tables = data.get("contact", [])
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        r.fail("contact", "must be [[contact]] tables, one per pair")
-        return []
+    tables = r.tables(data, "contact", ", one per pair")
     out = []
     for i, t in enumerate(tables, start=1):
         where = f"contact[{i}]"
@@ -974,11 +976,8 @@ def _ramp(r: _Reader, table: dict, key: str, dim: int | None):
 
 def _conditions(r: _Reader, data: dict, dim: int, law: str | None, model: str | None
                 ) -> list[Condition]:
-    tables = data.get("boundary", [])
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        r.fail("boundary", "must be [[boundary]] tables")
-        return []
-    if not tables:
+    tables = r.tables(data, "boundary")
+    if not data.get("boundary"):  # (not tables: said by r.tables)
         r.fail("boundary", "no [[boundary]] table: a body needs supports and loads")
     out = []
     for i, t in enumerate(tables, start=1):
@@ -1262,10 +1261,7 @@ def _check_stop(r: _Reader, stop: dict, names: list[str], model: str) -> None:
 
 
 def _probes(r: _Reader, data: dict, dim: int) -> list[Probe]:
-    tables = data.get("probe", [])
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        r.fail("probe", "must be [[probe]] tables")
-        return []
+    tables = r.tables(data, "probe")
     out, names = [], set()
     for i, t in enumerate(tables, start=1):
         where = f"probe[{i}]"
