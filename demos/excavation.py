@@ -57,7 +57,7 @@ from fenics_nl.io.cli import say
 from fenics_nl.io.parameters import Parameters, number
 from fenics_nl.materials import LinearElastic, kinematics
 from fenics_nl.materials.mohr_coulomb import MohrCoulomb
-from fenics_nl.plots import sections
+from fenics_nl.plots import plasticity as plasticity_pictures
 from fenics_nl.solvers.loading import LoadStepError, solve_incrementally
 from fenics_nl.solvers.newton import NewtonSolver
 
@@ -378,7 +378,7 @@ def stage_plot():
                                    else np.array(r[key])) for r in records}
                 for key, x in (("wall_deflection", depths), ("wall_moment", depths),
                                ("surface_settlement", surface_r))}
-    sections.fields_and_profiles(
+    plasticity_pictures.fields_and_profiles(
         u, {"vertical displacement u_z (mm)": u_z, "σ_eq in the soil (kPa)": soil_vm,
             "cumulated plastic strain p": p_cell},
         [{"x": "z (m)", "y": "wall's deflection u_r (mm)", "vertical": True,
