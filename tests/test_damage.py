@@ -276,7 +276,7 @@ def test_a_surfing_crack_follows_its_k_field_and_dissipates_the_mesh_toughness()
     # the toughness of the mesh for a crack along a line of nodes, from the 1D half bar
     # cracked at its free end (a band of one cell at α = 1 on the half: Gc (1 + 2h/(c_w ell))
     # = 1.1875, measured 1.1867); the surfing crack's 2 dD/da over its steady steps: -1.4 %
-    # (the issue asks 2 %). The tip trails the field's centre by a constant h
+    # (the issue asks 2 %). The tip trails the field's centre by a constant, h or 2h
     import numpy as np
     from damage_problems import end_crack, release_rate
     from mpi4py import MPI
@@ -289,7 +289,7 @@ def test_a_surfing_crack_follows_its_k_field_and_dissipates_the_mesh_toughness()
     G, lag = release_rate(record, skip=4)
     assert G == pytest.approx(2 * half, rel=0.02)
     lags = np.array(record.centre[4:]) - np.array(record.tip[4:])
-    assert np.ptp(lags) < 1e-9 and 0 <= lag <= 2 * record.h
+    assert np.ptp(lags) < 1e-9 and 0 <= lag <= 2 * record.h * (1 + 1e-12)  # 2h: measured
 
 
 @pytest.mark.mpi
