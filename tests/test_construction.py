@@ -106,6 +106,70 @@ def test_each_stage_ends_with_the_weight_of_what_is_present_on_the_supports():
     assert np.abs(u1.x.array - u4.x.array).max() < 1e-9 * np.abs(u4.x.array).max()
 
 
+def test_an_elastic_dig_is_the_remaining_body_unloaded_by_the_removed_soils_traction():
+    # an independent reference for the release: the lift (x < 2, y > -1) dug from the
+    # elastic ground in one stage (no wall: its cells stay soil) against the ground left, a
+    # submesh of its own, loaded by the traction the lift exerted on it, -σ0 n on the cut
+    # (σ0 geostatic, n the cut's outward normal) and nothing else: ∫ C ε(w) : ε(v) =
+    # -∫_cut σ0 n · v. Equal to round-off (measured 6e-15 of the largest displacement): σ0
+    # is linear in depth and the quadrature exact, so the frozen forces the stage releases
+    # are exactly that traction's
+    m, cells = tagged_ground(MPI.COMM_WORLD)
+    V = fem.functionspace(m, ("Lagrange", 2, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    geostatic = {"unit_weight": GAMMA_SOIL, "K0": 0.5, "surface": 0.0}
+    soil = MohrCoulomb(5.0e4, 0.3, c=1e4, phi=30.0, initial_stress=geostatic)
+    soil.bind(m, 2)
+    stages = Construction(V, cells, {"soil": [GROUND, LIFT, WALL]},
+                          weights={"soil": GAMMA_SOIL})
+    dx = kinematics.quadrature_measure("dx", m, 2)
+    eps, eps_v = (kinematics.small_strain(w, "plane_strain") for w in (u, v))
+    down = ufl.as_vector([0.0, -1.0])
+    sigma = {"soil": soil.stress(eps)}
+    residual = (stages.present["soil"] * ufl.inner(sigma["soil"], eps_v)
+                - ufl.dot(stages.body_force("soil", down), v)
+                + stages.released(v, down, eps_v)) * dx
+
+    def supports(V):
+        msh = V.mesh
+        sides = mesh.locate_entities_boundary(
+            msh, 1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 4.0))
+        bottom = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[1], -4.0))
+        return [boundary.component(V, 0, sides), boundary.component(V, 0, bottom),
+                boundary.component(V, 1, bottom)]
+
+    solver = NewtonSolver(residual, u, supports(V), rtol=1e-12, atol=1e-10,
+                          force_scale=GAMMA_SOIL, prefix="dig_reference_")
+    stages.begin("lift", remove={"soil": [LIFT]}, stresses=sigma, strain=eps)
+    solver.set_bcs(supports(V) + stages.held(u))
+    stages.progress.value = 1.0
+    solver.solve()
+
+    left, _, _, _ = mesh.create_submesh(m, 2, np.sort(np.concatenate(
+        [cells.find(GROUND), cells.find(WALL)])))
+    W = fem.functionspace(left, ("Lagrange", 2, (2,)))
+    w, z = fem.Function(W), ufl.TestFunction(W)
+    cut = mesh.locate_entities_boundary(
+        left, 1, lambda x: (np.isclose(x[0], 2.0) & (x[1] > -1.0 - 1e-9))
+        | (np.isclose(x[1], -1.0) & (x[0] < 2.0 + 1e-9)))
+    ds = ufl.Measure("ds", domain=left, subdomain_data=mesh.meshtags(
+        left, 1, cut, np.ones_like(cut)))
+    y = ufl.SpatialCoordinate(left)[1]
+    sigma0 = GAMMA_SOIL * y * ufl.as_matrix([[0.5, 0.0], [0.0, 1.0]])  # tension positive
+    elastic = LinearElastic(5.0e4, 0.3)
+    eps_w, eps_z = (kinematics.small_strain(f, "plane_strain") for f in (w, z))
+    dx_left = kinematics.quadrature_measure("dx", left, 2)
+    reference = (ufl.inner(elastic.stress(eps_w), eps_z) * dx_left
+                 + ufl.dot(sigma0 * ufl.FacetNormal(left), z) * ds(1))
+    NewtonSolver(reference, w, supports(W), rtol=1e-12, atol=1e-12, force_scale=GAMMA_SOIL,
+                 prefix="dig_reference_left_").solve()
+    points = [[1.0, -1.0], [2.0, 0.0], [2.0, -0.5], [3.0, -2.0], [0.5, -3.0]]
+    dug, unloaded = (np.array(Probes(f.function_space.mesh, points).continuous(f))
+                     for f in (u, w))
+    assert np.abs(dug - unloaded).max() < 1e-11 * np.abs(unloaded).max(), (dug, unloaded)
+    assert np.abs(unloaded).max() > 1e-4  # the cut moves
+
+
 def test_a_plastic_ground_dug_in_more_steps_ends_nearer_the_same_state():
     # c = 3: the ground yields as it is dug (the wall's foot, the lift's corner); the
     # reactions are still the weight present to round-off; the end state depends on the
