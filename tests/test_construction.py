@@ -38,6 +38,16 @@ def tagged_ground(comm):
     return m, mesh.meshtags(m, tdim, np.arange(n, dtype=np.int32), tag)
 
 
+def held_sides_and_bottom(V):
+    """u_x = 0 on the sides x = 0, 4 (of the cells of V's mesh), u = 0 on the bottom y = -4:
+    (the supports, the bottom's facets)."""
+    sides = mesh.locate_entities_boundary(
+        V.mesh, 1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 4.0))
+    bottom = mesh.locate_entities_boundary(V.mesh, 1, lambda x: np.isclose(x[1], -4.0))
+    return [boundary.component(V, 0, sides), boundary.component(V, 0, bottom),
+            boundary.component(V, 1, bottom)], bottom
+
+
 def dig(c, steps, comm=MPI.COMM_WORLD):
     """Build the wall, then dig, each stage in `steps` steps.
 
@@ -63,11 +73,7 @@ def dig(c, steps, comm=MPI.COMM_WORLD):
     residual = (sum(stages.present[p] * ufl.inner(sigma[p], eps_v) for p in sigma)
                 - sum(ufl.dot(stages.body_force(p, down), v) for p in sigma)
                 + stages.released(v, down, eps_v)) * dx
-    sides = mesh.locate_entities_boundary(
-        m, 1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 4.0))
-    bottom = mesh.locate_entities_boundary(m, 1, lambda x: np.isclose(x[1], -4.0))
-    supports = [boundary.component(V, 0, sides), boundary.component(V, 0, bottom),
-                boundary.component(V, 1, bottom)]
+    supports, bottom = held_sides_and_bottom(V)
     solver = NewtonSolver(residual, u, supports, rtol=1e-12, atol=1e-10,
                           force_scale=GAMMA_SOIL, max_it=30, prefix=f"dig{id(u)}_")
     weight = fem.form(sum(stages.weights[p] * stages.present[p] for p in sigma) * dx)
@@ -130,18 +136,10 @@ def test_an_elastic_dig_is_the_remaining_body_unloaded_by_the_removed_soils_trac
                 - ufl.dot(stages.body_force("soil", down), v)
                 + stages.released(v, down, eps_v)) * dx
 
-    def supports(V):
-        msh = V.mesh
-        sides = mesh.locate_entities_boundary(
-            msh, 1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 4.0))
-        bottom = mesh.locate_entities_boundary(msh, 1, lambda x: np.isclose(x[1], -4.0))
-        return [boundary.component(V, 0, sides), boundary.component(V, 0, bottom),
-                boundary.component(V, 1, bottom)]
-
-    solver = NewtonSolver(residual, u, supports(V), rtol=1e-12, atol=1e-10,
+    solver = NewtonSolver(residual, u, held_sides_and_bottom(V)[0], rtol=1e-12, atol=1e-10,
                           force_scale=GAMMA_SOIL, prefix="dig_reference_")
     stages.begin("lift", remove={"soil": [LIFT]}, stresses=sigma, strain=eps)
-    solver.set_bcs(supports(V) + stages.held(u))
+    solver.set_bcs(held_sides_and_bottom(V)[0] + stages.held(u))
     stages.progress.value = 1.0
     solver.solve()
 
@@ -161,8 +159,8 @@ def test_an_elastic_dig_is_the_remaining_body_unloaded_by_the_removed_soils_trac
     dx_left = kinematics.quadrature_measure("dx", left, 2)
     reference = (ufl.inner(elastic.stress(eps_w), eps_z) * dx_left
                  + ufl.dot(sigma0 * ufl.FacetNormal(left), z) * ds(1))
-    NewtonSolver(reference, w, supports(W), rtol=1e-12, atol=1e-12, force_scale=GAMMA_SOIL,
-                 prefix="dig_reference_left_").solve()
+    NewtonSolver(reference, w, held_sides_and_bottom(W)[0], rtol=1e-12, atol=1e-12,
+                 force_scale=GAMMA_SOIL, prefix="dig_reference_left_").solve()
     points = [[1.0, -1.0], [2.0, 0.0], [2.0, -0.5], [3.0, -2.0], [0.5, -3.0]]
     dug, unloaded = (np.array(Probes(f.function_space.mesh, points).continuous(f))
                      for f in (u, w))
