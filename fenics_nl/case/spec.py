@@ -52,8 +52,8 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # phi (friction angle, degrees), optionally psi (dilatancy angle, default phi: associated);
 # drucker-prager optionally fit ("compression": the cone through Mohr-Coulomb's compression
 # meridian, or "plane_strain"); perfect plasticity; not plane stress, not mixed;
-# mohr-coulomb in plane strain and axisymmetric only, optionally tension (a cut-off: no
-# principal stress above it). Their in-situ stress, uniform:
+# mohr-coulomb optionally tension (a cut-off: no principal stress above it). Their in-situ
+# stress, uniform:
 # [initial_stress]
 # stress = [[-10.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, -10.0]]  # as the probes say it
 # or geostatic, with the ground's weight (held): unit_weight = 18.0, K0 = 0.5, surface = 0.0
@@ -894,10 +894,6 @@ def _one_material(r: _Reader, m: dict, where: str, model: str | None):
             model == "plane_stress":
         r.fail(f"{where}.law", f"{law} has no plane-stress form: use mesh.model = "
                                f"\"plane_strain\" or another law")
-    if law == "mohr-coulomb" and model == "3d":
-        r.fail(f"{where}.law", "mohr-coulomb takes plane_strain and axisymmetric models (its "
-                               "return needs the third direction principal); in 3D use "
-                               "drucker-prager")
     return law, parameters
 
 
@@ -946,8 +942,8 @@ def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | dict |
         return None
     if any(stress[i][j] != stress[j][i] for i in range(3) for j in range(3)):
         r.fail(f"{where}.stress", "must be symmetric")
-    elif law == "mohr-coulomb" and (stress[0][2] != 0 or stress[1][2] != 0):
-        r.fail(f"{where}.stress", "mohr-coulomb's third direction is principal: its shears "
+    elif law == "mohr-coulomb" and model != "3d" and (stress[0][2] != 0 or stress[1][2] != 0):
+        r.fail(f"{where}.stress", f"in {model} the third direction is principal: the shears "
                                   "with it (rows 1 and 2, column 3) must be 0")
     return stress
 
