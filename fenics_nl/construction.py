@@ -152,6 +152,18 @@ class Construction:
                 + np.arange(Q.dofmap.bs)).ravel()
         target.x.array[dofs] = new.x.array[dofs]
 
+    def state_functions(self) -> dict:
+        """The fields a checkpoint keeps to go on inside a stage (by name).
+
+        The parts present, what arrives and leaves, the frozen stress and weight, the
+        arrival strain.
+        """
+        out = {f"present_{p}": f for p, f in self.present.items()}
+        for f in (self.arriving, self.leaving, self.left_weight, self.left_stress,
+                  self.arrival_strain):
+            out[f.name] = f
+        return out
+
     def end(self) -> None:
         """The stage done (s = 1): nothing leaving or arriving any more."""
         self.progress.value = 1.0

@@ -9,6 +9,7 @@ one).
 """
 
 import itertools
+import json
 
 import numpy as np
 import pytest
@@ -284,9 +285,15 @@ def test_a_case_file_digs_a_pit_in_stages(tmp_path, demo):
     # the pit's corner; what case files do not take yet is refused, one line each
     (tmp_path / "layered.geo").write_text(LAYERED_GEO)
     (tmp_path / "staged.toml").write_text(STAGED)
-    d = demo.case(tmp_path / "staged.toml")
+    from conftest import read_series
+
+    d = demo.case(tmp_path / "staged.toml", "--output", tmp_path / "out")
     dug = [s for s in d["steps"] if s.get("stage") == "dig"]
     assert [s["stage_progress"] for s in dug] == pytest.approx([0.25, 0.5, 0.75, 1.0])
+    # the fields' time: the load factor, then each stage's progress added (ParaView needs
+    # it to grow)
+    times, _ = read_series(tmp_path / "out" / "displacement.bp", "displacement")
+    assert times == pytest.approx([1.0, 1.25, 1.5, 1.75, 2.0])
     assert d["reactions"]["bottom"][1] == pytest.approx(18.0 * 14.0, rel=1e-10)
     assert dug[-1]["plastic_volume_fraction"] > 0
     for change, said in ((("steps = 4\n", 'steps = 4\nadd = ["pit"]\n'),
@@ -301,6 +308,39 @@ def test_a_case_file_digs_a_pit_in_stages(tmp_path, demo):
         (tmp_path / "bad.toml").write_text(STAGED.replace(*change))
         proc = demo.run(["-m fenics_nl", "run", tmp_path / "bad.toml"], check=False)
         assert proc.returncode == 2 and said in proc.stderr, proc.stderr
+
+
+LIFTS_GEO = LAYERED_GEO.replace("Rectangle(2) = {0, -1, 0, 2, 1};",
+                                "Rectangle(2) = {0, -0.5, 0, 2, 0.5};\n"
+                                "Rectangle(4) = {0, -1, 0, 2, 0.5};").replace(
+    'Physical Surface("pit") = {2};', 'Physical Surface("lift1") = {2};\n'
+                                      'Physical Surface("lift2") = {4};')
+LIFTS = STAGED.replace('name = "dig"\nremove = ["pit"]\nsteps = 4\n',
+                       'name = "lift 1"\nremove = ["lift1"]\nsteps = 2\n\n'
+                       '[[stage]]\nname = "lift 2"\nremove = ["lift2"]\nsteps = 2\n').replace(
+    "layered.geo", "lifts.geo")
+
+
+def test_a_staged_case_restarts_inside_a_stage_and_between_two(tmp_path, demo):
+    # the pit dug in two lifts of two steps (Mohr–Coulomb: the state matters), checkpoints
+    # every 2 steps (2 and 4 kept) and every 3 (3), restarted as a run killed after the
+    # first lift's first step (inside it: its frozen forces and the parts present from the
+    # checkpoint), after the first lift (the next begins from the restored state), and
+    # inside the second: each the same steps, iterations, probes and reactions as the whole
+    # run (1e-10); the bottom carries the weight left, 18 × 14, at the end
+    from conftest import same_answer
+
+    (tmp_path / "lifts.geo").write_text(LIFTS_GEO)
+    case = tmp_path / "lifts.toml"
+    case.write_text(LIFTS)
+    whole = demo.case(case, "--checkpoint", tmp_path / "two", "--checkpoint-every", "2")
+    assert [s.get("stage") for s in whole["steps"]] == [None] + ["lift 1"] * 2 + ["lift 2"] * 2
+    assert whole["reactions"]["bottom"][1] == pytest.approx(18.0 * 14.0, rel=1e-10)
+    assert whole["steps"][-1]["plastic_volume_fraction"] > 0
+    demo.case(case, "--checkpoint", tmp_path / "three", "--checkpoint-every", "3")
+    for folder, step in (("two", 2), ("three", 3), ("two", 4)):
+        (tmp_path / folder / "latest.json").write_text(json.dumps({"step": f"step-{step:06d}"}))
+        same_answer(whole, demo.case(case, "--restart", tmp_path / folder))
 
 
 @pytest.mark.mpi

@@ -242,6 +242,14 @@ class CaseProblem:
         stages.present["body"].x.array[:] = 1.0  # every cell, in a group or not
         return stages
 
+    def resume_stage(self, stage: dict) -> None:
+        """Go on inside `stage` from a checkpoint, its fields restored.
+
+        Its progress is the driver's; the dofs no present cell touches are held where they are.
+        """
+        self.construction.stage = stage["name"]
+        self.solver.set_bcs(self.bcs + self.construction.held(self.u))
+
     def begin_stage(self, stage: dict) -> None:
         """Start `stage` at equilibrium: its groups dug out, their forces frozen (s = 0)."""
         eps = kinematics.small_strain(self.u, self.model)

@@ -2,10 +2,11 @@
 
 The state is the unknown (with the pressure of the mixed form), the internal variables at
 the quadrature points (J2's plastic strain and cumulated plastic strain), the contact's
-active set (a pair's: its statuses, forces and committed slip) and Newton's force
-reference; the identity is the case file's content (its hash, not its name: a copy
-elsewhere restarts, an edit does not) and the unknowns. The phases of the path are the
-case's load segments (0 for equal steps).
+active set (a pair's: its statuses, forces and committed slip), the construction stages'
+fields (the parts present, the frozen stress and weight of what a stage digs out) and
+Newton's force reference; the identity is the case file's content (its hash, not its name:
+a copy elsewhere restarts, an edit does not) and the unknowns. The phases of the path are
+the case's load segments (0 for equal steps), then its stages.
 """
 
 from __future__ import annotations
@@ -24,6 +25,9 @@ def case_checkpoints(problem, folder: str, every: int = 1) -> PathCheckpoints:
     functions = {"unknown": problem.unknown}
     if problem.material.path_dependent:
         functions.update(problem.material.state_functions())
+    if getattr(problem, "construction", None) is not None:
+        functions.update({f"construction.{k}": f for k, f in
+                          problem.construction.state_functions().items()})
     solver = problem.solver
     # the rigid obstacle's active set, or the pairs' (their statuses and wear)
     contact = solver.contact if problem.contact is not None else solver if \

@@ -38,11 +38,6 @@ def solve_case(problem: CaseProblem, *, checkpoint: str | None = None,
     `checkpoint`: a folder where the state after every `checkpoint_every`-th converged step
     is saved; `restart`: a folder to go on from (the same case, mesh and ranks).
     """
-    if problem.case.stages and (checkpoint or restart):
-        from fenics_nl.case.spec import CaseError
-
-        raise CaseError(["--checkpoint, --restart: not with [[stage]] yet (a stage's frozen "
-                         "forces and the parts present are not in a checkpoint)"])
     t0 = time.perf_counter()
     solver = problem.make_solver()
     setup = time.perf_counter() - t0
@@ -120,6 +115,10 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
             say("  " + message)
 
     critical, ended_by, in_time = None, None, None
+    # the stages' phases follow the loading's: its segments (one for equal steps)
+    loading = 1 if case.equal_steps else len(case.factors)
+    if first >= loading:  # a restart inside the stages: the loads at their last factor
+        problem.set_load(steps[-1]["load_factor"])
     if case.time is not None and getattr(solver, "wear", None) is not None:
         _wear_in_time(problem, solver, converged, steps, work, saving, start)
     elif case.time is not None:  # a rate-dependent law: time is the load parameter
@@ -170,8 +169,12 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
                                    steps, case) from err
             work.add(path.work)
             previous = target
-    for stage in case.stages:  # after the loading, at its last load factor
-        _dig(problem, solver, stage, steps, work, commit, show)
+    for k, stage in enumerate(case.stages, start=loading):  # at the loading's last factor
+        if k >= first:
+            _dig(problem, solver, stage, steps, work, commit, show, save(k),
+                 start if k == first else None)
+        elif k == first - 1 and start is None:  # a restart after a complete stage
+            problem.construction.end()
     last = steps[-1]
     out = {"case": str(case.path), "model": case.model, "law": case.law_name,
            "dofs": problem.dofs, "ranks": problem.mesh.comm.size, "steps": steps,
@@ -206,25 +209,33 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
 
 
 def _dig(problem: CaseProblem, solver, stage: dict, steps: list[dict], work, commit,
-         show) -> None:
-    """One construction stage: its groups dug out, their forces released in its steps."""
-    problem.begin_stage(stage)
+         show, on_state=None, start=None) -> None:
+    """One construction stage: its groups dug out, their forces released in its steps.
+
+    `on_state`: the checkpoints' (after each converged step); `start`: where a restart goes
+    on inside the stage (its fields restored).
+    """
+    if start is None:
+        problem.begin_stage(stage)
+    else:
+        problem.resume_stage(stage)
     t = steps[-1]["load_factor"] if steps else 1.0
 
     def release(s):
         problem.construction.progress.value = s
 
     def record(s, result):
-        steps.append(step_record(problem, t, result) | {"stage": stage["name"],
-                                                        "stage_progress": s})
+        steps.append(step_record(problem, t, result, stage=(stage["name"], s)))
         cli.converged_step(steps[-1], fields=lambda: fields(problem))
 
     say(f"stage {stage['name']!r}: {', '.join(stage['remove'])} dug out in "
-        f"{stage['steps']} step(s)")
+        f"{stage['steps']} step(s)" + ("" if start is None else
+                                       f", from {start.t:.4g} of it (restarted)"))
     try:
         path = solve_incrementally(solver, release, stage["steps"], adaptive=True,
                                    max_step=1.0 / stage["steps"], progress=show,
-                                   commit=commit, on_step=record)
+                                   commit=commit, on_step=record, on_state=on_state,
+                                   start=start)
     except LoadStepError as err:
         raise SolveError(f"stage {stage['name']!r} stopped at {err.reached:.4g} of its "
                          f"release: {err}") from err
@@ -356,10 +367,16 @@ def _stop_condition(stop: dict | None, steps: list[dict], model: str):
     return lambda: _probe_component(steps[-1], stop, model) / stop["value"] >= 1.0
 
 
-def step_record(problem: CaseProblem, t: float, result, at: float | None = None) -> dict:
-    """What one converged step reports (collective); `at`: in time, the step's time."""
+def step_record(problem: CaseProblem, t: float, result, at: float | None = None,
+                stage: tuple[str, float] | None = None) -> dict:
+    """What one converged step reports (collective).
+
+    `at`: in time, the step's time; `stage`: a construction stage's (name, progress).
+    """
     rec = {"load_factor": t, "newton_iterations": result.iterations,
            "probes": problem.probe_values(), "reactions": problem.reactions()}
+    if stage is not None:
+        rec |= {"stage": stage[0], "stage_progress": stage[1]}
     if problem.damage:
         d = problem.solver
         rec |= {"alternate_iterations": d.last.iterations,
@@ -382,7 +399,9 @@ def step_record(problem: CaseProblem, t: float, result, at: float | None = None)
         extra = (f" in {rec['alternate_iterations']} alternate iterations, largest damage "
                  f"{rec['largest_damage']:.3g}")
     when = "" if at is None else f"time {at:.6g}, "
-    say(f"{when}load factor {t:.4g}: {result.iterations} Newton iterations{extra}")
+    where = f"load factor {t:.4g}" if stage is None else \
+        f"stage {stage[0]!r} at {stage[1]:.4g}"
+    say(f"{when}{where}: {result.iterations} Newton iterations{extra}")
     return rec
 
 

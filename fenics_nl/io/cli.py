@@ -204,7 +204,8 @@ def converged_step(record: dict, fields: Callable[[], list] | None = None) -> No
             from fenics_nl.io.output import FieldSeries
 
             run.series = FieldSeries(run.output)
-        run.series.write(record["load_factor"], fields, record.get("time"))
+        run.series.write(record["load_factor"], fields, record.get("time"),
+                         record.get("stage_progress"))
 
 
 def on_failure(writers: Callable[[dict], Sequence[Callable[[], None]]]) -> None:

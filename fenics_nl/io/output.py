@@ -3,8 +3,8 @@
 * `write_fields`: one ADIOS2 VTX file per function (any Lagrange degree, on any mesh
   degree: P2 on quadrilaterals included), which ParaView opens directly.
 * `FieldSeries`: the same files as a time series, one time per converged load step (the
-  load factor as time, Σ|Δt| on a path that comes back), written as the steps converge: a
-  run that fails keeps them.
+  load factor as time, Σ|Δt| on a path that comes back, plus each construction stage's
+  progress), written as the steps converge: a run that fails keeps them.
 * `gather_grid`: the mesh of a Lagrange space, its nodal and cell fields, collected from
   every rank on rank 0, so that a picture shows the whole body whatever the number of ranks.
 """
@@ -65,9 +65,10 @@ class FieldSeries:
 
     The time is the load-path time τ = Σ |Δt| of the load factors t given: the load factor
     itself while it grows, and still increasing when the path comes back (an unloading), as
-    ParaView needs. `functions()` gives the fields of the current state (new Function
-    objects each call are fine: their values are copied into the series' own). Each file is
-    written at every step. Collective; `close()` at the end.
+    ParaView needs; a construction stage's steps (at one load factor) add their progress.
+    `functions()` gives the fields of the current state (new Function objects each call are
+    fine: their values are copied into the series' own). Each file is written at every
+    step. Collective; `close()` at the end.
     """
 
     def __init__(self, folder: str | Path):
@@ -75,17 +76,23 @@ class FieldSeries:
         self._series: dict[str, tuple] = {}  # name -> (writer, its own copy of the field)
         self.times: list[float] = []
         self._last = 0.0  # the last load factor
+        self._progress = 0.0  # the last stage step's progress
 
-    def write(self, t: float, functions, time: float | None = None) -> None:
+    def write(self, t: float, functions, time: float | None = None,
+              progress: float | None = None) -> None:
         """Every field of the current state, `functions()`, at load factor t.
 
         Its time in the files is Σ|Δt| of the load factors so far, or `time` if given (a
-        viscous law's own time).
+        viscous law's own time); a stage's step (`progress` s in (0, 1]) adds its Δs (a
+        stage begins at s = 0).
         """
         from dolfinx.io import VTXWriter
 
-        tau = time if time is not None else (
-            (self.times[-1] if self.times else 0.0) + abs(t - self._last))
+        step = abs(t - self._last)
+        if progress is not None:
+            step += progress - (self._progress if progress > self._progress else 0.0)
+            self._progress = progress
+        tau = time if time is not None else (self.times[-1] if self.times else 0.0) + step
         self._last = t
         for f in functions():
             if f.name not in self._series:
