@@ -117,7 +117,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
     critical, ended_by, in_time = None, None, None
     # the stages' phases follow the loading's: its segments (one for equal steps)
     loading = 1 if case.equal_steps else len(case.factors)
-    if first >= loading:  # a restart inside the stages: the loads at their last factor
+    if case.stages and first >= loading:  # a restart in the stages: the loading's end
         problem.set_load(steps[-1]["load_factor"])
     if case.time is not None and getattr(solver, "wear", None) is not None:
         _wear_in_time(problem, solver, converged, steps, work, saving, start)
