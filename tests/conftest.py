@@ -325,7 +325,8 @@ def run_and_kill(cmd, cwd, after_line: str, ranks=1):
 def same_answer(a, b, rel=1e-10):
     """Every step's load factor, iterations, probes and reactions agree (to `rel` of the
     largest value): the restart took the same path (predictor, force reference, statuses)."""
-    for key in ("load_factor", "newton_iterations", "active_set_iterations"):
+    for key in ("load_factor", "newton_iterations", "active_set_iterations", "stage",
+                "stage_progress"):
         assert [s.get(key) for s in a["steps"]] == [s.get(key) for s in b["steps"]], key
     import numpy as np
 

@@ -314,20 +314,25 @@ LIFTS_GEO = LAYERED_GEO.replace("Rectangle(2) = {0, -1, 0, 2, 1};",
                                 "Rectangle(2) = {0, -0.5, 0, 2, 0.5};\n"
                                 "Rectangle(4) = {0, -1, 0, 2, 0.5};").replace(
     'Physical Surface("pit") = {2};', 'Physical Surface("lift1") = {2};\n'
-                                      'Physical Surface("lift2") = {4};')
+                                      'Physical Surface("lift2") = {4};\n'
+                                      'Physical Curve("top") = Curve In BoundingBox'
+                                      '{1.9, -0.1, -0.1, 4.1, 0.1, 0.1};')
 LIFTS = STAGED.replace('name = "dig"\nremove = ["pit"]\nsteps = 4\n',
                        'name = "lift 1"\nremove = ["lift1"]\nsteps = 2\n\n'
                        '[[stage]]\nname = "lift 2"\nremove = ["lift2"]\nsteps = 2\n').replace(
-    "layered.geo", "lifts.geo")
+    "layered.geo", "lifts.geo").replace("[loading]", '[[boundary]]\ngroup = "top"\n'
+                                        'pressure = 1.0\n\n[loading]')
 
 
 def test_a_staged_case_restarts_inside_a_stage_and_between_two(tmp_path, demo):
-    # the pit dug in two lifts of two steps (Mohr–Coulomb: the state matters), checkpoints
-    # every 2 steps (2 and 4 kept) and every 3 (3), restarted as a run killed after the
-    # first lift's first step (inside it: its frozen forces and the parts present from the
-    # checkpoint), after the first lift (the next begins from the restored state), and
-    # inside the second: each the same steps, iterations, probes and reactions as the whole
-    # run (1e-10); the bottom carries the weight left, 18 × 14, at the end
+    # the pit dug in two lifts of two steps (Mohr–Coulomb: the state matters) beside a
+    # surcharge of 1 on the ground's top x > 2 (its load held through the stages: a restart
+    # must put it back), checkpoints every 1 (4 and 5 kept), 2 (2 and 4) and 3 steps (3),
+    # restarted as a run killed after the first lift's first step (inside it: its frozen
+    # forces and the parts present from the checkpoint), after the first lift (the next
+    # begins from the restored state), inside the second and after the last: each the same
+    # steps, stages, iterations, probes and reactions as the whole run (1e-10); the bottom
+    # carries the weight left and the surcharge, 18 × 14 + 1 × 2, at the end
     from conftest import same_answer
 
     (tmp_path / "lifts.geo").write_text(LIFTS_GEO)
@@ -335,10 +340,11 @@ def test_a_staged_case_restarts_inside_a_stage_and_between_two(tmp_path, demo):
     case.write_text(LIFTS)
     whole = demo.case(case, "--checkpoint", tmp_path / "two", "--checkpoint-every", "2")
     assert [s.get("stage") for s in whole["steps"]] == [None] + ["lift 1"] * 2 + ["lift 2"] * 2
-    assert whole["reactions"]["bottom"][1] == pytest.approx(18.0 * 14.0, rel=1e-10)
+    assert whole["reactions"]["bottom"][1] == pytest.approx(18.0 * 14.0 + 2.0, rel=1e-10)
     assert whole["steps"][-1]["plastic_volume_fraction"] > 0
-    demo.case(case, "--checkpoint", tmp_path / "three", "--checkpoint-every", "3")
-    for folder, step in (("two", 2), ("three", 3), ("two", 4)):
+    for every in ("1", "3"):
+        demo.case(case, "--checkpoint", tmp_path / every, "--checkpoint-every", every)
+    for folder, step in (("two", 2), ("3", 3), ("two", 4), ("1", 5)):
         (tmp_path / folder / "latest.json").write_text(json.dumps({"step": f"step-{step:06d}"}))
         same_answer(whole, demo.case(case, "--restart", tmp_path / folder))
 

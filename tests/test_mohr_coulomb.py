@@ -440,6 +440,76 @@ def test_the_tension_cut_off_holds_a_pull_and_an_equal_pull():
         MohrCoulomb(E, NU, c=C, phi=PHI, tension=2.0)
 
 
+@pytest.mark.parametrize("model", ["plane_strain", "3d"])
+def test_the_tangent_is_consistent_where_two_trial_stresses_meet(model):
+    # where two trial principal stresses meet their directions are not defined, and the
+    # tangent needs how the return moves the pair: together onto an edge (a ground at
+    # σ0 = −10 I strained ε = (a, a, 0): σ_xx = σ_yy returned onto the edge σ1 = σ2), or
+    # alike (3D: the cube pulled along z past the cut-off t = 0.6, its sides free:
+    # σ_xx = σ_yy = 0 shifted together). Taylor's slope 2 a plastic step further, its
+    # remainders not round-off (slope 1 before the pair's ratio was carried: the in-plane
+    # shear's tangent was elastic, or nothing)
+    law = MohrCoulomb(E, NU, c=C, phi=PHI, psi=10.0,
+                      initial_stress=((-10.0, 0, 0), (0, -10.0, 0), (0, 0, -10.0)))
+    square = Square(law, model, pulled=True)
+    step = (lambda a: (a, a)) if model == "plane_strain" else (lambda a: (a, 0.0))
+    on_edge = square.go([step(1.2e-3)])[0]
+    lateral, third = on_edge[0], on_edge[2 if model == "plane_strain" else 1]
+    assert (lateral - third) + (lateral + third) * SIN == pytest.approx(2 * C * COS, rel=1e-12)
+    for bc, value in zip(square.moved, step(1.3e-3) if model == "plane_strain"
+                         else (1.3e-3, 1.3e-3, 0.0), strict=True):
+        bc.g.x.array[:] = value
+    square.solver.solve()
+    remainders, slopes = taylor_remainders(square.residual, square.u, 5e-5, seed=2)
+    if model == "plane_strain":  # the edge's return is linear there (the pair's sum, σ_zz):
+        # the remainders are round-off (1e-3 without the ratio: the trial's shear kept)
+        assert max(remainders) < 1e-12, remainders
+    else:  # the third direction turns with the strain
+        assert remainders[0] > 1e-8 and np.all(slopes > 1.9), remainders
+    if model == "3d":
+        cube = Square(MohrCoulomb(E, NU, c=C, phi=PHI, psi=10.0, tension=0.6), model)
+        sigma = cube.go(np.array([0.5, 2.0]) * 0.6 / E)
+        assert sigma[-1] == pytest.approx([0.0, 0.6, 0.0], abs=1e-10)
+        cube.moved[0].g.x.array[:] *= 1.2
+        cube.solver.solve()
+        remainders, slopes = taylor_remainders(cube.residual, cube.u, 5e-5 * 0.6, seed=2)
+        assert remainders[0] > 1e-10 and np.all(slopes > 1.9), remainders
+
+
+def test_a_sheared_initial_stress_is_judged_by_its_principal_stresses():
+    # σ0 with a shear σ_xz = 5 (3D): principal −5, −10, −15, outside a φ = 10°, c = 1
+    # pyramid by f = 10 − 20 sin10° − 2 cos10° = 4.56 (the yield check of the initial stress
+    # took the third direction as principal: f < 0, accepted); the 3x3 closed form against
+    # numpy's eigenvalues at random stresses, to 1e-12 of the stress
+    from fenics_nl.expression import Expression
+    from fenics_nl.materials.mohr_coulomb import principal_3d
+
+    m = mesh.create_unit_cube(MPI.COMM_SELF, 1, 1, 1)
+    stress = fem.Constant(m, np.zeros((3, 3)))
+    Q = fem.functionspace(m, ("DG", 0, (4,)))
+    value = fem.Function(Q)
+    law = MohrCoulomb(E, NU, c=C, phi=10.0)
+    compiled = Expression(ufl.as_vector([law.yield_function(stress), *principal_3d(stress)[0]]),
+                          Q.element.interpolation_points)
+
+    def at(sigma):  # (f, σ1, σ2, σ3) of a stress
+        stress.value[:] = sigma
+        value.interpolate(compiled)
+        return value.x.array[:4]
+
+    s10, c10 = math.sin(math.radians(10.0)), math.cos(math.radians(10.0))
+    f = at([[-10.0, 0.0, 5.0], [0.0, -10.0, 0.0], [5.0, 0.0, -10.0]])[0]
+    assert f == pytest.approx(10.0 - 20.0 * s10 - 2.0 * c10, rel=1e-12)
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        a = rng.normal(size=(3, 3))
+        a = a + a.T
+        if rng.random() < 0.5:  # two equal
+            w, q = np.linalg.eigh(a)
+            a = q @ np.diag([w[0], w[0], w[2]]) @ q.T
+        assert at(a)[1:] == pytest.approx(np.sort(np.linalg.eigvalsh(a))[::-1], abs=1e-12 * 6)
+
+
 def footing_pressures(n: int, phi: float = 20.0, cell: str = "crossed",
                       comm=MPI.COMM_WORLD) -> list:
     """The pressures under a rigid smooth strip footing (half-width 1) on a weightless

@@ -285,14 +285,15 @@ class CaseProblem:
 
         law, Q = self.material, self.material.quadrature_space()
         eps_v = kinematics.small_strain(self.fields.v, self.model)
-        f = law.yield_function(law.initial(eps_v))
         geostatic = isinstance(self.case.initial_stress, dict)
-        if geostatic:  # at each point
-            at_points = fem.Function(Q)
-            at_points.interpolate(Expression(f, Q.element.interpolation_points))
-            values = at_points.x.array[:Q.dofmap.index_map.size_local]
-        else:  # uniform: one value (UFL evaluates a constant expression)
-            values = np.array([float(f(()))])
+        # (a uniform one as a Constant of the mesh: compiled, as the geostatic one; UFL's
+        # own evaluation of a 3D principal stress's graph takes minutes)
+        stress = law.initial(eps_v) if geostatic else fem.Constant(
+            self.mesh, np.array(self.case.initial_stress, dtype=float))
+        at_points = fem.Function(Q)
+        at_points.interpolate(Expression(law.yield_function(stress),
+                                         Q.element.interpolation_points))
+        values = at_points.x.array[:Q.dofmap.index_map.size_local]
         worst = self.mesh.comm.allreduce(float(values.max(initial=-np.inf)), op=MPI.MAX)
         scale = law.yield_scale
         if worst > 1e-9 * scale:

@@ -110,9 +110,9 @@ class MohrCoulomb(SoilPlasticity):
         """f(σ) = (σ1 − σ3) + (σ1 + σ3) sinφ − 2c cosφ (UFL): ≤ 0 inside.
 
         Args:
-            sigma: a stress (UFL, 3x3) whose third direction is principal.
+            sigma: a symmetric stress (UFL, 3x3).
         """
-        s1, _, s3 = principal(sigma)[0]
+        s1, _, s3 = principal_3d(sigma)[0]
         sine = math.sin(math.radians(self.phi))
         f = (s1 - s3) + (s1 + s3) * sine - self.yield_scale
         if self.tension is None:
@@ -160,13 +160,19 @@ class MohrCoulomb(SoilPlasticity):
                 self._returned(s, ("13", "23"), sphi, spsi),
                 self._returned(s, ("13", "12"), sphi, spsi), strict=True)]
             below_apex = ufl.ge(edge[0], edge[2])
+            at_apex = (self.apex,) * 3 + (0.0, 0.0)
             returned = [ufl.conditional(ordered, main[i], ufl.conditional(
-                below_apex, edge[i], self.apex)) for i in range(3)]
+                below_apex, edge[i], at_apex[i])) for i in range(5)]
         if three_d:  # the returned stress from its principal values (module docstring)
-            return self._flowed(ufl.conditional(plastic, sigma_tr - back(returned), 0 * sigma_tr),
+            sigma = back(returned[:3], returned[3:])
+            return self._flowed(ufl.conditional(plastic, sigma_tr - sigma, 0 * sigma_tr),
                                 plastic)
+        # (2D: the correction σ_tr − σ along the directions, whose pair's ratio is 1 − the
+        # returned pair's)
         return self._flowed(back([ufl.conditional(plastic, s[i] - returned[i], 0.0)
-                                  for i in range(3)]), plastic)
+                                  for i in range(3)],
+                                 [ufl.conditional(plastic, 1 - r, 0.0) for r in returned[3:]]),
+                            plastic)
 
     def _flowed(self, d_sigma, plastic):
         """(ε_p, p̄, Δp̄) of the step's stress correction σ_tr − σ: Δε_p = C⁻¹ : it."""
@@ -175,7 +181,7 @@ class MohrCoulomb(SoilPlasticity):
         return (self._bound().eps_p + d_eps_p, *self.cumulated(d_eps_p, plastic))
 
     def _cut_off_return(self, s, sphi, spsi, tolerance):
-        """The sorted stresses returned with the cut-off (UFL, 3 values).
+        """The sorted stresses returned with the cut-off, and the pairs' ratios (5 values).
 
         The first of `CUT_OFF_SETS` (the main plane, its edges, the cut-off's planes and
         their corners) whose multipliers are ≥ 0 and whose stress breaks no plane.
@@ -184,7 +190,7 @@ class MohrCoulomb(SoilPlasticity):
         chosen = None
         for planes in reversed(CUT_OFF_SETS):  # the last is the fallback, the first wins
             stress, gammas = self._returned(s, planes, sphi, spsi, multipliers=True)
-            sigma = ufl.as_vector(stress)
+            sigma = ufl.as_vector(stress[:3])
             admissible = [ufl.le(self._plane_value(sigma, p, sphi), tolerance) for p in every
                           if p not in planes] + [ufl.ge(g, 0.0) for g in gammas]
             if chosen is None:
@@ -203,14 +209,18 @@ class MohrCoulomb(SoilPlasticity):
         return ufl.dot(ufl.as_vector(plane(pair, sphi)), sigma) - bound
 
     def _returned(self, s, pairs, sphi, spsi, multipliers=False):
-        """The sorted principal stresses returned onto the planes `pairs` (UFL, 3 values).
+        """The sorted principal stresses returned onto the planes `pairs`, and two ratios.
 
         σ = σ_tr − D Σ Δγ_a n_a with k_b · σ = r_b on each plane b (r = 2c cosφ on
         Mohr–Coulomb's, t on the cut-off's): the multipliers solve M Δγ = k · σ_tr − r,
         M_ba = k_b · D n_a (constants, solved here). `multipliers`: also the Δγ_a.
         The stress is written σ = A σ_tr + b, its rows that must be equal (an edge: σ1 = σ2;
         a corner of the cut-off) made exactly equal: a pair split by round-off would have
-        its own directions (3D: ill-defined there).
+        its own directions (3D: ill-defined there). The ratios: how the returned pair's
+        difference follows the trial's, (σ1 − σ2)/(σ1_tr − σ2_tr) and (σ2 − σ3)/(σ2_tr −
+        σ3_tr) as the trial's pair meets (0 where the return makes them equal, 1 where it
+        moves them alike: the cut-off's face): `principal_3d`'s `back` needs them there.
+        Returns 5 values (UFL and numbers).
         """
         lam, G = self.kappa - 2.0 * self.mu / 3.0, self.mu
         D = 2.0 * G * np.eye(3) + lam * np.ones((3, 3))
@@ -227,6 +237,8 @@ class MohrCoulomb(SoilPlasticity):
             A[same], b[same] = A[same].mean(axis=0), b[same].mean()
         stress = [sum(float(A[i, j]) * s[j] for j in range(3) if A[i, j] != 0) + float(b[i])
                   for i in range(3)]
+        stress += [float((A[i, i] - A[i, j]) - (A[j, i] - A[j, j])) / 2
+                   for i, j in ((0, 1), (1, 2))]
         if not multipliers:
             return stress
         f = [self._plane_value(s, p, sphi) for p in pairs]
@@ -244,16 +256,16 @@ def principal(sigma):
         sigma: a stress (UFL, 3x3) with σ_xz = σ_yz = 0.
 
     Returns:
-        ((σ1, σ2, σ3), back): `back` turns three values along the sorted directions into
-        the 3x3 tensor with the stress's principal directions (UFL).
+        ((σ1, σ2, σ3), back): `back(values, ratios)` turns three values along the sorted
+        directions into the 3x3 tensor with the stress's principal directions (UFL);
+        `ratios` as `principal_3d`'s.
     """
     a, b, xy, z = sigma[0, 0], sigma[1, 1], sigma[0, 1], sigma[2, 2]
     m, half = (a + b) / 2, (a - b) / 2
     square = half * half + xy * xy
     # R's root has no derivative at 0 (an in-plane pair that coincides): below round-off
-    # of the stress it is taken as that round-off (its tangent there is then elastic in
-    # the in-plane shear: a symmetric state, K0 = 1, converges more slowly, to the same
-    # answer)
+    # of the stress it is taken as that round-off (the pair's directions are then the
+    # tangent's business: `ratios`)
     tiny = (1e-14 * (abs(a) + abs(b) + abs(xy))) ** 2 + 1e-300
     big = ufl.gt(square, tiny)
     R = ufl.sqrt(ufl.conditional(big, square, tiny))
@@ -263,14 +275,15 @@ def principal(sigma):
     s3 = ufl.conditional(z_last, z, lo)
     s2 = ufl.conditional(z_first, hi, ufl.conditional(z_last, lo, z))
 
-    def back(values):
+    def back(values, ratios=(0.0, 0.0)):
         v1, v2, v3 = values
         v_hi = ufl.conditional(z_first, v2, v1)
         v_lo = ufl.conditional(z_last, v2, v3)
         v_z = ufl.conditional(z_first, v1, ufl.conditional(z_last, v3, v2))
         # the in-plane pair along the pair's directions: its mean, and its half-difference
-        # along (σ − m I) / R (0 where the pair coincides: no direction, no difference)
-        ratio = ufl.conditional(big, (v_hi - v_lo) / (2 * R), 0.0)
+        # along (σ − m I) / R; where the pair meets, the given ratio (`principal_3d`'s)
+        limit = ufl.conditional(z_first, ratios[1], ratios[0])
+        ratio = ufl.conditional(big, (v_hi - v_lo) / (2 * R), limit)
         mean = (v_hi + v_lo) / 2
         return ufl.as_matrix([[mean + ratio * half, ratio * xy, 0],
                               [ratio * xy, mean - ratio * half, 0],
@@ -302,8 +315,10 @@ def principal_3d(sigma):
         sigma: a symmetric stress (UFL, 3x3).
 
     Returns:
-        ((σ1, σ2, σ3), back): `back` turns three values along the sorted directions into
-        the 3x3 tensor with the stress's principal directions (UFL).
+        ((σ1, σ2, σ3), back): `back(values, ratios)` turns three values along the sorted
+        directions into the 3x3 tensor with the stress's principal directions (UFL);
+        `ratios`: (σ1 − σ2, σ2 − σ3)'s to the stress's where that pair meets (the
+        tangent's there; `MohrCoulomb._returned`).
     """
     identity = ufl.Identity(3)
     p = ufl.tr(sigma) / 3
@@ -311,7 +326,8 @@ def principal_3d(sigma):
     # a stress with (nearly) no deviator has no Lode angle: J2 below round-off of the stress
     # is taken as that round-off (the three values then meet, and `back` gives their mean)
     size = sum(abs(sigma[i, j]) for i in range(3) for j in range(3))
-    tiny = (1e-14 * size) ** 2 + 1e-300
+    # (the floor: J2^(3/2) of it is no underflow, σ = 0 no 0/0)
+    tiny = (1e-14 * size) ** 2 + 1e-150
     j2 = ufl.inner(s, s) / 2
     j2 = ufl.conditional(ufl.gt(j2, tiny), j2, tiny)
     j3 = ufl.det(s)
@@ -339,13 +355,16 @@ def principal_3d(sigma):
     s2 = ufl.conditional(major, m + h, m - h)
     s3 = ufl.conditional(major, m - h, simple)
 
-    def back(values):
+    def back(values, ratios=(0.0, 0.0)):
         v1, v2, v3 = values
         v_s = ufl.conditional(major, v1, v3)
         v_hi, v_lo = ufl.conditional(major, v2, v1), ufl.conditional(major, v3, v2)
-        # the pair along its directions: its mean, and its half-difference along N / h (0
-        # where the pair coincides: no direction, no difference)
-        ratio = ufl.conditional(big, (v_hi - v_lo) / (2 * h), 0.0)
+        # the pair along its directions: its mean, and its half-difference along N / h;
+        # where the trial's pair meets (h below round-off: no directions), the given ratio,
+        # the limit of the returned pair's difference to the trial's (its value is then
+        # times N ≈ 0; its derivative's is the tangent's)
+        limit = ufl.conditional(major, ratios[1], ratios[0])
+        ratio = ufl.conditional(big, (v_hi - v_lo) / (2 * h), limit)
         return v_s * E_s + (v_hi + v_lo) / 2 * (identity - E_s) + ratio * N
 
     return (s1, s2, s3), back
