@@ -346,7 +346,14 @@ def test_a_staged_case_restarts_inside_a_stage_and_between_two(tmp_path, demo):
         demo.case(case, "--checkpoint", tmp_path / every, "--checkpoint-every", every)
     for folder, step in (("two", 2), ("3", 3), ("two", 4), ("1", 5)):
         (tmp_path / folder / "latest.json").write_text(json.dumps({"step": f"step-{step:06d}"}))
-        same_answer(whole, demo.case(case, "--restart", tmp_path / folder))
+        same_answer(whole, demo.case(case, "--restart", tmp_path / folder, "--output",
+                                     tmp_path / f"fields{step}"))
+    # the restarted fields go on at the whole run's times (the load factor, then each
+    # stage's progress: 1, 1.5, 2, 2.5, 3), not from 0
+    from conftest import read_series
+
+    times, _ = read_series(tmp_path / "fields3" / "displacement.bp", "displacement")
+    assert times == pytest.approx([2.5, 3.0])
 
 
 @pytest.mark.mpi

@@ -175,7 +175,8 @@ class _Run:
 
     def close_series(self) -> None:
         """Close the fields' time series, saying what it holds (collective)."""
-        if self.series is None:
+        if self.series is None or not self.series.times:
+            self.series = None
             return
         paths = self.series.paths
         self.series.close()
@@ -199,13 +200,16 @@ def converged_step(record: dict, fields: Callable[[], list] | None = None) -> No
     if run is None:
         return
     run.steps.append(dict(record))
-    if fields is not None and run.output:
+    if run.output:
         if run.series is None:
             from fenics_nl.io.output import FieldSeries
 
             run.series = FieldSeries(run.output)
-        run.series.write(record["load_factor"], fields, record.get("time"),
-                         record.get("stage_progress"))
+        at = (record["load_factor"], record.get("time"), record.get("stage_progress"))
+        if fields is None:  # a step not written (a restart's before it): its time counts
+            run.series.advance(*at)
+        else:
+            run.series.write(at[0], fields, *at[1:])
 
 
 def on_failure(writers: Callable[[dict], Sequence[Callable[[], None]]]) -> None:

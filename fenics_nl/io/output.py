@@ -77,6 +77,7 @@ class FieldSeries:
         self.times: list[float] = []
         self._last = 0.0  # the last load factor
         self._progress = 0.0  # the last stage step's progress
+        self._tau = 0.0  # the last step's time
 
     def write(self, t: float, functions, time: float | None = None,
               progress: float | None = None) -> None:
@@ -88,12 +89,7 @@ class FieldSeries:
         """
         from dolfinx.io import VTXWriter
 
-        step = abs(t - self._last)
-        if progress is not None:
-            step += progress - (self._progress if progress > self._progress else 0.0)
-            self._progress = progress
-        tau = time if time is not None else (self.times[-1] if self.times else 0.0) + step
-        self._last = t
+        tau = self.advance(t, time, progress)
         for f in functions():
             if f.name not in self._series:
                 self.folder.mkdir(parents=True, exist_ok=True)
@@ -105,6 +101,20 @@ class FieldSeries:
             copy.x.array[:] = f.x.array
             writer.write(tau)
         self.times.append(tau)
+
+    def advance(self, t: float, time: float | None = None, progress: float | None = None
+                ) -> float:
+        """The time of a step at load factor t (`write`'s), counted without writing it.
+
+        A restart's steps before it count so, and its fields go on at their times.
+        """
+        step = abs(t - self._last)
+        if progress is not None:
+            step += progress - (self._progress if progress > self._progress else 0.0)
+            self._progress = progress
+        self._tau = time if time is not None else self._tau + step
+        self._last = t
+        return self._tau
 
     @property
     def paths(self) -> list[Path]:
