@@ -108,7 +108,7 @@ test-mpi: $(VENV)/.installed
 # and every capability on the iterative path at ~1M (about an hour more)
 BENCHMARKS := newton contact contact_pair buckling bracket iterative arch_iterative plasticity sphere_ranks \
 	plasticity_peer mixed secant \
-	friction continuation newtonal damage damage_peer identification forming creep slope
+	friction continuation newtonal damage damage_peer identification forming creep slope soil_3d
 bench: $(VENV)/.bench-installed
 	@for b in $(BENCHMARKS); do echo "== benchmarks/$$b.py"; \
 	  NGSOLVE_PYTHON=$(NGSOLVE) $(PY) benchmarks/$$b.py $(if $(QUICK),--quick,--update-docs) \
