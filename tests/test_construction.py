@@ -24,7 +24,7 @@ from fenics_nl.materials import LinearElastic, kinematics
 from fenics_nl.materials.mohr_coulomb import MohrCoulomb
 from fenics_nl.solvers.newton import NewtonSolver
 
-GROUND, LIFT, WALL = 1, 2, 3
+GROUND, LIFT, WALL = 1, 2, 3  # the cell tags of `tagged_ground`
 GAMMA_SOIL, GAMMA_WALL = 18.0, 25.0
 
 
@@ -49,24 +49,29 @@ def held_sides_and_bottom(V):
             boundary.component(V, 1, bottom)], bottom
 
 
-def dig(c, steps, comm=MPI.COMM_WORLD):
+def dig(c, steps, comm=MPI.COMM_WORLD, ground=None, quadrature=2):
     """Build the wall, then dig, each stage in `steps` steps.
+
+    `ground`: (mesh, cell tags, (ground's, lift's, wall's tag)); `tagged_ground`'s if None.
+    `quadrature`: the degree of the rule.
 
     Returns:
         (u, [[bottom's vertical reaction, weight present] at each stage's end], the area
         of the soil present that has yielded).
     """
-    m, cells = tagged_ground(comm)
+    m, cells, (ground_tag, lift_tag, wall_tag) = ground or (*tagged_ground(comm),
+                                                            (GROUND, LIFT, WALL))
     V = fem.functionspace(m, ("Lagrange", 2, (2,)))
     u, v = fem.Function(V), ufl.TestFunction(V)
     soil = MohrCoulomb(5.0e4, 0.3, c=c, phi=30.0, initial_stress={
         "unit_weight": GAMMA_SOIL, "K0": 0.5, "surface": 0.0})
     wall = LinearElastic(3.0e6, 0.2)
-    soil.bind(m, 2)
-    stages = Construction(V, cells, {"soil": [GROUND, LIFT, WALL], "wall": [WALL]},
+    soil.bind(m, quadrature)
+    stages = Construction(V, cells, {"soil": [ground_tag, lift_tag, wall_tag],
+                                     "wall": [wall_tag]},
                           weights={"soil": GAMMA_SOIL, "wall": GAMMA_WALL},
-                          absent={"wall": [WALL]})
-    dx = kinematics.quadrature_measure("dx", m, 2)
+                          absent={"wall": [wall_tag]}, degree=quadrature)
+    dx = kinematics.quadrature_measure("dx", m, quadrature)
     eps, eps_v = (kinematics.small_strain(w, "plane_strain") for w in (u, v))
     down = ufl.as_vector([0.0, -1.0])
     sigma = {"soil": soil.stress(eps),
@@ -79,8 +84,8 @@ def dig(c, steps, comm=MPI.COMM_WORLD):
                           force_scale=GAMMA_SOIL, max_it=30, prefix=f"dig{id(u)}_")
     weight = fem.form(sum(stages.weights[p] * stages.present[p] for p in sigma) * dx)
     out = []
-    for name, remove, add in (("wall", {"soil": [WALL]}, {"wall": [WALL]}),
-                              ("lift", {"soil": [LIFT]}, {})):
+    for name, remove, add in (("wall", {"soil": [wall_tag]}, {"wall": [wall_tag]}),
+                              ("lift", {"soil": [lift_tag]}, {})):
         stages.begin(name, remove=remove, add=add, stresses=sigma, strain=eps)
         solver.set_bcs(supports + stages.held(u))
         # the stage starts in equilibrium: the frozen forces balance what left (the
@@ -278,36 +283,122 @@ steps = 4
 """
 
 
-def test_a_case_file_digs_a_pit_in_stages(tmp_path, demo):
-    # the ground 4 × 4 at rest (geostatic, Mohr–Coulomb c = 3), the pit 2 × 1 at its
-    # corner dug out in 4 steps: each step named by its stage, the bottom's reaction the
-    # weight left (18 × 14 = 252) once the pit's forces are released, the ground yields at
-    # the pit's corner; what case files do not take yet is refused, one line each
-    (tmp_path / "layered.geo").write_text(LAYERED_GEO)
-    (tmp_path / "staged.toml").write_text(STAGED)
+WALLED_GEO = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, -4, 0, 4, 4};
+Rectangle(2) = {0, -1, 0, 2, 1};
+Rectangle(3) = {2, -3, 0, 0.5, 3};
+BooleanFragments{ Surface{1}; Delete; }{ Surface{2, 3}; Delete; }
+Physical Curve("bottom") = Curve In BoundingBox{-0.1, -4.1, -0.1, 4.1, -3.9, 0.1};
+Physical Curve("sides") = Curve In BoundingBox{-0.1, -4.1, -0.1, 0.1, 0.1, 0.1};
+Physical Curve("far") = Curve In BoundingBox{3.9, -4.1, -0.1, 4.1, 0.1, 0.1};
+pit() = Surface In BoundingBox{-0.1, -1.1, -0.1, 2.01, 0.1, 0.1};
+wall() = Surface In BoundingBox{1.99, -3.1, -0.1, 2.51, 0.1, 0.1};
+ground() = Surface{:};
+ground() -= pit();
+ground() -= wall();
+Physical Surface("ground") = ground();
+Physical Surface("pit") = pit();
+Physical Surface("wall") = wall();
+Mesh.MeshSizeMax = 0.25;
+Mesh.ElementOrder = 2;
+"""
+SOIL = """law = "mohr-coulomb"
+E = 50000.0
+nu = 0.3
+c = 3.0
+phi = 30.0
+"""
+# the ground of `dig` (Mohr–Coulomb in three groups, the wall's soil replaced by concrete in
+# stage "wall", the pit dug in stage "dig"), meshed by gmsh, as a case file
+WALLED = STAGED.replace("layered.geo", "walled.geo").replace(
+    "[material]\n" + SOIL,
+    "".join(f'[[material]]\ngroup = "{g}"\n{SOIL}\n' for g in ("ground", "pit", "wall"))
+    + '[[material]]\ngroup = "wall"\nlaw = "linear-elastic"\nE = 3.0e6\nnu = 0.2\n'
+      "unit_weight = 25.0\n").replace(
+    "[loading]", "[solver]\ntolerance = 1e-12\n\n[loading]").replace(
+    '[[stage]]\nname = "dig"', '[[stage]]\nname = "wall"\nremove = ["wall"]\nadd = ["wall"]\n'
+                               'steps = 4\n\n[[stage]]\nname = "dig"') + """
+[[probe]]
+name = "floor"
+point = [1.0, -1.0]
+
+[[probe]]
+name = "head"
+point = [2.25, 0.0]
+
+[[probe]]
+name = "foot"
+point = [2.5, -3.0]
+"""
+
+
+def test_a_case_file_builds_a_wall_then_digs_a_pit(tmp_path, demo):
+    # `dig`'s stages as a case file ([[material]] groups: the wall's second table arrives
+    # in stage "wall", the pit dug in stage "dig", 4 steps each) on a gmsh mesh: the bottom
+    # carries the weight present at the end of each stage, 18 × 14.5 + 25 × 1.5 = 298.5,
+    # then 18 × 12.5 + 25 × 1.5 = 262.5 (1e-10); the ground yields at the pit's corner; the
+    # displacements and the plastic area are `dig`'s on the same mesh (its residual written
+    # with the parts' indicators, the soil's state committed everywhere) to 1e-9: the case
+    # integrates each part on its cells and commits its state only where it is present
+    (tmp_path / "walled.geo").write_text(WALLED_GEO)
+    (tmp_path / "walled.toml").write_text(WALLED)
     from conftest import read_series
 
-    d = demo.case(tmp_path / "staged.toml", "--output", tmp_path / "out")
-    dug = [s for s in d["steps"] if s.get("stage") == "dig"]
-    assert [s["stage_progress"] for s in dug] == pytest.approx([0.25, 0.5, 0.75, 1.0])
+    from fenics_nl.case.mesh import load_mesh
+    from fenics_nl.case.spec import read_case
+
+    d = demo.case(tmp_path / "walled.toml", "--output", tmp_path / "out")
+    ends = [s for s in d["steps"] if s.get("stage_progress") == 1.0]
+    assert [s["stage"] for s in ends] == ["wall", "dig"]
+    assert [s["reactions"]["bottom"][1] for s in ends] == pytest.approx([298.5, 262.5],
+                                                                         rel=1e-10)
+    assert ends[0]["plastic_volume_fraction"] == 0.0 < ends[1]["plastic_volume_fraction"]
     # the fields' time: the load factor, then each stage's progress added (ParaView needs
     # it to grow)
     times, _ = read_series(tmp_path / "out" / "displacement.bp", "displacement")
-    assert times == pytest.approx([1.0, 1.25, 1.5, 1.75, 2.0])
-    assert d["reactions"]["bottom"][1] == pytest.approx(18.0 * 14.0, rel=1e-10)
-    assert dug[-1]["plastic_volume_fraction"] > 0
-    for change, said in ((("steps = 4\n", 'steps = 4\nadd = ["pit"]\n'),
-                          "stage[1].add: not built"),
-                         (('remove = ["pit"]', 'remove = ["hole"]'),
-                          "stage[1].remove: 'hole' is not a cell group"),
-                         (('degree = 2', 'degree = 2\nformulation = "mixed"'),
-                          "stage: construction stages take the displacement formulation"),
-                         # (the tables read last were read after the problems were said:
-                         # a K0 < 0 ran, exit 0)
-                         (("K0 = 0.5", "K0 = -0.5"), "initial_stress.K0: must be > 0")):
-        (tmp_path / "bad.toml").write_text(STAGED.replace(*change))
+    assert times == pytest.approx([1.0, *np.arange(1.25, 3.01, 0.25)])
+    data = load_mesh(read_case(tmp_path / "walled.toml"))
+    tags = tuple(data.physical_groups[g].tag for g in ("ground", "pit", "wall"))
+    u, reactions, plastic = dig(3.0, 4, ground=(data.mesh, data.cell_tags, tags),
+                                quadrature=4)
+    assert reactions[:, 0] == pytest.approx([298.5, 262.5], rel=1e-10)
+    probes = Probes(u.function_space.mesh, [[1.0, -1.0], [2.25, 0.0], [2.5, -3.0]])
+    ours = np.array([d["probes"][name]["displacement"] for name in ("floor", "head", "foot")])
+    assert ours == pytest.approx(np.array(probes.continuous(u)), rel=1e-9, abs=1e-12)
+    assert ends[1]["plastic_volume_fraction"] == pytest.approx(plastic / 14.0, rel=1e-9)
+
+
+def test_a_case_file_says_what_its_stages_cannot_do(tmp_path, demo):
+    # each mistake one line, exit 2, before a mesh is made
+    (tmp_path / "walled.geo").write_text(WALLED_GEO)
+    (tmp_path / "layered.geo").write_text(LAYERED_GEO)
+    for text, change, said in (
+            (WALLED, ('remove = ["wall"]\n', ""), "stage[1].add: 'wall' is still there "
+                                                 "(wall.1): remove it"),
+            (WALLED, ('add = ["wall"]\n', ""), "material: 'wall' has 2 [[material]] table(s) "
+                                               "and 0 stage(s) add it"),
+            (WALLED, ('remove = ["pit"]', 'remove = ["pit", "pit"]'),
+             "stage[2].remove: 'pit' is not there to remove"),
+            (WALLED, ('group = "pit"\n', 'group = "pit"\nunit_weight = 1.0\n'),
+             "material[2].unit_weight: only for a part a [[stage]] adds"),
+            (STAGED, ("steps = 4\n", 'steps = 4\nadd = ["pit"]\n'),
+             "stage[1].add: needs [[material]] groups"),
+            (STAGED, ('remove = ["pit"]', 'remove = ["hole"]'),
+             "stage[1].remove: 'hole' is not a cell group"),
+            (STAGED, ('degree = 2', 'degree = 2\nformulation = "mixed"'),
+             "stage: construction stages take the displacement formulation"),
+            # (the tables read last were read after the problems were said: a K0 < 0 ran,
+            # exit 0)
+            (STAGED, ("K0 = 0.5", "K0 = -0.5"), "initial_stress.K0: must be > 0")):
+        (tmp_path / "bad.toml").write_text(text.replace(*change))
         proc = demo.run(["-m fenics_nl", "run", tmp_path / "bad.toml"], check=False)
         assert proc.returncode == 2 and said in proc.stderr, proc.stderr
+    # a cell in two physical groups (dolfinx refused it with a traceback)
+    (tmp_path / "walled.geo").write_text(WALLED_GEO.replace("ground() -= pit();\n", ""))
+    (tmp_path / "bad.toml").write_text(WALLED)
+    proc = demo.run(["-m fenics_nl", "run", tmp_path / "bad.toml"], check=False)
+    assert proc.returncode == 2 and "is in the physical groups 'ground' and 'pit' (each " \
+        "cell takes one group)" in proc.stderr, proc.stderr
 
 
 LIFTS_GEO = LAYERED_GEO.replace("Rectangle(2) = {0, -1, 0, 2, 1};",
@@ -358,10 +449,12 @@ def test_a_staged_case_restarts_inside_a_stage_and_between_two(tmp_path, demo):
 
 @pytest.mark.mpi
 def test_a_staged_case_on_two_ranks_gives_the_serial_answer(tmp_path, demo):
-    (tmp_path / "layered.geo").write_text(LAYERED_GEO)
-    (tmp_path / "staged.toml").write_text(STAGED)
-    s = demo.case(tmp_path / "staged.toml")
-    p = demo.case(tmp_path / "staged.toml", ranks=2)
+    # the wall built, then the pit dug: the parts' indicators and their states committed
+    # on the cells each rank has
+    (tmp_path / "walled.geo").write_text(WALLED_GEO)
+    (tmp_path / "walled.toml").write_text(WALLED)
+    s = demo.case(tmp_path / "walled.toml")
+    p = demo.case(tmp_path / "walled.toml", ranks=2)
     assert p["ranks"] == 2
     assert [x["newton_iterations"] for x in p["steps"]] == [
         x["newton_iterations"] for x in s["steps"]]

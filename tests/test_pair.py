@@ -465,8 +465,8 @@ def test_a_case_of_two_bodies_says_what_it_cannot_take(tmp_path, demo):
         'law = "linear-elastic"\nE = 1.0', 'law = "j2"\nsigma0 = 1.0\nE = 1.0').replace(
         "friction = 0.0", "friction = -0.1\nwear = 1e-3"))
     assert [line.split(": ")[0] for line in lines] == [
-        "material[2].law", "contact[1].friction", "contact[1].speed", "loading.time",
-        "mesh.degree"], lines
+        "contact[1].friction", "contact[1].speed", "loading.time", "mesh.degree",
+        "material[2].law"], lines
     # wear: with friction, a speed without wear, adaptive time steps
     pin = (CASES / "worn_pin.toml").read_text()
     (tmp_path / "worn_pin.geo").write_text((CASES / "worn_pin.geo").read_text())

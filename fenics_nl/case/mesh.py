@@ -133,6 +133,8 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
             elif not gmsh.model.getPhysicalGroups(dim):
                 error = (f"mesh.file: {name} has no {dim}D physical group (dolfinx keeps only "
                          f"the cells of physical groups)")
+            elif twice := _in_two_groups(dim):
+                error = f"mesh.file: {name}: {twice} (each cell takes one group)"
         except Exception as err:  # gmsh raises Exception with its own message
             error = (f"mesh.file: gmsh cannot {action} {name}: "
                      f"{' '.join(str(err).split()) or type(err).__name__}")
@@ -145,3 +147,16 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
     if comm.rank == 0:
         gmsh.model.remove()
     return data
+
+
+def _in_two_groups(dim: int) -> str | None:
+    """What the first `dim`D entity in two physical groups is in (gmsh's model), or None."""
+    seen: dict[int, str] = {}
+    for _, tag in gmsh.model.getPhysicalGroups(dim):
+        group = gmsh.model.getPhysicalName(dim, tag) or str(tag)
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
+            if int(entity) in seen:
+                return (f"the {dim}D entity {int(entity)} is in the physical groups "
+                        f"{seen[int(entity)]!r} and {group!r}")
+            seen[int(entity)] = group
+    return None

@@ -129,23 +129,26 @@ class CaseProblem:
         msh = data.mesh
         tdim = msh.topology.dim
         have = {n: g.tag for n, g in data.physical_groups.items() if g.dim == tdim}
-        problems, by_tag = [], {}
-        for i, (group, law) in enumerate(self.case.laws(), start=1):
+        problems, by_part, tags = [], {}, set()
+        for part, law in self.case.laws():
+            group = part["group"]
             if group not in have:
+                i = next(k for k, g in enumerate(self.case.groups, start=1) if g[0] == group)
                 problems.append(f"material[{i}].group: {group!r} is not a cell group of the "
                                 f"mesh (it has: {', '.join(sorted(have)) or 'none'})")
             else:
-                by_tag[have[group]] = law
+                by_part[part["name"]] = ([have[group]], law)
+                tags.add(have[group])
         if problems:
             return None, problems
-        material = ByGroup(by_tag, data.cell_tags)
+        material = ByGroup(by_part, data.cell_tags)
         n = msh.topology.index_map(tdim).size_local
         bare = msh.comm.allreduce(len(material.cells_without(n)))
         if bare:
-            named = [g for g, t in have.items() if t not in by_tag]
+            named = [g for g, t in have.items() if t not in tags]
             problems.append(f"material: {bare} cells are in no [[material]] group (cell groups "
                             f"without one: {', '.join(sorted(named)) or 'none'})")
-        self.apart = self._bodies_apart(data, {t: g for g, t in have.items() if t in by_tag})
+        self.apart = self._bodies_apart(data, {t: g for g, t in have.items() if t in tags})
         return material, problems
 
     def _bodies_apart(self, data, names: dict[int, str]) -> list[str]:
@@ -208,21 +211,32 @@ class CaseProblem:
         if gravity is not None and self.construction is None:  # a geostatic initial
             loads -= ufl.dot(gravity, v) * w * self.dx  # stress: the ground's weight, held
         self._loads = loads
-        if isinstance(self.material, ByGroup):  # each law on its cells
-            return self.material.work(self.u, v, self.model, self.dx) + loads
-        internal = self.fields.internal_work(self.material, self.model)
-        if self.construction is None:
-            return internal * self.dx + loads
-        stages = self.construction  # the body present; what a stage digs out, released
+        stages = self.construction
+        by_group = isinstance(self.material, ByGroup)
+        if by_group and stages is not None:
+            self.material.follow(stages)  # χ_p: the parts present; arrivals stress-free
+        if by_group:  # each law on its cells (χ_p: its presence, when stages follow)
+            internal = self.material.work(self.u, v, self.model, self.dx)
+        else:
+            internal = self.fields.internal_work(self.material, self.model)
+            present = 1 if stages is None else stages.present["body"]
+            internal = present * internal * self.dx
+        if stages is None:
+            return internal + loads
+        # the parts present; what a stage digs out, released; what it builds, weighing in
         down = ufl.as_vector([-1.0 if i == self.mesh.geometry.dim - 1 else 0.0
                               for i in range(self.mesh.geometry.dim)])
         self._released = stages.released(v, down, kinematics.small_strain(v, self.model)
                                           ) * w * self.dx
-        return (stages.present["body"] * internal - ufl.dot(stages.body_force("body", down), v)
-                * w) * self.dx + self._released + loads
+        weights = sum(ufl.dot(stages.body_force(p, down), v) for p in stages.parts)
+        return internal - weights * w * self.dx + self._released + loads
 
     def _construction(self, data, gravity):
-        """The stages' parts (`fenics_nl.construction`): the whole body, its weight γ."""
+        """The stages' parts (`fenics_nl.construction`): each [[material]] table, or the body.
+
+        Each part weighs its unit weight ([initial_stress]'s if not given); the parts a stage
+        adds are absent until then.
+        """
         if not self.case.stages:
             return None
         from fenics_nl.construction import Construction
@@ -236,11 +250,19 @@ class CaseProblem:
         if wrong:
             raise CaseError(wrong)
         self._stage_tags = {g: have[g] for g in have}
-        weight = 0.0 if gravity is None else self.case.initial_stress["unit_weight"]
-        stages = Construction(self.V, data.cell_tags, {"body": sorted(set(have.values()))},
-                              weights={"body": weight}, degree=2 * self.case.degree)
-        stages.present["body"].x.array[:] = 1.0  # every cell, in a group or not
-        return stages
+        ground = 0.0 if gravity is None else self.case.initial_stress["unit_weight"]
+        degree = 2 * self.case.degree
+        if self.case.parts is None:
+            stages = Construction(self.V, data.cell_tags, {"body": sorted(set(have.values()))},
+                                  weights={"body": ground}, degree=degree)
+            stages.present["body"].x.array[:] = 1.0  # every cell, in a group or not
+            return stages
+        parts = {p["name"]: [have[p["group"]]] for p in self.case.parts}
+        weights = {p["name"]: ground if p["unit_weight"] is None else p["unit_weight"]
+                   for p in self.case.parts}
+        absent = {p["name"]: parts[p["name"]] for p in self.case.parts if not p["start"]}
+        return Construction(self.V, data.cell_tags, parts, weights=weights, absent=absent,
+                            degree=degree)
 
     def resume_stage(self, stage: dict) -> None:
         """Go on inside `stage` from a checkpoint, its fields restored.
@@ -253,9 +275,16 @@ class CaseProblem:
     def begin_stage(self, stage: dict) -> None:
         """Start `stage` at equilibrium: its groups dug out, their forces frozen (s = 0)."""
         eps = kinematics.small_strain(self.u, self.model)
-        self.construction.begin(stage["name"],
-                                remove={"body": [self._stage_tags[g] for g in stage["remove"]]},
-                                stresses={"body": self.material.stress(eps)})
+        if self.case.parts is None:
+            remove = {"body": [self._stage_tags[g] for g in stage["remove"]]}
+            add, stresses = {}, {"body": self.material.stress(eps)}
+        else:
+            remove, add = ({part: [self._stage_tags[g]] for part, g in stage[key]}
+                           for key in ("leave", "arrive"))
+            law = self.material.laws
+            stresses = {part: law[part].stress(self.material.law_strain(eps)) for part in remove}
+        self.construction.begin(stage["name"], remove=remove, add=add, stresses=stresses,
+                                strain=eps)
         self.solver.set_bcs(self.bcs + self.construction.held(self.u))
         # the stage starts in equilibrium: the frozen forces hold what the dug cells did
         # (to 1e-9 of those forces)
@@ -283,25 +312,32 @@ class CaseProblem:
 
         from fenics_nl.expression import Expression
 
-        law, Q = self.material, self.material.quadrature_space()
+        Q = self.material.quadrature_space()
         eps_v = kinematics.small_strain(self.fields.v, self.model)
         geostatic = isinstance(self.case.initial_stress, dict)
         # (a uniform one as a Constant of the mesh: compiled, as the geostatic one; UFL's
         # own evaluation of a 3D principal stress's graph takes minutes)
-        stress = law.initial(eps_v) if geostatic else fem.Constant(
+        stress = self.material.initial(eps_v) if geostatic else fem.Constant(
             self.mesh, np.array(self.case.initial_stress, dtype=float))
+        # f / its scale (c cos φ ...), of each soil's part present (−1 elsewhere)
+        if isinstance(self.material, ByGroup):
+            soils = [(self.material.indicator(self.mesh, key), law)
+                     for key, law in self.material.laws.items() if hasattr(law, "initial")]
+            excess = sum(chi * (law.yield_function(stress) / law.yield_scale + 1)
+                         for chi, law in soils) - 1
+        else:
+            law = self.material
+            excess = law.yield_function(stress) / law.yield_scale
         at_points = fem.Function(Q)
-        at_points.interpolate(Expression(law.yield_function(stress),
-                                         Q.element.interpolation_points))
+        at_points.interpolate(Expression(excess, Q.element.interpolation_points))
         values = at_points.x.array[:Q.dofmap.index_map.size_local]
         worst = self.mesh.comm.allreduce(float(values.max(initial=-np.inf)), op=MPI.MAX)
-        scale = law.yield_scale
-        if worst > 1e-9 * scale:
-            outside = self.mesh.comm.allreduce(int((values > 1e-9 * scale).sum()))
+        if worst > 1e-9:
+            outside = self.mesh.comm.allreduce(int((values > 1e-9).sum()))
             where = (f"at {outside} quadrature point(s)" if geostatic
                      else "(uniform: everywhere)")
             raise CaseError([f"initial_stress: outside the yield surface {where} (the "
-                             f"largest f = {worst:.3g}, against {scale:.3g}): the "
+                             f"largest f is {worst:.3g} of f's constant term): the "
                              "ground could not stand in it (a K0 below the active limit, a "
                              "surface below the mesh's top?)"])
 

@@ -210,7 +210,7 @@ def _solve(problem: CaseProblem, solver, saving: PathCheckpoints | None,
 
 def _dig(problem: CaseProblem, solver, stage: dict, steps: list[dict], work, commit,
          show, on_state=None, start=None) -> None:
-    """One construction stage: its groups dug out, their forces released in its steps.
+    """One construction stage: its groups dug out (their forces released) and built.
 
     `on_state`: the checkpoints' (after each converged step); `start`: where a restart goes
     on inside the stage (its fields restored).
@@ -228,9 +228,11 @@ def _dig(problem: CaseProblem, solver, stage: dict, steps: list[dict], work, com
         steps.append(step_record(problem, t, result, stage=(stage["name"], s)))
         cli.converged_step(steps[-1], fields=lambda: fields(problem))
 
-    say(f"stage {stage['name']!r}: {', '.join(stage['remove'])} dug out in "
-        f"{stage['steps']} step(s)" + ("" if start is None else
-                                       f", from {start.t:.4g} of it (restarted)"))
+    done = [f"{', '.join(stage[key])} {what}" for key, what in (("remove", "dug out"),
+                                                                 ("add", "built"))
+            if stage[key]]
+    say(f"stage {stage['name']!r}: {' and '.join(done)} in {stage['steps']} step(s)"
+        + ("" if start is None else f", from {start.t:.4g} of it (restarted)"))
     try:
         path = solve_incrementally(solver, release, stage["steps"], adaptive=True,
                                    max_step=1.0 / stage["steps"], progress=show,
@@ -383,7 +385,8 @@ def step_record(problem: CaseProblem, t: float, result, at: float | None = None,
                 "damage_iterations": d.last.damage_iterations,
                 "dissipated_energy": d.dissipated_energy(),
                 "largest_damage": global_max(problem.mesh.comm, d.alpha.x.array)}
-    if hasattr(problem.material, "plastic_zone"):  # the largest p̄, the plastic share
+    if problem.material.path_dependent and hasattr(problem.material, "plastic_zone"):
+        # the largest p̄, the plastic share
         rec |= problem.material.plastic_zone(problem.dx)
     if problem.contact is not None:
         c = problem.solver.contact

@@ -76,12 +76,14 @@ nu = 0.3                 # Mises plasticity) also sigma0, and optionally H (isot
 # or bodies of different materials: one [[material]] table per cell group (a physical
 # group of the mesh's cells; every cell in one), laws without internal variables
 # (linear-elastic, power-law, saint-venant-kirchhoff, neo-hookean), all small or all finite
-# strain:
+# strain, and one plastic law of small strain (j2, drucker-prager or mohr-coulomb: soil
+# layers, a wall in a ground), not in plane stress:
 # [[material]]
 # group = "ball"
 # law = "linear-elastic"
 # E = 3.0
 # nu = 0.2
+# unit_weight = 25.0      # a part a [[stage]] adds: its weight (default: the ground's)
 
 [[boundary]]             # one table per condition, on a physical group of the mesh
 group = "clamped"
@@ -163,7 +165,9 @@ point = [10.0, 1.0]
 # [[stage]]              # optional: construction stages after the loading, in order (its
 # name = "lift 1"        # steps' JSON names it); remove: the cell groups dug out (their
 # remove = ["soil_1"]    # stiffness and weight leave, their forces on the rest released
-# steps = 10             # over the steps); one [material] of linear-elastic, power-law, j2,
+# add = ["wall"]         # over the steps); add: [[material]] groups built (their next
+# steps = 10             # table's law, stress-free when they arrive, their weight coming
+#                        # in over the steps); the laws linear-elastic, power-law, j2,
 #                        # drucker-prager or mohr-coulomb; no contact, arc-length or time
 """
 
@@ -189,8 +193,11 @@ KEYS = [
      "`perzyna`", "required",
      "—"),
     ("material", "group", "[[material]] only: the cell group (a physical group of the mesh's "
-     "cells) this law holds on; one table per group, every cell in one", "required there",
+     "cells) this law holds on; one table per group, every cell in one; a second table of a "
+     "group arrives when a [[stage]] adds it (a wall in place of the soil)", "required there",
      "—"),
+    ("material", "unit_weight", "[[material]] only, a part a [[stage]] adds: its unit weight "
+     "(a wall's concrete)", "[initial_stress]'s unit_weight, or 0", "force/volume"),
     ("material", "E", "Young's modulus, > 0", "required", "stress"),
     ("material", "nu", "Poisson's ratio, −1 < ν ≤ 0.5 (0.5: the mixed formulation)",
      "required", "—"),
@@ -300,8 +307,10 @@ KEYS = [
     ("stage", "name", "a construction stage, after the loading, in order: its name in the "
      "steps' JSON", "required", "—"),
     ("stage", "remove", "the cell groups it digs out: their stiffness and weight leave, the "
-     "forces they exerted released over its steps (`fenics_nl.construction`)", "required",
-     "—"),
+     "forces they exerted released over its steps (`fenics_nl.construction`)",
+     "[] (remove or add required)", "—"),
+    ("stage", "add", "the [[material]] groups it builds: each its group's next table, "
+     "stress-free when it arrives, its weight coming in over the steps", "[]", "—"),
     ("stage", "steps", "its load steps (the release from 0 to 1; a step that fails is cut "
      "in half)", "1", "—"),
 ]
@@ -344,6 +353,8 @@ OPTIONAL = {"j2": {"H": 0.0, "C": 0.0}, "perzyna": {"H": 0.0},
             "j2-finite": {"H": 0.0, "saturation": None, "delta": 0.0},
             **{law: {"residual_stiffness": 1e-6, "split": "none"} for law in DAMAGE}}
 STATE_FREE = ("linear-elastic", "power-law", "saint-venant-kirchhoff", "neo-hookean")
+# the plastic laws a [[material]] group takes (their state committed on its cells only)
+GROUP_PLASTIC = ("j2", "drucker-prager", "mohr-coulomb")
 WORDS = {"split": SPLITS, "fit": FITS}  # parameters that are words, and their choices
 MODELS = ("3d", "plane_strain", "plane_stress", "axisymmetric")
 NEWTON = ("full", "modified", "periodic", "bfgs", "snes")
@@ -407,24 +418,39 @@ class Case:
     refine_near: dict | None = None  # .geo: groups, size, distance (`case.mesh`)
     time: dict | None = None  # a viscous law's time axis: end, steps, adaptive, tolerance,
     # stationary, and factor (the load factor against time, [[t, f], ...])
-    groups: list[tuple[str, str, dict]] | None = None  # [[material]]: (group, law, parameters)
+    # [[material]]: (group, law, parameters, unit_weight or None), in the file's order
+    groups: list[tuple[str, str, dict, float | None]] | None = None
     pairs: list[dict] = field(default_factory=list)  # [[contact]]: slave, master, friction, key
     # [initial_stress]: stress 3x3 (the model's components), or {unit_weight, K0, surface}
     initial_stress: list | dict | None = None
-    stages: list[dict] = field(default_factory=list)  # [[stage]]: name, remove, steps
+    # [[stage]]: name, remove, add (cell groups), steps; with [[material]] groups, leave
+    # and arrive (the parts' names, `parts`)
+    stages: list[dict] = field(default_factory=list)
+    # [[material]] tables as parts (`_parts`): name, group, law, parameters, unit_weight,
+    # start (present at the start); None with one [material]
+    parts: list[dict] | None = None
 
     @property
     def law_name(self) -> str:
         """The law, or each group's: "linear-elastic (ball), neo-hookean (block)"."""
         if self.groups is None:
             return self.law
-        return ", ".join(f"{law} ({group})" for group, law, _ in self.groups)
+        return ", ".join(f"{law} ({group})" for group, law, _, _ in self.groups)
 
-    def laws(self) -> list[tuple[str | None, laws.Material]]:
-        """(cell group, law) of each [[material]]; [(None, the material)] for [material]."""
-        if self.groups is None:
+    def laws(self) -> list[tuple[dict | None, laws.Material]]:
+        """(part, law) of each [[material]]; [(None, the material)] for [material].
+
+        A part present at the start whose law takes an initial stress has the case's.
+        """
+        if self.parts is None:
             return [(None, self.material())]
-        return [(g, LAWS[law](**parameters)) for g, law, parameters in self.groups]
+        out = []
+        for part in self.parts:
+            extra = {}
+            if part["start"] and part["law"] in INITIAL and self.initial_stress is not None:
+                extra = {"initial_stress": self._initial_stress()}
+            out.append((part, LAWS[part["law"]](**part["parameters"], **extra)))
+        return out
 
     @property
     def dim(self) -> int:
@@ -436,10 +462,13 @@ class Case:
 
         With its initial stress, if the case gives one.
         """
-        s0 = self.initial_stress
-        extra = {} if s0 is None else {"initial_stress": dict(s0) if isinstance(s0, dict)
-                                       else tuple(map(tuple, s0))}
+        extra = {} if self.initial_stress is None else {
+            "initial_stress": self._initial_stress()}
         return LAWS[self.law](**self.parameters, **extra)
+
+    def _initial_stress(self):
+        s0 = self.initial_stress
+        return dict(s0) if isinstance(s0, dict) else tuple(map(tuple, s0))
 
 
 class _Reader:
@@ -627,8 +656,11 @@ def read_case(path: str | Path) -> Case:
             r.fail(key, message)
     if law in DAMAGE:
         _damage_limits(r, law, model, formulation, newton, linear, conditions)
-    psi, phi = parameters.get("psi"), parameters.get("phi")
-    if law in SOILS and psi is not None and phi is not None and psi < phi:
+    unsymmetric = [(g[2]["psi"], g[2]["phi"]) for g in (groups or [(None, law, parameters)])
+                   if g[1] in SOILS and g[2].get("psi") is not None
+                   and g[2].get("phi") is not None and g[2]["psi"] < g[2]["phi"]]
+    if unsymmetric:
+        psi, phi = unsymmetric[0]
         # a tangent that is not symmetric: MUMPS's LU takes it, CG does not
         if linear == "gamg":
             r.fail("solver.linear_solver", f"gamg is CG: psi = {psi} < phi = {phi} makes the "
@@ -639,8 +671,10 @@ def read_case(path: str | Path) -> Case:
                               "rigid obstacle: not built (its solves reuse a factorization "
                               "under CG)")
     if pairs:
-        _pair_limits(r, pairs, degree, formulation, law, newton, linear, conditions,
-                     arc)
+        law_key = "material.law" if groups is None else next(
+            f"material[{i}].law" for i, g in enumerate(groups, start=1) if g[1] == law)
+        _pair_limits(r, pairs, degree, formulation, law, law_key, newton, linear,
+                     conditions, arc)
     probes = _probes(r, data, dim)
     if arc is not None and arc["stop"] is not None and model is not None:
         tables = data.get("probe", [])
@@ -651,12 +685,13 @@ def read_case(path: str | Path) -> Case:
     initial_stress = _initial_stress(r, data, law, model, groups)
     stages = _stages(r, data, law, model, groups, formulation, conditions, pairs, arc,
                      time_axis)
+    parts = _parts(r, groups, stages, initial_stress)
     if r.problems:
         raise CaseError(r.problems)
     equal = isinstance(data.get("loading", {}).get("steps"), int)
     return Case(path, mesh_file, size, model, degree, law, parameters, conditions, factors,
                 adaptive, equal, arc, newton, linear, tolerance, max_it, probes, formulation,
-                refine_near, time_axis, groups, pairs, initial_stress, stages)
+                refine_near, time_axis, groups, pairs, initial_stress, stages, parts)
 
 
 STAGED = ("linear-elastic", "power-law", "j2", *SOILS)  # the laws a case digs in
@@ -664,7 +699,7 @@ STAGED = ("linear-elastic", "power-law", "j2", *SOILS)  # the laws a case digs i
 
 def _stages(r: _Reader, data: dict, law, model, groups, formulation, conditions, pairs, arc,
             time_axis) -> list[dict]:
-    """[[stage]]: construction stages after the loading, each digging out cell groups."""
+    """[[stage]]: construction stages after the loading, each removing and adding groups."""
     tables = r.tables(data, "stage", ", one per stage")
     out, names = [], set()
     for i, t in enumerate(tables, start=1):
@@ -674,20 +709,24 @@ def _stages(r: _Reader, data: dict, law, model, groups, formulation, conditions,
         if name in names:
             r.fail(f"{where}.name", f"{name!r} names an earlier stage too")
         names.add(name)
-        remove = t.get("remove")
-        if not (isinstance(remove, list) and remove and all(isinstance(g, str) for g in remove)):
-            r.fail(f"{where}.remove", f"must be a list of cell groups, got {remove!r}")
-            remove = None
-        if t.get("add"):
-            r.fail(f"{where}.add", "not built in case files: a part that arrives needs its own "
-                                   "law (demos/excavation.py builds a wall so, with "
-                                   "fenics_nl.construction)")
+        lists = {}
+        for key in ("remove", "add"):
+            value = lists[key] = t.get(key, [])
+            if not (isinstance(value, list) and all(isinstance(g, str) for g in value)):
+                r.fail(f"{where}.{key}", f"must be a list of cell groups, got {value!r}")
+                lists[key] = []
+        if not (lists["remove"] or lists["add"]) and "remove" in t:
+            r.fail(where, "removes and adds nothing: give remove or add a cell group")
+        elif not (lists["remove"] or lists["add"]):
+            r.fail(f"{where}.remove", "missing: the cell groups it digs out (or add: those "
+                                      "it builds)")
         steps = r.get(t, "steps", where, int, default=1, minimum=1)
-        out.append({"name": name, "remove": remove, "steps": steps})
+        out.append({"name": name, **lists, "steps": steps})
     if not out:
         return out
-    reasons = [(groups is not None, "one [material] (not [[material]] groups)"),
-               (law is not None and law not in STAGED, f"the laws {', '.join(STAGED)}"),
+    used = [law] if groups is None else [g[1] for g in groups]
+    off = [name for name in dict.fromkeys(used) if name is not None and name not in STAGED]
+    reasons = [(bool(off), f"the laws {', '.join(STAGED)} (not {', '.join(off)})"),
                (formulation == "mixed", "the displacement formulation"),
                (model == "plane_stress", "plane strain, axisymmetric or 3D models"),
                (bool(pairs) or any(c.kind == "contact" for c in conditions), "no contact"),
@@ -697,6 +736,74 @@ def _stages(r: _Reader, data: dict, law, model, groups, formulation, conditions,
         if failed:
             r.fail("stage", f"construction stages take {needs}")
     return out
+
+
+def _parts(r: _Reader, groups, stages: list[dict], initial_stress) -> list[dict] | None:
+    """The [[material]] tables as parts that come and go with the stages.
+
+    A group's tables follow one another: the first is there from the start unless a stage
+    adds the group as many times as it has tables; each `add` of the group brings its next
+    table, once the one before has been removed (by that stage or an earlier one). Each
+    stage gets `leave` and `arrive`: [(part name, group)]. None with one [material].
+    """
+    if groups is None:
+        for i, st in enumerate(stages, start=1):
+            if st["add"]:
+                r.fail(f"stage[{i}].add", "needs [[material]] groups: what arrives is a cell "
+                                          "group's [[material]] table (its law)")
+        return None
+    tables: dict[str, list[int]] = {}
+    for k, (group, *_) in enumerate(groups):
+        tables.setdefault(group, []).append(k)
+    adds = {g: sum(g in st["add"] for st in stages) for g in tables}
+    parts, present, coming = [], {}, {}
+    for group, ks in tables.items():
+        n, a = len(ks), adds[group]
+        if a not in (n - 1, n):
+            r.fail("material", f"{group!r} has {n} [[material]] table(s) and {a} stage(s) add "
+                               "it: each table after the first arrives when a stage adds the "
+                               "group (the first too, if stages add it once per table)")
+            continue
+        names = [group] if n == 1 else [f"{group}.{j}" for j in range(1, n + 1)]
+        for j, (k, name) in enumerate(zip(ks, names, strict=True)):
+            _, law, parameters, gamma = groups[k]
+            start = j == 0 and a == n - 1
+            parts.append({"name": name, "group": group, "law": law, "parameters": parameters,
+                          "unit_weight": gamma, "start": start})
+            where = f"material[{k + 1}]"
+            if start and gamma is not None:
+                r.fail(f"{where}.unit_weight", "only for a part a [[stage]] adds (the ground "
+                                               "present at the start weighs [initial_stress]'s "
+                                               "unit_weight)")
+            if start and initial_stress is not None and law not in INITIAL:
+                r.fail(f"{where}.law", f"{law} takes no initial stress: its cells, present at "
+                                       "the start, would be out of balance under "
+                                       "[initial_stress] (make it arrive in a [[stage]], add)")
+        present[group] = names[0] if a == n - 1 else None
+        coming[group] = names[1:] if a == n - 1 else names
+    for i, st in enumerate(stages, start=1):
+        st["leave"], st["arrive"] = [], []
+        for key, to in (("remove", "leave"), ("add", "arrive")):
+            for group in st[key]:
+                if group not in present:
+                    if group not in tables:
+                        r.fail(f"stage[{i}].{key}", f"{group!r} is not a [[material]] group "
+                                                    f"(they are: {', '.join(tables)})")
+                    continue
+                there = present[group]
+                if key == "remove" and there is None:
+                    r.fail(f"stage[{i}].remove", f"{group!r} is not there to remove (removed "
+                                                 "already, or not yet added)")
+                elif key == "add" and there is not None:
+                    r.fail(f"stage[{i}].add", f"{group!r} is still there ({there}): remove it "
+                                              "in this stage or an earlier one")
+                elif key == "remove":
+                    st[to].append((there, group))
+                    present[group] = None
+                else:
+                    present[group] = coming[group].pop(0)
+                    st[to].append((present[group], group))
+    return parts
 
 
 def arc_length_obstacles(law: str, newton: str, conditions: list[Condition]
@@ -752,7 +859,7 @@ def _pairs(r: _Reader, data: dict) -> list[dict]:
     return out
 
 
-def _pair_limits(r: _Reader, pairs, degree, formulation, law, newton, linear,
+def _pair_limits(r: _Reader, pairs, degree, formulation, law, law_key, newton, linear,
                  conditions, arc) -> None:
     """What a case with [[contact]] pairs cannot take, each said (`contact.pair`'s reach)."""
     if degree is not None and degree != 1:
@@ -761,7 +868,7 @@ def _pair_limits(r: _Reader, pairs, degree, formulation, law, newton, linear,
     if formulation == "mixed":
         r.fail("mesh.formulation", "contact pairs take the displacement formulation")
     if law is not None and law not in STATE_FREE:
-        r.fail("material.law", f"{law}: contact pairs take laws without internal variables "
+        r.fail(law_key, f"{law}: contact pairs take laws without internal variables "
                                f"({', '.join(STATE_FREE)})")
     if newton not in (None, "full"):
         r.fail("solver.newton", "contact pairs run their own Newton on the saddle point "
@@ -812,9 +919,10 @@ def _damage_limits(r: _Reader, law: str, model, formulation, newton, linear, con
 def _material(r: _Reader, data: dict, model: str | None):
     """(law, parameters, groups): one [material], or [[material]] tables by cell group.
 
-    With groups, `law` and `parameters` are the first group's (what the checks of a single
-    law read: every group's law is state-free, so those checks pass for all alike) and
-    `groups` lists (group, law, parameters); else `groups` is None.
+    With groups, `law` and `parameters` are the plastic group's if one is (its law is the
+    only plastic one), else the first group's: what the checks of a single law read (the
+    state-free laws pass them all alike); `groups` lists (group, law, parameters,
+    unit_weight); else `groups` is None.
     """
     m = data.get("material")
     if isinstance(m, list) and m and all(isinstance(t, dict) for t in m):
@@ -827,27 +935,31 @@ def _material(r: _Reader, data: dict, model: str | None):
 
 
 def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
-    groups, seen = [], {}
+    groups = []
     for i, t in enumerate(tables, start=1):
         where = f"material[{i}]"
         group = r.get(t, "group", where, str, required=True)
-        law, parameters = _one_material(r, {k: v for k, v in t.items() if k != "group"},
-                                        where, model)
-        if law is not None and law not in STATE_FREE:
-            r.fail(f"{where}.law", f"{law} keeps internal variables on every quadrature point "
-                                   f"of the mesh: [[material]] groups take "
-                                   f"{', '.join(STATE_FREE)}; or one [material] for all")
+        gamma = r.get(t, "unit_weight", where, float, positive=True)
+        law, parameters = _one_material(
+            r, {k: v for k, v in t.items() if k not in ("group", "unit_weight")}, where, model)
+        if law is not None and law not in (*STATE_FREE, *GROUP_PLASTIC):
+            r.fail(f"{where}.law", f"{law} in a [[material]] group: not built (groups take "
+                                   f"{', '.join(STATE_FREE + GROUP_PLASTIC)}); or one "
+                                   "[material] for all")
+        elif law in GROUP_PLASTIC and model == "plane_stress":
+            r.fail(f"{where}.law", f"{law} in plane stress takes one [material] (its "
+                                   "out-of-plane strain is an unknown of the whole mesh)")
         if parameters.get("nu") == 0.5 and model != "plane_stress":
             r.fail(f"{where}.nu", "0.5 needs the mixed formulation, which [[material]] groups "
                                   "do not take")
-        if group is not None and group in seen:
-            r.fail(f"{where}.group", f"{group!r} has its material in {seen[group]} already")
-        elif group is not None:
-            seen[group] = where
         if group is not None and law is not None:
-            groups.append((group, law, parameters))
-    if len({LAWS[law].finite_strain for _, law, _ in groups}) > 1:
-        kinds = {k: ", ".join(f"{law} ({g})" for g, law, _ in groups
+            groups.append((group, law, parameters, gamma))
+    plastic = list(dict.fromkeys(law for _, law, _, _ in groups if law in GROUP_PLASTIC))
+    if len(plastic) > 1:
+        r.fail("material", f"one plastic law in [[material]] groups, got {', '.join(plastic)}"
+                           " (give the layers one law, each its parameters)")
+    if len({LAWS[law].finite_strain for _, law, _, _ in groups}) > 1:
+        kinds = {k: ", ".join(f"{law} ({g})" for g, law, _, _ in groups
                               if LAWS[law].finite_strain == (k == "finite"))
                  for k in ("small", "finite")}
         r.fail("material", f"all groups small strain or all finite strain (one kinematics "
@@ -856,7 +968,8 @@ def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
                            "finite strain)")
     if not groups:
         return None, {}, None
-    return groups[0][1], groups[0][2], groups
+    governing = next((g for g in groups if g[1] in GROUP_PLASTIC), groups[0])
+    return governing[1], governing[2], groups
 
 
 def _parameters(law) -> list:
@@ -907,7 +1020,8 @@ def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | dict |
     stress = 3x3 in the model's components (as the probes report it); or unit_weight, K0,
     surface: the vertical stress −γ times the depth below the surface, on the mesh's last
     axis, K0 times it across, and the ground's weight as a body force, held. The soils'
-    laws (`INITIAL`) in one [material]. Its equilibrium with the loads at load factor 0 and
+    laws (`INITIAL`); with [[material]] groups, the soil's parts present at the start (`_parts`
+    refuses another law there). Its equilibrium with the loads at load factor 0 and
     the supports is the problem's to check (it has the mesh).
     """
     t = data.get("initial_stress")
@@ -918,9 +1032,8 @@ def _initial_stress(r: _Reader, data: dict, law, model, groups) -> list | dict |
         r.fail(where, "must be a table: stress = [[...], [...], [...]]")
         return None
     r.unknown(t, where, ("stress", *GEOSTATIC))
-    if groups is not None or (law is not None and law not in INITIAL):
-        r.fail(where, f"taken by {', '.join(INITIAL)} in one [material] (the soils' laws), "
-                      f"not {law if groups is None else '[[material]] groups'}")
+    if law is not None and law not in INITIAL:
+        r.fail(where, f"taken by {', '.join(INITIAL)} (the soils' laws), not {law}")
     if model == "plane_stress":
         r.fail(where, "not in plane stress")
     rows = t.get("stress")

@@ -87,7 +87,7 @@ def hookes_tangent(material, u, model: str, dx):
     return ufl.derivative(work * dx, u)
 
 
-def store_at_points(targets, expressions) -> None:
+def store_at_points(targets, expressions, cells=None) -> None:
     """Evaluate every expression at the quadrature points, then store each in its target.
 
     All are evaluated before any is stored: each reads the committed state it replaces.
@@ -95,16 +95,26 @@ def store_at_points(targets, expressions) -> None:
     Args:
         targets: the state's quadrature Functions.
         expressions: their new values (`fenics_nl.expression.Expression`, one per target).
+        cells: only the points of these local cells (the others keep their values); None:
+            every cell.
     """
     from dolfinx import fem
 
     values = []
     for target, expression in zip(targets, expressions, strict=True):
         new = fem.Function(target.function_space)
-        new.interpolate(expression)
+        if cells is None:
+            new.interpolate(expression)
+        else:
+            new.interpolate(expression, cells0=cells)
         values.append(new.x.array)
     for target, value in zip(targets, values, strict=True):
-        target.x.array[:] = value
+        if cells is None:
+            target.x.array[:] = value
+        else:
+            dofmap = target.function_space.dofmap
+            dofs = (dofmap.list[cells][:, :, None] * dofmap.bs + np.arange(dofmap.bs)).ravel()
+            target.x.array[dofs] = value[dofs]
 
 
 def quadrature_spaces(mesh, degree: int):
@@ -384,17 +394,19 @@ class SmallStrainPlasticity(QuadratureStateOutputs):
         eps_p, _, _ = self.return_map(eps)
         return LinearElastic(self.E, self.nu).stress(eps - eps_p)
 
-    def commit_strain(self, strain) -> None:
+    def commit_strain(self, strain, cells=None) -> None:
         """`commit` for a 3x3 strain expression (plane stress: `plane_stress.whole_strain`).
 
         Args:
             strain: the small strain ε (UFL, 3x3); the update is compiled for the first given.
+            cells: only at the points of these local cells (the law's part of a body:
+                `piecewise.ByGroup`); None: everywhere.
         """
         st = self._bound()
         if st.commit is None:  # compiled once
             eps_p, p, _ = self.return_map(strain)
             st.commit = (Expression(eps_p, st.points), Expression(p, st.points))
-        store_at_points((st.eps_p, st.p), st.commit)
+        store_at_points((st.eps_p, st.p), st.commit, cells)
 
 
 @dataclass(frozen=True, eq=False)
