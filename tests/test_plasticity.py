@@ -142,3 +142,35 @@ def test_consistent_tangent_taylor_slope_two_in_the_plastic_regime():
     bar.solver.solve()
     errs, slopes = taylor_remainders(bar.residual, bar.u, EPS_Y * 0.05, seed=1)
     assert np.all(slopes > 1.9), (errs, slopes)
+
+
+def test_two_groups_of_j2_keep_each_its_own_plastic_strain():
+    # a unit square in shear, u = (γ y, 0), the left half σ0 = 1, the right σ0 = 2 (ByGroup
+    # of two J2 laws): each law's state is committed on its own cells only, and there it is
+    # the closed form of perfect plasticity in one step, p = (√3 μ γ − σ0) / (3μ); the other
+    # half of each law's state stays 0, and the material's p per cell is its own law's
+    from fenics_nl.materials.piecewise import ByGroup
+
+    m = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    tdim = m.topology.dim
+    n = m.topology.index_map(tdim).size_local + m.topology.index_map(tdim).num_ghosts
+    left = mesh.compute_midpoints(m, tdim, np.arange(n, dtype=np.int32))[:, 0] < 0.5
+    tags = mesh.meshtags(m, tdim, np.arange(n, dtype=np.int32), np.where(left, 1, 2))
+    laws = {1: J2Plasticity(E, NU, sigma0=1.0), 2: J2Plasticity(E, NU, sigma0=2.0)}
+    material = ByGroup(laws, tags)
+    material.bind(m, 2)
+    u = fem.Function(fem.functionspace(m, ("Lagrange", 1, (2,))))
+    gamma = 6.0 / E  # σ_eq = √3 μ γ ≈ 4: both halves yield
+    u.interpolate(lambda x: np.vstack([gamma * x[1], 0.0 * x[0]]))
+    material.commit(u, "plane_strain")
+    mu = E / (2 * (1 + NU))
+    expected = {t: (math.sqrt(3) * mu * gamma - law.sigma0) / (3 * mu) for t, law in laws.items()}
+    for tag, law in laws.items():
+        p = law.cumulated_plastic_strain
+        mine = np.isin(np.arange(n), tags.find(tag))
+        at = p.x.array.reshape(n, -1)
+        assert at[mine] == pytest.approx(expected[tag], rel=1e-12)
+        assert np.all(at[~mine] == 0.0)
+    per_cell = material.cumulated_plastic_strain_per_cell().x.array
+    assert per_cell[left] == pytest.approx(expected[1], rel=1e-12)
+    assert per_cell[~left] == pytest.approx(expected[2], rel=1e-12)

@@ -133,8 +133,8 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
             elif not gmsh.model.getPhysicalGroups(dim):
                 error = (f"mesh.file: {name} has no {dim}D physical group (dolfinx keeps only "
                          f"the cells of physical groups)")
-            elif twice := _in_two_groups(dim):
-                error = f"mesh.file: {name}: {twice} (each cell takes one group)"
+            elif wrong := _not_one_group(dim):
+                error = f"mesh.file: {name}: {wrong} (each cell takes one group)"
         except Exception as err:  # gmsh raises Exception with its own message
             error = (f"mesh.file: gmsh cannot {action} {name}: "
                      f"{' '.join(str(err).split()) or type(err).__name__}")
@@ -149,14 +149,19 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
     return data
 
 
-def _in_two_groups(dim: int) -> str | None:
-    """What the first `dim`D entity in two physical groups is in (gmsh's model), or None."""
+def _not_one_group(dim: int) -> str | None:
+    """What is wrong with the first `dim`D entity not in one physical group, or None."""
     seen: dict[int, str] = {}
     for _, tag in gmsh.model.getPhysicalGroups(dim):
         group = gmsh.model.getPhysicalName(dim, tag) or str(tag)
-        for entity in gmsh.model.getEntitiesForPhysicalGroup(dim, tag):
-            if int(entity) in seen:
-                return (f"the {dim}D entity {int(entity)} is in the physical groups "
-                        f"{seen[int(entity)]!r} and {group!r}")
-            seen[int(entity)] = group
+        for entity in map(int, gmsh.model.getEntitiesForPhysicalGroup(dim, tag)):
+            if entity in seen:
+                return (f"the {dim}D entity {entity} is in the physical groups "
+                        f"{seen[entity]!r} and {group!r}")
+            seen[entity] = group
+    bare = [t for _, t in gmsh.model.getEntities(dim) if t not in seen]
+    if bare:
+        return (f"the {dim}D entit{'ies' if len(bare) > 1 else 'y'} "
+                f"{', '.join(map(str, bare))} {'are' if len(bare) > 1 else 'is'} in no "
+                "physical group")
     return None

@@ -223,6 +223,7 @@ class CaseProblem:
             internal = present * internal * self.dx
         if stages is None:
             return internal + loads
+        self._internal = internal
         # the parts present; what a stage digs out, released; what it builds, weighing in
         down = ufl.as_vector([-1.0 if i == self.mesh.geometry.dim - 1 else 0.0
                               for i in range(self.mesh.geometry.dim)])
@@ -287,12 +288,15 @@ class CaseProblem:
                                 strain=eps)
         self.solver.set_bcs(self.bcs + self.construction.held(self.u))
         # the stage starts in equilibrium: the frozen forces hold what the dug cells did
-        # (to 1e-9 of those forces)
+        # (to 1e-9 of those forces, or of the body's internal forces if nothing is dug)
         left = boundary.out_of_balance(self.residual, self.solver.bcs)
         frozen = boundary.out_of_balance(self._released, self.solver.bcs)
-        if left > 1e-9 * max(frozen, 1e-300):
+        scale = frozen if stage["remove"] else boundary.out_of_balance(self._internal,
+                                                                        self.solver.bcs)
+        if left > 1e-9 * max(scale, 1e-300):
             raise SolveError(f"stage {stage['name']!r} does not start in equilibrium: "
-                             f"{left:.3g} of the dug cells' forces {frozen:.3g} unbalanced")
+                             f"{left:.3g} of the {'dug cells' if stage['remove'] else 'body'}"
+                             f"'s forces {scale:.3g} unbalanced")
 
     def _gravity(self):
         """The body force of a geostatic initial stress, −γ along the last axis (or None)."""
