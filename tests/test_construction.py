@@ -401,6 +401,82 @@ def test_a_case_file_says_what_its_stages_cannot_do(tmp_path, demo):
         "cell takes one group)" in proc.stderr, proc.stderr
 
 
+FILL_GEO = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, -2, 0, 4, 2};
+Rectangle(2) = {0, 0, 0, 2, 0.5};
+Coherence;
+Physical Curve("bottom") = Curve In BoundingBox{-0.1, -2.1, -0.1, 4.1, -1.9, 0.1};
+Physical Curve("sides") = Curve In BoundingBox{-0.1, -2.1, -0.1, 0.1, 0.6, 0.1};
+Physical Curve("far") = Curve In BoundingBox{3.9, -2.1, -0.1, 4.1, 0.1, 0.1};
+Physical Curve("loaded") = Curve In BoundingBox{1.9, -0.1, -0.1, 4.1, 0.1, 0.1};
+Physical Surface("ground") = {1};
+Physical Surface("fill") = {2};
+Mesh.MeshSizeMax = 0.25;
+"""
+FILL = """[mesh]
+file = "fill.geo"
+model = "plane_strain"
+
+[[material]]
+group = "ground"
+law = "linear-elastic"
+E = 1000.0
+nu = 0.3
+
+[[material]]
+group = "fill"
+law = "j2"
+E = 1000.0
+nu = 0.3
+sigma0 = 2.0
+unit_weight = 1.0
+
+[[boundary]]
+group = "sides"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "far"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "bottom"
+displacement = [0.0, 0.0]
+
+[[boundary]]
+group = "loaded"
+pressure = 10.0
+
+[loading]
+steps = 2
+
+[solver]
+newton = "modified"
+tolerance = 1e-12
+
+[[stage]]
+name = "fill"
+add = ["fill"]
+steps = 2
+"""
+
+
+def test_a_plastic_fill_arrives_stress_free_after_the_ground_was_loaded(tmp_path, demo):
+    # an elastic ground pressed beside the place of a fill (J2, σ0 = 2, γ = 1) that is not
+    # there yet (its nodes held, but those it shares with the ground settle: its cells are
+    # strained far beyond yield before it exists), then the fill built: it arrives
+    # stress-free and unyielded (its state is committed only where it is present) and
+    # stays elastic under its own weight (0.5 at most); the bottom carries the load and the
+    # fill, 10 × 2 + 1 × 2 × 0.5 = 21 (1e-10); modified Newton on Hooke's tangent of each
+    # part, the absent one's dofs held during the loading
+    (tmp_path / "fill.geo").write_text(FILL_GEO)
+    (tmp_path / "fill.toml").write_text(FILL)
+    d = demo.case(tmp_path / "fill.toml")
+    assert [s.get("stage") for s in d["steps"]] == [None, None, "fill", "fill"]
+    assert all(s["max_cumulated_plastic_strain"] == 0.0 for s in d["steps"])
+    assert d["reactions"]["bottom"][1] == pytest.approx(21.0, rel=1e-10)
+
+
 LIFTS_GEO = LAYERED_GEO.replace("Rectangle(2) = {0, -1, 0, 2, 1};",
                                 "Rectangle(2) = {0, -0.5, 0, 2, 0.5};\n"
                                 "Rectangle(4) = {0, -1, 0, 2, 0.5};").replace(

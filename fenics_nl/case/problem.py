@@ -274,7 +274,12 @@ class CaseProblem:
         self.solver.set_bcs(self.bcs + self.construction.held(self.u))
 
     def begin_stage(self, stage: dict) -> None:
-        """Start `stage` at equilibrium: its groups dug out, their forces frozen (s = 0)."""
+        """Start `stage` at equilibrium (s = 0): what it digs out frozen, what it builds in.
+
+        The groups dug out leave, their forces frozen; those built are present, stress-free.
+        """
+        # what the last step left (Newton's tolerance), which the stage adds to
+        before = boundary.out_of_balance(self.residual, self.solver.bcs)
         eps = kinematics.small_strain(self.u, self.model)
         if self.case.parts is None:
             remove = {"body": [self._stage_tags[g] for g in stage["remove"]]}
@@ -287,16 +292,16 @@ class CaseProblem:
         self.construction.begin(stage["name"], remove=remove, add=add, stresses=stresses,
                                 strain=eps)
         self.solver.set_bcs(self.bcs + self.construction.held(self.u))
-        # the stage starts in equilibrium: the frozen forces hold what the dug cells did
-        # (to 1e-9 of those forces, or of the body's internal forces if nothing is dug)
+        # the stage starts in equilibrium: the frozen forces hold what the dug cells did,
+        # the parts that arrive carry nothing (to 1e-9 of the frozen forces and the body's
+        # internal forces, beyond what the last step left)
         left = boundary.out_of_balance(self.residual, self.solver.bcs)
-        frozen = boundary.out_of_balance(self._released, self.solver.bcs)
-        scale = frozen if stage["remove"] else boundary.out_of_balance(self._internal,
-                                                                        self.solver.bcs)
-        if left > 1e-9 * max(scale, 1e-300):
+        scale = max(boundary.out_of_balance(f, self.solver.bcs)
+                    for f in (self._released, self._internal))
+        if left > before + 1e-9 * scale:
             raise SolveError(f"stage {stage['name']!r} does not start in equilibrium: "
-                             f"{left:.3g} of the {'dug cells' if stage['remove'] else 'body'}"
-                             f"'s forces {scale:.3g} unbalanced")
+                             f"{left:.3g} unbalanced, against the last step's {before:.3g} "
+                             f"and the frozen and internal forces' {scale:.3g}")
 
     def _gravity(self):
         """The body force of a geostatic initial stress, −γ along the last axis (or None)."""
@@ -620,6 +625,8 @@ class CaseProblem:
                                                                     self.dx)
         if case.pairs:
             return PairSteps(self)
+        # a part a stage adds is absent until then: its dofs no present cell touches held
+        bcs = self.bcs + ([] if self.construction is None else self.construction.held(self.u))
         if self.contact is not None:
             _, facets, axis, sign = self.contact
             contact = ActiveSetContact(
@@ -629,11 +636,11 @@ class CaseProblem:
                 displacement_space=self.V if self.mixed or self.plane_stress else None)
             return ContactSteps(contact, self)
         if case.newton == "snes":
-            return SnesSolver(self.residual, self.unknown, self.bcs, prefix=PREFIX + "snes_",
+            return SnesSolver(self.residual, self.unknown, bcs, prefix=PREFIX + "snes_",
                               rtol=opts["rtol"], atol=case.tolerance,
                               force_scale=self.force_scale, max_it=case.max_it,
                               linear_solver=linear)
-        return NewtonSolver(self.residual, self.unknown, self.bcs, method=method, prefix=PREFIX,
+        return NewtonSolver(self.residual, self.unknown, bcs, method=method, prefix=PREFIX,
                             linear_solver=linear, **opts)
 
     # -- loads and results --------------------------------------------------------------

@@ -765,6 +765,10 @@ def _parts(r: _Reader, groups, stages: list[dict], initial_stress) -> list[dict]
                                "group (the first too, if stages add it once per table)")
             continue
         names = [group] if n == 1 else [f"{group}.{j}" for j in range(1, n + 1)]
+        for name in names if n > 1 else []:  # (a part's name is its checkpoint's)
+            if name in tables:
+                r.fail("material", f"{group!r}'s tables are the parts {', '.join(names)}, "
+                                   f"and {name!r} is a cell group too: rename it")
         for j, (k, name) in enumerate(zip(ks, names, strict=True)):
             _, law, parameters, gamma = groups[k]
             start = j == 0 and a == n - 1
@@ -781,6 +785,10 @@ def _parts(r: _Reader, groups, stages: list[dict], initial_stress) -> list[dict]
                                        "[initial_stress] (make it arrive in a [[stage]], add)")
         present[group] = names[0] if a == n - 1 else None
         coming[group] = names[1:] if a == n - 1 else names
+    if initial_stress is not None and tables and not any(
+            p["start"] and p["law"] in INITIAL for p in parts):
+        r.fail("initial_stress", f"no part present at the start takes it (a soil's law, "
+                                 f"{', '.join(INITIAL)})")
     for i, st in enumerate(stages, start=1):
         st["leave"], st["arrive"] = [], []
         for key, to in (("remove", "leave"), ("add", "arrive")):
@@ -793,7 +801,9 @@ def _parts(r: _Reader, groups, stages: list[dict], initial_stress) -> list[dict]
                 there = present[group]
                 if key == "remove" and there is None:
                     r.fail(f"stage[{i}].remove", f"{group!r} is not there to remove (removed "
-                                                 "already, or not yet added)")
+                                                 "already, or not yet added: a group the "
+                                                 "stages add once per table is absent at the "
+                                                 "start)")
                 elif key == "add" and there is not None:
                     r.fail(f"stage[{i}].add", f"{group!r} is still there ({there}): remove it "
                                               "in this stage or an earlier one")
@@ -939,7 +949,7 @@ def _materials_by_group(r: _Reader, tables: list[dict], model: str | None):
     for i, t in enumerate(tables, start=1):
         where = f"material[{i}]"
         group = r.get(t, "group", where, str, required=True)
-        gamma = r.get(t, "unit_weight", where, float, positive=True)
+        gamma = r.get(t, "unit_weight", where, float, minimum=0.0)
         law, parameters = _one_material(
             r, {k: v for k, v in t.items() if k not in ("group", "unit_weight")}, where, model)
         if law is not None and law not in (*STATE_FREE, *GROUP_PLASTIC):

@@ -156,8 +156,9 @@ class ByGroup(Material):
     def modified_newton_tangent(self, u, model: str, dx):
         """Each part's constant tangent on its cells: Hooke's for a plastic law (its E, ν).
 
-        A state-free law's own tangent, where the solver first assembles it. "initial" if
-        no law is path-dependent (the tangent at each solve's start, as one law's).
+        A state-free law's own tangent at the displacement the solver assembles it at
+        (exact for Hooke's law, whose tangent is constant). "initial" if no law is
+        path-dependent (the tangent at each solve's start, as one law's).
         """
         if not self.path_dependent:
             return "initial"
