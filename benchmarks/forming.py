@@ -106,7 +106,7 @@ def upset(cells, friction, variant):
         return lambda x: 0.5 * h0 * (1.0 - reduction) - x[1]
 
     newton = {"method": "full", "rtol": 1e-10, "atol": 1e-10, "force_scale": law.sigma0 * R0**2,
-              "max_it": 30, **VARIANTS[variant]}
+              "max_it": 30, "line_search": True, **VARIANTS[variant]}
     on_die = {"normal_axis": 1, "initial": "penetrating", "newton_options": newton,
               "prefix": "upsetting_"}
     S_C = np.union1d(tagged("top"), tagged("side"))
@@ -356,4 +356,5 @@ def main():
     publish("forming", out, table, args, say)
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -59,7 +59,7 @@ class FrictionalContact(ActiveSetContact):
     # normal forces of the last solve); its third visit is a cycle
     STATUSES, REVISITS = "statuses", 2
 
-    def __init__(self, *args, friction: float, **kwargs):
+    def __init__(self, *args, friction: float, consistent: bool | None = None, **kwargs):
         if not (math.isfinite(friction) and friction >= 0):
             raise ValueError(f"the friction coefficient must be a finite number >= 0, got "
                              f"{friction}")
@@ -68,6 +68,10 @@ class FrictionalContact(ActiveSetContact):
                              "(--formulation elimination)")
         super().__init__(*args, **kwargs)
         self.f = float(friction)
+        # the slip forces follow T_n inside Newton (row couplings) where the tangent is
+        # rebuilt anyway (a non-linear material); a linear one's iterations keep its
+        # factorization with point forces from the last solve's T_n
+        self.consistent = not self.newton.linear if consistent is None else bool(consistent)
         S = self.surface
         self.axes = S.tangential_axes
         n, m = len(S.dofs_n), len(self.axes)
@@ -245,10 +249,17 @@ class FrictionalContact(ActiveSetContact):
                     for k, i in enumerate(self.axes)]
         self.system.set_active(self.active, changes, extra_bcs=sticking)
         loaded = [S.owned & self.slip & self.free[:, k] for k in range(len(self.axes))]
-        dofs = np.concatenate([S.tangential(i)[0][on]
-                               for i, on in zip(self.axes, loaded, strict=True)])
-        values = np.concatenate([self.slip_force[on, k] for k, on in enumerate(loaded)])
-        self.newton.nodal.set_load(dofs, values)
+        dofs = [S.tangential(i)[0][on] for i, on in zip(self.axes, loaded, strict=True)]
+        if self.consistent:
+            # the friction force f |T_n| s with T_n = sign R_n, its normal dof's reaction
+            # in Newton's own iteration: R_t − f (−sign R_n) s_t, a row coupling
+            sources = np.concatenate([S.dofs_V[on] for on in loaded])
+            c = np.concatenate([self.f * S.sign * self.direction[on, k]
+                                for k, on in enumerate(loaded)])
+            self.newton.nodal.set_couplings(np.concatenate(dofs), sources, c)
+        else:  # a point force from the last solve's T_n
+            values = np.concatenate([self.slip_force[on, k] for k, on in enumerate(loaded)])
+            self.newton.nodal.set_load(np.concatenate(dofs), values)
         if len(self.axes) > 1:
             self._set_springs(target)
 
@@ -313,7 +324,12 @@ class FrictionalContact(ActiveSetContact):
             moving = kept & (along > max(tol_u, floor))
             spring[moving] = bound[moving] / along[moving]
         slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
-        drift = global_max(self.comm, np.abs(slip_force - self.slip_force))
+        # consistent: the solve's friction forces followed its own T_n (`_set_conditions`),
+        # what moves them is a new direction (a first sense, or one turning in 3D); else
+        # they were the last solve's, and follow T_n from solve to solve
+        solved = np.where(self.slip[:, None], bound[:, None] * self.direction, 0.0) \
+            if self.consistent else self.slip_force
+        drift = global_max(self.comm, np.abs(slip_force - solved))
         changes = S.count(active != self.active) + S.count(slip != self.slip)
         n_slip, n_stick = S.count(slip), S.count(active & ~slip)
         self.active, self.slip, self.direction = active, slip, direction

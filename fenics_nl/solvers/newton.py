@@ -253,6 +253,7 @@ class NewtonSolver:
         # rows are then applied to a copy instead of reassembling.
         J_expanded = expand_derivatives(J)
         fixed = not (J_expanded.coefficients() or extract_constants(J_expanded))
+        self.linear = fixed  # the tangent does not depend on u (a linear material)
         self._K_fixed = None  # K without Dirichlet rows, kept after its first assembly
         self._A_stale = False  # A is K_fixed with older rows (see `_fixed_tangent`)
         self._A_factorized = False  # A is the matrix last factorized (no rows, springs since)
@@ -530,9 +531,10 @@ class NewtonSolver:
         """
         if self.nodal.version != self._nodal_version:  # new springs: the tangent is stale
             # but near the last one (friction's springs follow the slip directions as they
-            # converge): with reuse, the last factorization preconditions CG first
+            # converge): with reuse, the last factorization preconditions CG first; not
+            # with couplings (rows not symmetric: no CG)
             self._nodal_version = self.nodal.version
-            self._policy.bcs_changed(small=True)
+            self._policy.bcs_changed(small=self.nodal.couplings is None)
             self._supports_checked = False
         if not self._policy.needs_tangent(k):
             return False
@@ -684,6 +686,12 @@ class NewtonSolver:
         with _Timer(work, "tangent"):
             if self._policy.fixed and not self._constant:
                 self._fixed_tangent(work)
+            elif self.nodal.couplings is not None:  # the source rows first, then Dirichlet's
+                self._matrix.assemble(self._K_used)
+                work.tangent_assemblies += 1
+                self.nodal.couple_rows(self.A)
+                self.A.zeroRowsColumnsLocal(constrained_dofs(self.bcs).astype(PETSc.IntType),
+                                            diag=1.0)
             else:
                 self._matrix.assemble(self._K_used, self.bcs)
                 work.tangent_assemblies += 1
@@ -699,7 +707,7 @@ class NewtonSolver:
             self._supports_checked = True
         if self._rows is not None:
             self._rows.serving = False
-        if self._rows is not None and self.nodal.springs is None:
+        if self._rows is not None and self.nodal.plain:
             # a linear material's new rows: on the last factorization while that pays
             with _Timer(work, "solve"):  # its columns are back-solves
                 serves = self._rows.set_rows(constrained_dofs(self.bcs), work)
@@ -732,7 +740,7 @@ class NewtonSolver:
         self._A_stale = True
         # deferred only while A is the base's matrix: springs added since (and gone again)
         # or other rows applied without a factorization leave another matrix in A
-        if (self._rows is None or self._rows.factor is None or self.nodal.springs is not None
+        if (self._rows is None or self._rows.factor is None or not self.nodal.plain
                 or not self._A_factorized):
             self._apply_rows_to_fixed_tangent()
 
@@ -741,6 +749,7 @@ class NewtonSolver:
         if not self._A_stale:
             return
         self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.nodal.couple_rows(self.A)  # (K's source rows, before Dirichlet's)
         rows = constrained_dofs(self.bcs)
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
         self._A_stale = self._A_factorized = False
@@ -768,9 +777,9 @@ class NewtonSolver:
             pc = self._ksp.getPC()
             if pc.getFactorSolverType() != "mumps":  # (the options chose another package)
                 self._rows = None
-            elif self.nodal.springs is None:
+            elif self.nodal.plain:
                 self._rows.rebase(pc.getFactorMatrix(), constrained_dofs(self.bcs))
-            else:  # its K would miss the springs
+            else:  # its K would miss the springs and couplings
                 self._rows.factor = None
 
     def _linear_solve(self, rhs: PETSc.Vec, work: WorkCounts, retry: bool = True) -> None:

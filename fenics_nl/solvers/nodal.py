@@ -1,10 +1,16 @@
-"""Nodal terms: point forces and nodal springs that no integral gives, added to R and K.
+"""Nodal terms: point forces, nodal springs and row couplings that no integral gives.
 
 A `NewtonSolver` holds one `NodalTerms` (`solver.nodal`), its one hook for them: the
 friction force of a slipping contact node and, in 3D, its spring against slip across the
 force's direction (`contact.friction` sets both before each solve); the apex load of the
 von Mises truss (tests/test_arclength.py). The solver adds them to every residual and
-tangent it assembles, and rebuilds its tangent when the springs change.
+tangent it assembles, and rebuilds its tangent when the springs or couplings change.
+
+A *coupling* makes a row take a multiple of another's, R_t + c R_s and K_t + c K_s, R_s
+the residual at a Dirichlet dof (its reaction, before the Dirichlet row replaces it):
+friction's force f |T_n| s at a slipping node with T_n its normal dof's reaction, in
+Newton's iteration itself (the force follows the normal force, with its derivative),
+rather than a point force from the last solve's T_n.
 """
 
 from __future__ import annotations
@@ -23,7 +29,13 @@ class NodalTerms:
         self.V, self.comm = V, comm
         self.load = None  # (dofs, values)
         self.springs = None  # (dofs, stiffness, anchor)
-        self.version = 0  # grows when the springs change: the tangent is then stale
+        self.couplings = None  # (targets, sources, coefficients)
+        self.version = 0  # grows when the springs or couplings change: the tangent is stale
+
+    @property
+    def plain(self) -> bool:
+        """No springs and no couplings: the tangent is the form's alone."""
+        return self.springs is None and self.couplings is None
 
     def set_load(self, dofs: np.ndarray, values: np.ndarray) -> None:
         """Point forces F = `values` at `dofs`: R(u) − F.
@@ -54,19 +66,63 @@ class NodalTerms:
         self.springs = (dofs, np.asarray(stiffness, dtype=float),
                         np.asarray(anchor, dtype=float)) if has else None
 
+    def set_couplings(self, targets: np.ndarray, sources: np.ndarray,
+                      coefficients: np.ndarray) -> None:
+        """Rows that take a multiple of others: R_t + c R_s, K_t + c K_s.
+
+        Replaces the previous ones. Collective: every rank's tangent is rebuilt if any rank
+        has (or had) couplings.
+
+        Args:
+            targets: the local indices t of the rows changed (owned dofs).
+            sources: the local indices s of the rows added to them (owned dofs whose
+                residual is a reaction: Dirichlet dofs, read before their rows are set).
+            coefficients: c for each pair.
+        """
+        targets = np.asarray(targets, dtype=np.int32)
+        had = self.couplings is not None
+        has = self.comm.allreduce(bool(targets.size), op=MPI.LOR)
+        if had or has:
+            self.version += 1
+        self.couplings = (targets, np.asarray(sources, dtype=np.int32),
+                          np.asarray(coefficients, dtype=float)) if has else None
+
     def add_to_residual(self, u: np.ndarray, b: np.ndarray) -> None:
-        """b −= F, b += k (u − a): on the local arrays, after the residual's assembly.
+        """b_t += c b_s, b −= F, b += k (u − a): on the local arrays, after the assembly.
+
+        Before the Dirichlet rows are set: b_s is still the reaction there.
 
         Args:
             u: the local array of the unknown.
             b: the local array of the residual R, changed in place.
         """
+        if self.couplings is not None:
+            targets, sources, c = self.couplings
+            b[targets] += c * b[sources]
         if self.load is not None:
             dofs, values = self.load
             b[dofs] -= values
         if self.springs is not None:
             dofs, k, anchor = self.springs
             b[dofs] += np.einsum("nij,nj->ni", k, u[dofs] - anchor)
+
+    def couple_rows(self, A: PETSc.Mat) -> None:
+        """K_t += c K_s for each coupling (collective; nothing without).
+
+        A must still have the source rows (assembled without their Dirichlet rows); the
+        target's pattern holds the source's (two components of one node).
+
+        Args:
+            A: the assembled tangent K, changed in place.
+        """
+        if self.couplings is None:
+            return
+        targets, sources, c = self.couplings
+        first = A.getOwnershipRange()[0]  # owned local dof i is global row first + i
+        rows = [A.getRow(first + int(s)) for s in sources]
+        for t, (cols, values), ct in zip(targets, rows, c, strict=True):
+            A.setValues([first + int(t)], cols, ct * values, addv=PETSc.InsertMode.ADD_VALUES)
+        A.assemble()
 
     def add_to_tangent(self, A: PETSc.Mat) -> None:
         """A += each spring's stiffness (collective, as A.assemble(); nothing without).
