@@ -309,3 +309,62 @@ def test_the_command_line_tolerances_are_petscs_for_newton_and_snes():
     finally:
         for k in ("rtol", "max_it", "atol"):
             opts.delValue(f"cl_snes_{k}")
+
+
+def test_row_couplings_enter_the_residual_and_its_tangent_alike():
+    # friction's consistent slip force as `NodalTerms` writes it: a row t takes c times a
+    # Dirichlet row s, R_t + c R_s, on a neo-Hookean square (its tangent depends on u) held
+    # at its bottom and at one top node's vertical dof s, t that node's horizontal one. The
+    # tangent the solver assembles (K_t + c K_s, K_s read before the Dirichlet rows are
+    # set) is that residual's derivative: Taylor remainders of slope 2 off the Dirichlet
+    # rows; the tangent without the coupling gives slope 1 (the test sees the coupling)
+    from dolfinx import mesh
+
+    from fenics_nl.materials.laws import NeoHookean
+    from fenics_nl.solvers.result import WorkCounts
+    from fenics_nl.solvers.supports import constrained_dofs
+
+    m = mesh.create_unit_square(MPI.COMM_SELF, 4, 4)
+    V = fem.functionspace(m, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    rng = np.random.default_rng(7)
+    u.x.array[:] = 0.05 * rng.standard_normal(u.x.array.size)
+    residual = NeoHookean(1.0, 0.3).internal_work(u, v, "plane_strain") * ufl.dx
+    corner = mesh.locate_entities_boundary(m, 0, lambda x: np.isclose(x[0], 1) & np.isclose(
+        x[1], 1))
+    bottom = mesh.locate_entities_boundary(m, 1, lambda x: np.isclose(x[1], 0))
+    held = [fem.dirichletbc(np.zeros(2), fem.locate_dofs_topological(V, 1, bottom), V),
+            fem.dirichletbc(0.0, fem.locate_dofs_topological(V.sub(1), 0, corner), V.sub(1))]
+    for bc in held:  # (u where it is held: 0)
+        bc.set(u.x.array)
+    node = fem.locate_dofs_topological(V, 0, corner)[0]
+    t, s = 2 * node, 2 * node + 1
+    solver = NewtonSolver(residual, u, held, prefix="couplings_")
+    work, u0 = WorkCounts(), u.x.array.copy()
+    du = 0.05 * rng.standard_normal(u.x.array.size)
+    fixed = constrained_dofs(held)
+    du[fixed] = 0.0
+    free = np.setdiff1d(np.arange(u.x.array.size), fixed)
+
+    def remainders(coupled_tangent):
+        solver.nodal.set_couplings([t] if coupled_tangent else [], [s] if coupled_tangent
+                                   else [], [0.3] if coupled_tangent else [])
+        u.x.array[:] = u0
+        solver.assemble_exact_tangent(work)
+        Kdu = solver.A.createVecLeft()
+        x = solver.A.createVecRight()
+        x.array[:] = du
+        solver.A.mult(x, Kdu)
+        solver.nodal.set_couplings([t], [s], [0.3])  # the residual is always coupled
+        solver.residual(work)
+        b0 = solver.residual_vector.array.copy()
+        out = []
+        for h in (1e-3, 5e-4, 2.5e-4, 1.25e-4):
+            u.x.array[:] = u0 + h * du
+            solver.residual(work)
+            r = solver.residual_vector.array - b0 - h * Kdu.array
+            out.append(np.linalg.norm(r[free]))
+        return np.log2(np.array(out[:-1]) / np.array(out[1:]))
+
+    assert remainders(True) == pytest.approx(2.0, abs=0.05)
+    assert remainders(False)[-1] == pytest.approx(1.0, abs=0.15)

@@ -41,6 +41,7 @@ import numpy as np
 from mpi4py import MPI
 
 from fenics_nl.contact.active_set import ActiveSetContact, StatusUpdate
+from fenics_nl.errors import SolveError
 from fenics_nl.parallel import gather_rows, global_max
 
 __all__ = ["FrictionalContact"]
@@ -71,7 +72,10 @@ class FrictionalContact(ActiveSetContact):
         # the slip forces follow T_n inside Newton (row couplings) where the tangent is
         # rebuilt anyway (a non-linear material); a linear one's iterations keep its
         # factorization with point forces from the last solve's T_n
-        self.consistent = not self.newton.linear if consistent is None else bool(consistent)
+        if consistent is None:
+            consistent = not self.newton.linear
+        self.consistent = bool(consistent) and self.newton.allow_unsymmetric()
+        self.fallbacks = 0  # consistent steps taken again with point forces
         S = self.surface
         self.axes = S.tangential_axes
         n, m = len(S.dofs_n), len(self.axes)
@@ -239,6 +243,41 @@ class FrictionalContact(ActiveSetContact):
             return None
         order = np.argsort(rows[0])
         return tuple(r[order] for r in rows)
+
+    # -- the loop, consistent or not ---------------------------------------------------
+
+    def solve(self):
+        """The loop (`ActiveSetContact.solve`); if a consistent one fails, with point forces.
+
+        The consistent tangent is not symmetric, and near singular where a slipping node's
+        normal and tangential stiffnesses couple strongly (a plastic billet at finite
+        strain): Newton then diverges. The step is taken again from where it began with
+        point forces from the last solve's T_n (the fixed point, slower, robust) rather than
+        cut; its iterations count the failed attempt's, and `fallbacks` counts these steps.
+        """
+        if not self.consistent:
+            return super().solve()
+        u0, state = self.u.x.array.copy(), self._state()
+        try:
+            return super().solve()
+        except SolveError as err:
+            spent = getattr(err, "result", None)
+            self.u.x.array[:] = u0
+            self.active, self.slip, self.direction, self.slip_force, self.spring = (
+                a.copy() for a in state)
+            self.newton.nodal.set_couplings(np.zeros(0), np.zeros(0), np.zeros(0))
+            self.fallbacks += 1
+            self.consistent = False
+            try:
+                res = super().solve()
+            finally:
+                self.consistent = True
+                self.newton.nodal.set_load(np.zeros(0), np.zeros(0))
+            if spent is not None:
+                res.iterations += spent.iterations
+                res.work.add(spent.work)
+            res.history.insert(0, {"point_forces_after": str(err).split(";")[0]})
+            return res
 
     # -- one iteration's conditions ---------------------------------------------------
 

@@ -124,6 +124,23 @@ def factorized_counting_null_pivots(ksp: PETSc.KSP) -> int:
     return pc.getFactorMatrix().getMumpsInfog(28)
 
 
+def allow_unsymmetric(ksp: PETSc.KSP) -> bool:
+    """Let `ksp` solve a tangent that is not symmetric: CG becomes GMRES; whether it can.
+
+    A reused factorization or GAMG preconditions GMRES (right, restarted as for an indefinite
+    tangent); LU needs nothing; Cholesky cannot.
+
+    Returns:
+        False with Cholesky (the tangent must stay symmetric), else True.
+    """
+    pc = ksp.getPC()
+    if pc.getType() == "cholesky":
+        return False
+    if ksp.getType() == "cg":
+        _true_residual_gmres(ksp, restart=200 if pc.getType() == "gamg" else 50)
+    return True
+
+
 def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
     """GMRES preconditioned on the right: it stops on ‖A x − b‖, what Newton needs."""
     ksp.setType("gmres")

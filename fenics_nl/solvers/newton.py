@@ -51,6 +51,7 @@ from fenics_nl.solvers.factorizations import Factorizations
 from fenics_nl.solvers.form_matrix import FormMatrix
 from fenics_nl.solvers.linear_solver import (
     LinearSolver,
+    allow_unsymmetric,
     block_preconditioned_ksp,
     create_ksp,
     rigid_body_modes,
@@ -341,6 +342,19 @@ class NewtonSolver:
         """Global number of scalar unknowns."""
         imap = self.u.function_space.dofmap.index_map  # scalar unknowns, all ranks
         return imap.size_global * self.u.function_space.dofmap.index_map_bs
+
+    def allow_unsymmetric(self) -> bool:
+        """Let the tangent lose its symmetry (friction's couplings); whether it may.
+
+        A reused factorization then preconditions GMRES instead of CG
+        (`linear_solver.allow_unsymmetric`); not with Cholesky, nor a block preconditioner.
+
+        Returns:
+            Whether the linear solver takes a tangent that is not symmetric.
+        """
+        if self._M is not None:
+            return False
+        return allow_unsymmetric(self._ksp)
 
     def set_bcs(self, bcs: Sequence[fem.DirichletBC], small_change: bool = False,
                 new_path: bool = False) -> None:
