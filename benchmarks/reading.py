@@ -434,7 +434,7 @@ def forming(x: dict) -> str:
     for problem in dict.fromkeys(r["problem"] for r in x["variants"]):
         full = rows[(problem, "full")]
         parts = []
-        for variant in ("modified", "bfgs"):
+        for variant in ("full, point forces", "modified", "bfgs"):
             r = rows.get((problem, variant))
             if r is None:
                 continue
