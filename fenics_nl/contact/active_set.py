@@ -477,6 +477,13 @@ class ActiveSetContact:
             nr = self.system.solve()
         except SupportError as err:
             raise self._unheld(err, k) from None
+        except SolveError as err:  # the loop's work so far goes with it (the driver counts it)
+            spent = getattr(err, "result", None)
+            if spent is not None:
+                res.iterations += spent.iterations
+                res.work.add(spent.work)
+            err.result = res
+            raise
         res.iterations += nr.iterations
         res.work.add(nr.work)
         res.residual_norms = nr.residual_norms

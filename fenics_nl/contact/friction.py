@@ -270,6 +270,11 @@ class FrictionalContact(ActiveSetContact):
             self.consistent = False
             try:
                 res = super().solve()
+            except SolveError as again:  # both failed: the driver counts both
+                if spent is not None and getattr(again, "result", None) is not None:
+                    again.result.iterations += spent.iterations
+                    again.result.work.add(spent.work)
+                raise
             finally:
                 self.consistent = True
                 self.newton.nodal.set_load(np.zeros(0), np.zeros(0))
