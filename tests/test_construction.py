@@ -244,7 +244,20 @@ Mesh.MeshSizeMax = 0.25;
 Mesh.ElementOrder = 2;
 """
 
-STAGED = """[mesh]
+# the ground's supports: its sides slide, its bottom is held
+SUPPORTS = """[[boundary]]
+group = "sides"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "far"
+displacement = [0.0, "free"]
+
+[[boundary]]
+group = "bottom"
+displacement = [0.0, 0.0]
+"""
+STAGED = ("""[mesh]
 file = "layered.geo"
 model = "plane_strain"
 degree = 2
@@ -261,18 +274,8 @@ unit_weight = 18.0
 K0 = 0.5
 surface = 0.0
 
-[[boundary]]
-group = "sides"
-displacement = [0.0, "free"]
-
-[[boundary]]
-group = "far"
-displacement = [0.0, "free"]
-
-[[boundary]]
-group = "bottom"
-displacement = [0.0, 0.0]
-
+"""
+    + SUPPORTS + """
 [loading]
 steps = 1
 
@@ -280,7 +283,7 @@ steps = 1
 name = "dig"
 remove = ["pit"]
 steps = 4
-"""
+""")
 
 
 WALLED_GEO = """SetFactory("OpenCASCADE");
@@ -413,7 +416,7 @@ Physical Surface("ground") = {1};
 Physical Surface("fill") = {2};
 Mesh.MeshSizeMax = 0.25;
 """
-FILL = """[mesh]
+FILL = ("""[mesh]
 file = "fill.geo"
 model = "plane_strain"
 
@@ -431,18 +434,8 @@ nu = 0.3
 sigma0 = 2.0
 unit_weight = 1.0
 
-[[boundary]]
-group = "sides"
-displacement = [0.0, "free"]
-
-[[boundary]]
-group = "far"
-displacement = [0.0, "free"]
-
-[[boundary]]
-group = "bottom"
-displacement = [0.0, 0.0]
-
+"""
+    + SUPPORTS + """
 [[boundary]]
 group = "loaded"
 pressure = 10.0
@@ -458,7 +451,7 @@ tolerance = 1e-12
 name = "fill"
 add = ["fill"]
 steps = 2
-"""
+""")
 
 
 def test_a_plastic_fill_arrives_stress_free_after_the_ground_was_loaded(tmp_path, demo):
