@@ -703,9 +703,7 @@ class NewtonSolver:
             elif self.nodal.couplings is not None:  # the source rows first, then Dirichlet's
                 self._matrix.assemble(self._K_used)
                 work.tangent_assemblies += 1
-                self.nodal.couple_rows(self.A)
-                self.A.zeroRowsColumnsLocal(constrained_dofs(self.bcs).astype(PETSc.IntType),
-                                            diag=1.0)
+                self._couple_then_set_dirichlet_rows()
             else:
                 self._matrix.assemble(self._K_used, self.bcs)
                 work.tangent_assemblies += 1
@@ -763,10 +761,17 @@ class NewtonSolver:
         if not self._A_stale:
             return
         self._K_fixed.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.nodal.couple_rows(self.A)  # (K's source rows, before Dirichlet's)
+        self._couple_then_set_dirichlet_rows()
+        self._A_stale = self._A_factorized = False
+
+    def _couple_then_set_dirichlet_rows(self) -> None:
+        """A (K without Dirichlet rows): the nodal couplings, then the identity's rows.
+
+        The couplings read K's source rows, which the Dirichlet rows then replace.
+        """
+        self.nodal.couple_rows(self.A)
         rows = constrained_dofs(self.bcs)
         self.A.zeroRowsColumnsLocal(rows.astype(PETSc.IntType), diag=1.0)
-        self._A_stale = self._A_factorized = False
 
     def _factorize(self, work: WorkCounts) -> None:
         """Numeric factorization of the current tangent (the symbolic one is reused).
