@@ -104,6 +104,11 @@ class FrictionalContact(ActiveSetContact):
         return (self.active.copy(), self.slip.copy(), self.direction.copy(),
                 self.slip_force.copy(), self.spring.copy())
 
+    def _set_state(self, state) -> None:
+        """The statuses, directions, slip forces and springs of `_state()` back (copies)."""
+        self.active, self.slip, self.direction, self.slip_force, self.spring = (
+            a.copy() for a in state)
+
     def commit(self) -> None:
         """The current state becomes the start of the next step's increments."""
         self._committed = self._state()
@@ -116,8 +121,7 @@ class FrictionalContact(ActiveSetContact):
 
         The displacement is the caller's to restore (the driver keeps it).
         """
-        self.active, self.slip, self.direction, self.slip_force, self.spring = (
-            a.copy() for a in self._committed)
+        self._set_state(self._committed)
         self.motion = self.committed_motion.copy()
 
     def checkpoint_arrays(self) -> dict[str, np.ndarray]:
@@ -263,8 +267,7 @@ class FrictionalContact(ActiveSetContact):
         except SolveError as err:
             spent = getattr(err, "result", None)
             self.u.x.array[:] = u0
-            self.active, self.slip, self.direction, self.slip_force, self.spring = (
-                a.copy() for a in state)
+            self._set_state(state)
             self.newton.nodal.set_couplings(np.zeros(0), np.zeros(0), np.zeros(0))
             self.fallbacks += 1
             self.consistent = False

@@ -220,9 +220,8 @@ class ByGroup(Material):
         mesh = self.quadrature_space().mesh
         out = None
         for key, law in self._kept():
-            f = of(law)
-            f.x.array[:] *= np.repeat(self.indicator(mesh, key).x.array,
-                                      f.x.array.size // self.indicator(mesh, key).x.array.size)
+            f, chi = of(law), self.indicator(mesh, key).x.array
+            f.x.array[:] *= np.repeat(chi, f.x.array.size // chi.size)  # (each block its cell's)
             if out is None:
                 out = f
             else:
