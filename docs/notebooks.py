@@ -37,6 +37,7 @@ SMALL = {
     "bearing.py": [],
     "excavation.py": [],
     "upsetting.py": [],
+    "forging.py": [],
     "snap_through.py": [],
     "damage_bar.py": [],
     "crack.py": ["--ell", "0.05", "--steps", "8"],

@@ -7,7 +7,8 @@ from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 __all__ = ["PUNCH_GROWTH", "distributed", "graded_block", "punch_block", "punch_block_size",
-           "quarter_annulus", "size_by_field", "start_model", "threshold_field"]
+           "quarter_annulus", "quarter_cylinder", "size_by_field", "start_model",
+           "threshold_field"]
 
 
 def start_model(name: str) -> None:
@@ -229,3 +230,37 @@ def quarter_annulus(comm: MPI.Comm, a: float, b: float, size: float, order: int 
         gmsh.option.setNumber("Mesh.ElementOrder", order)
         gmsh.model.mesh.generate(2)
     return distributed(comm, a)
+
+
+def quarter_cylinder(comm: MPI.Comm, radius: float, height: float, size: float,
+                     order: int = 2) -> gmshio.MeshData:
+    """The quarter cylinder x, y ≥ 0, x² + y² < R², 0 < z < `height`: tetrahedra of `size`.
+
+    For a billet with three planes of symmetry (an eighth of it: `height` is half the
+    billet's). Curved faces of `order` (2: the round side is a curved P2 surface, whose area
+    is πR² h to the quadrature's accuracy). Physical groups: ``top`` (z = height), ``mid``
+    (z = 0), ``side`` (the round face), ``x0`` (the plane x = 0), ``y0`` (y = 0), ``body``.
+    Meshed in units of R (gmsh's tolerances are absolute), scaled back.
+    """
+    if comm.rank == 0:
+        start_model("quarter_cylinder")
+        occ = gmsh.model.occ
+        H = height / radius
+        cylinder = occ.addCylinder(0, 0, 0, 0, 0, H, 1.0)
+        occ.intersect([(3, cylinder)], [(3, occ.addBox(0, 0, 0, 2, 2, 2 * H))])
+        occ.synchronize()
+        groups: dict[str, list[int]] = {}
+        for _, tag in gmsh.model.getEntities(2):
+            x, y, z = occ.getCenterOfMass(2, tag)
+            name = ("top" if abs(z - H) < 1e-9 else "mid" if abs(z) < 1e-9
+                    else "x0" if abs(x) < 1e-9 else "y0" if abs(y) < 1e-9 else "side")
+            groups.setdefault(name, []).append(tag)
+        for tag, name in enumerate(("top", "mid", "side", "x0", "y0"), start=1):
+            gmsh.model.addPhysicalGroup(2, groups[name], tag, name=name)
+        gmsh.model.addPhysicalGroup(3, [t for _, t in gmsh.model.getEntities(3)], 1,
+                                    name="body")
+        for option in ("MeshSizeMin", "MeshSizeMax"):  # uniform: not the points' sizes
+            gmsh.option.setNumber(f"Mesh.{option}", size / radius)
+        gmsh.option.setNumber("Mesh.ElementOrder", order)
+        gmsh.model.mesh.generate(3)
+    return distributed(comm, radius, 3)

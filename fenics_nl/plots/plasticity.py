@@ -11,7 +11,9 @@ them. And the vessel creeping under a held pressure (`demos/creep_vessel.py`): i
 profiles at several times against Lamé's and the stationary closed form, the bore's stresses
 and displacement against time (`creep_vessel_figure`). And any 2D section's cell fields
 (plastic strain, σ_eq, a displacement) beside profiles along lines after each stage or step
-(`fields_and_profiles`: `demos/excavation.py`).
+(`fields_and_profiles`: `demos/excavation.py`). And a closed-die forging in 3D: the part
+mirrored whole from its computed eighth, coloured by p, with the die cavity's outline
+(`forging_picture`), and its load against the stroke (`forging_load_curve`).
 """
 
 from __future__ import annotations
@@ -27,7 +29,8 @@ from fenics_nl.plots import deformed, figures
 from fenics_nl.theory import vessels
 
 __all__ = ["VesselRun", "billet_picture", "creep_vessel_figure", "fields_and_profiles",
-           "upsetting_force_curve", "vessel_plastic_zone", "vessel_pressure_curve"]
+           "forging_load_curve", "forging_picture", "upsetting_force_curve",
+           "vessel_plastic_zone", "vessel_pressure_curve"]
 
 
 @dataclass
@@ -338,4 +341,80 @@ def fields_and_profiles(u: fem.Function, fields: dict[str, fem.Function],
     for ax in panels[n:]:
         ax.set_visible(False)
     fig.suptitle(title, fontsize=10)
+    figures.save_figure(fig, path)
+
+
+def forging_picture(displacement: fem.Function, plastic_strain_per_cell: fem.Function,
+                    path: str, title: str, *, outline: np.ndarray, land: float) -> None:
+    """The forged part, whole (its eighth mirrored), coloured by p; the cavity's outline.
+
+    At true scale, seen from above at an angle and from above: the flash is the metal
+    beyond the outline. Collective; rank 0 writes `path`.
+
+    Args:
+        displacement: u on the eighth x, y, z ≥ 0 (a 3D vector Lagrange Function).
+        plastic_strain_per_cell: p, each cell's largest (DG0).
+        path: the PNG.
+        title: the picture's title.
+        outline: the cavity's outline in plan, (n, 2) points of its quarter x, y ≥ 0.
+        land: the lands' height z above the mid-plane (the outline is drawn there).
+    """
+    u1 = output.vertex_interpolant(displacement)
+    grid = output.gather_grid(u1.function_space, {"u": u1},
+                              {"p": output.owned_cell_values(plastic_strain_per_cell)})
+    if grid is None:
+        return
+    pv = figures.off_screen()
+    part = grid.pyvista().warp_by_vector("u")
+    for normal in ((1, 0, 0), (0, 1, 0), (0, 0, 1)):  # the eighth to the whole part
+        part = part.merge(part.reflect(normal, point=(0, 0, 0)))
+    quarter = np.column_stack([outline, np.full(len(outline), land)])
+    ring = np.vstack([quarter, quarter[::-1] * [-1, 1, 1], quarter * [-1, -1, 1],
+                      quarter[::-1] * [1, -1, 1]])
+    pl = pv.Plotter(off_screen=True, window_size=(1700, 800), shape=(1, 2))
+    for view in range(2):
+        pl.subplot(0, view)
+        pl.add_mesh(part.copy(), scalars="p", cmap="turbo", show_scalar_bar=view == 0,
+                    scalar_bar_args={"title": "cumulated plastic strain p",
+                                     "position_x": 0.2, "position_y": 0.03, "width": 0.6,
+                                     "fmt": "%.2g"})
+        pl.add_lines(np.vstack([ring, ring[:1]]), color="black", width=3, connected=True)
+        if view == 0:
+            pl.view_vector((1.0, -1.4, 1.1))
+            pl.add_text(title, font_size=11, position="upper_left")
+        else:
+            pl.view_xy()
+            pl.add_text("from above; black: the cavity's outline (beyond it, the flash)",
+                        font_size=10, position="upper_left")
+    pl.screenshot(path)
+    pl.close()
+
+
+def forging_load_curve(history: list[dict], slab: float, path: str, title: str) -> None:
+    """The die's load against its stroke, the flat start's closed form and the slab estimate.
+
+    Args:
+        history: each converged step's ``stroke``, ``force``, ``force_flat_die_exact``
+            and ``die_fill``.
+        slab: the flash's slab estimate of the last load.
+        path: the PNG (call on one rank).
+        title: the figure's title.
+    """
+    plt = figures.pyplot()
+    d = np.array([0.0] + [h["stroke"] for h in history])
+    fig, (ax, fill) = plt.subplots(1, 2, figsize=(12, 4.8))
+    ax.plot(d, [0.0] + [h["force"] for h in history], "o-", ms=3, label="computed")
+    ax.plot(d, [0.0] + [h["force_flat_die_exact"] for h in history], "k--",
+            label="flat die, frictionless: σ_y(p) π R0² h0/h")
+    ax.plot([d[-1]], [slab], "g*", ms=12, label="the flash's slab estimate")
+    ax.set_xlabel("die stroke d (length)")
+    ax.set_ylabel("load F (force units)")
+    ax.set_title(title, fontsize=10)
+    fill.plot(d[1:], [h["die_fill"] for h in history], "o-", ms=3)
+    fill.set_xlabel("die stroke d (length)")
+    fill.set_ylabel("die fill: the ceiling's area in contact")
+    fill.set_ylim(0, 1.05)
+    for a in (ax, fill):
+        a.grid(alpha=0.3)
+    ax.legend()
     figures.save_figure(fig, path)

@@ -1,6 +1,7 @@
-"""Closed forms of the upsetting of a cylinder between flat dies.
+"""Closed forms of the upsetting of a cylinder between flat dies, and a closed die's load.
 
-The homogeneous compression without friction, and the slab method's estimate with it.
+The homogeneous compression without friction, and the slab method's estimate with it;
+the slab estimate of a closed-die forging's load, from its flash.
 
 Without friction the compression stays homogeneous: the logarithmic strain ln(h0/h) is the
 plastic strain p plus the elastic σ_y(p)/E (Hencky's law in uniaxial stress), and the force
@@ -18,7 +19,7 @@ from collections.abc import Callable
 
 from scipy.optimize import brentq
 
-__all__ = ["frictionless_force", "homogeneous_plastic_strain", "slab_force"]
+__all__ = ["flash_slab_force", "frictionless_force", "homogeneous_plastic_strain", "slab_force"]
 
 
 def homogeneous_plastic_strain(reduction: float, yield_stress: Callable[[float], float],
@@ -46,3 +47,28 @@ def slab_force(reduction: float, radius: float, height: float, friction: float,
     R = radius / math.sqrt(1.0 - reduction)
     return frictionless_force(reduction, radius, yield_stress, E) * (
         1.0 + 2.0 * friction * R / (3.0 * h))
+
+
+def flash_slab_force(yield_stress: float, friction: float, cavity_area: float,
+                     flash_area: float, perimeter: float, gap: float) -> float:
+    """The slab estimate of a closed die's load from its flash (Schey; Altan et al.).
+
+    The flash is a strip of width w = A_f / perimeter and thickness t between the lands,
+    in plane strain (flow stress σ_f = 2σ_y/√3) with Coulomb friction f: its pressure
+    rises from σ_f at the exit to σ_f (1 + 2 f w/t) at the cavity (linearized), which the
+    cavity takes whole: F = σ_f [(1 + 2 f w/t) A_c + (1 + f w/t) A_f].
+
+    Args:
+        yield_stress: σ_y of the metal in the flash.
+        friction: f.
+        cavity_area: A_c, the cavity's area in plan.
+        flash_area: A_f, the flash's (the metal on the lands) in plan.
+        perimeter: the cavity outline's length.
+        gap: t, the lands' distance apart.
+
+    Returns:
+        The estimated load.
+    """
+    flow = 2.0 * yield_stress / math.sqrt(3.0)
+    rise = friction * flash_area / perimeter / gap
+    return flow * ((1.0 + 2.0 * rise) * cavity_area + (1.0 + rise) * flash_area)
