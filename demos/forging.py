@@ -241,11 +241,13 @@ press_force = p_contact * n[2] - t_friction[2]  # the die's vertical load per un
 # ### The solver and the load steps
 #
 # Newton's method with the full tangent (UFL's derivative of the residual: the penalty's,
-# the friction's, not symmetric, and the material's), MUMPS LU, a line search on $\|R\|$.
-# The die goes down in `--steps` steps; each starts from the extrapolation of the last
-# two converged states (the driver's predictor: without it, the first iterate of a step
-# presses the side's top edge far into the die and Newton crawls back), and a step that
-# fails is cut in half. A converged step commits the plastic state and the slip's origin.
+# the friction's, not symmetric, and the material's), MUMPS LU (`--linear-solver gamg`:
+# GMRES + GAMG, for large meshes), a line search on $\|R\|$. The die goes down in
+# `--steps` steps, the first one an eighth of a step, each next 1.5 times the last up to a
+# full one; each starts from the extrapolation of the last two converged states (the
+# driver's predictor: without it, the first iterate of a step presses the side's top edge
+# far into the die and Newton crawls back), and a step that fails is cut in half. A
+# converged step commits the plastic state and the slip's origin.
 
 # +
 newton = NewtonSolver(residual, u, supports, rtol=1e-8, atol=1e-8,

@@ -1,0 +1,97 @@
+"""The 3D closed-die forging (`demos/forging.py`): the mesh's trend, and its size on 2 ranks.
+
+A. The mesh: the demo's defaults (f = 0.2, 42 %) with tetrahedra of 2.0, 1.5 and 1.0 on one
+   rank: the final load, die fill, flash, the Newton iterations, cuts and time, where the
+   time went (assembly, factorization, solve).
+B. The size: tetrahedra of 0.58 (about 100k unknowns) on 2 ranks over the first 8 % of the
+   stroke, with GMRES + GAMG and with MUMPS LU: the time per Newton iteration of each, on
+   the same mesh and steps. (The whole stroke there did not end within 30 minutes: its
+   time is estimated in the docs from these and the 20k mesh's linear solves.)
+
+Writes benchmarks/results/forging_3d.json and, with --update-docs, its section of
+docs/benchmarks.md.
+"""
+
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from common import ROOT, machine, options, publish
+
+PHASES = ("residual", "tangent", "factorization", "solve")
+
+
+def say(msg):
+    print(msg, flush=True)
+
+
+def demo_run(ranks, *args):
+    """The demo's JSON from `mpiexec -n ranks` with `args`."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "f.json"
+        cmd = [str(ROOT / ".venv" / "bin" / "mpiexec"), "-n", str(ranks), sys.executable,
+               str(ROOT / "demos" / "forging.py"), *map(str, args), "--json", str(out)]
+        subprocess.run(cmd, check=True, capture_output=True, text=True)
+        return json.loads(out.read_text())
+
+
+def row(d, **given):
+    keep = ("dofs", "ranks", "force", "die_fill", "flash_width", "flash_fraction",
+            "force_over_slab", "volume_change", "newton_iterations", "step_cuts",
+            "linear_solves", "solve_time_s", "wall_time_s")
+    r = {**given, **{k: d[k] for k in keep}}
+    r["time_by_phase_s"] = {k: d[f"{k}_phase_time_s"] for k in PHASES}
+    r["per_iteration_s"] = d["solve_time_s"] / max(d["linear_solves"], 1)
+    return r
+
+
+def mesh_runs(quick):
+    rows = []
+    for size in ((2.0,) if quick else (2.0, 1.5, 1.0)):
+        r = row(demo_run(1, "--size", size), size=size, linear_solver="lu",
+                stroke="the demo's")
+        say(f"size {size}: {r['dofs']} unknowns, F = {r['force']:.6g}, fill "
+            f"{r['die_fill']:.3f}, {r['newton_iterations']} Newton, {r['step_cuts']} cuts, "
+            f"{r['solve_time_s']:.1f} s")
+        rows.append(r)
+    return rows
+
+
+def size_runs(quick):
+    size = 1.2 if quick else 0.58
+    rows = []
+    for solver, extra in (("gamg", ("--reduction", "0.034", "--steps", "2")),
+                          ("lu", ("--reduction", "0.034", "--steps", "2"))):
+        r = row(demo_run(2, "--size", size, "--linear-solver", solver, *extra), size=size,
+                linear_solver=solver, stroke=" ".join(extra) or "the demo's")
+        say(f"size {size}, {solver}, {r['stroke']}: {r['dofs']} unknowns on 2 ranks, "
+            f"{r['linear_solves']} linear solves, {r['per_iteration_s']:.2f} s each, "
+            f"{r['solve_time_s']:.1f} s")
+        rows.append(r)
+    return rows
+
+
+def table(out):
+    lines = ["| tetrahedra | unknowns | ranks | linear solver | stroke | F | die fill | "
+             "flash width | Newton its (cuts) | linear solves | s per iteration | "
+             "solve time (s) |", "|" + "---|" * 12]
+    for r in out["mesh"] + out["size"]:
+        lines.append(
+            f"| {r['size']:g} | {r['dofs']} | {r['ranks']} | {r['linear_solver']} | "
+            f"{r['stroke']} | {r['force']:.5g} | {r['die_fill']:.3f} | "
+            f"{r['flash_width']:.3g} | {r['newton_iterations']} ({r['step_cuts']}) | "
+            f"{r['linear_solves']} | {r['per_iteration_s']:.2f} | {r['solve_time_s']:.1f} |")
+    return "\n".join(lines)
+
+
+def main():
+    args = options(__doc__, "size 2.0 only, and the 2-rank runs at size 1.2")
+    out = {"machine": machine(2), "mesh": mesh_runs(args.quick),
+           "size": size_runs(args.quick)}
+    publish("forging_3d", out, table, args, say)
+
+
+if __name__ == "__main__":
+    main()
