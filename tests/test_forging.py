@@ -1,7 +1,8 @@
 """The closed-die forging demo: a billet pressed into an oval cavity, in 3D, with a flash.
 
 The flat start against the upsetting's closed form (exact at the penalty's penetration),
-the forging's end (die filled, flash formed, load above the flat die's, volume kept), the
+the forging's end (the ceiling covered, a flash, the load above the flat die's, the volume
+kept to its elastic change), the
 same answer on two ranks, one-line refusals.
 """
 
@@ -24,35 +25,43 @@ def test_the_flat_start_is_the_homogeneous_closed_form_at_the_penetrated_height(
     # off by the penetration's effect (about 1e-3)
     d = demo.json("forging.py", "--friction", "0", "--reduction", "0.15", "--steps", "3")
     law = FiniteJ2Plasticity(E, NU, sigma0=400.0, H=1000.0)
-    kappa = 3.0 * E / 2.0  # --penalty 3 (E/size), --size 2
     assert d["flat_steps"] == len(d["force_history"])  # (the first step ramped up: 7)
     for r, F in zip(d["reduction_history"], d["force_history"], strict=True):
-        penetration = F / (math.pi * 10.0**2) / kappa
+        penetration = F / (math.pi * 10.0**2) / d["penalty_stiffness"]
         at_top = r - 2 * penetration / 20.0
         assert F == pytest.approx(forming.frictionless_force(at_top, 10.0, law.yield_stress, E),
                                   rel=5e-6)
-    assert 1e-5 < d["flat_force_error"] < 2e-3
-    # the elastic volume change of the homogeneous state: J = exp(−σ_y (1 − 2ν)/E)
-    p = forming.homogeneous_plastic_strain(d["reduction"], law.yield_stress, E)
+    assert 1e-5 < d["flat_force_error"] < 2e-3  # at the die's height: measured 7.2e-4
+    # the homogeneous state at the top's height: the elastic volume change
+    # J = exp(−σ_y (1 − 2ν)/E) of the mesh's own volume, and the top face's area in plan
+    # J π R0² h0/h against the flat ceiling's, π a (b − w)²/b
+    p = forming.homogeneous_plastic_strain(at_top, law.yield_stress, E)
     J = math.exp(-law.yield_stress(p) * (1 - 2 * NU) / E)
-    assert d["volume_change"] == pytest.approx(J - 1, rel=2e-3)
-    assert d["die_fill"] < 1 and d["flash_fraction"] == 0
+    assert d["volume_change"] == pytest.approx(J - 1, rel=1e-5)
+    a, b, w = 15.5, 12.5, 1.5
+    assert d["die_fill"] == pytest.approx(J * 10.0**2 / (1 - at_top) / (a * (b - w) ** 2 / b),
+                                          rel=1e-5)
+    assert d["flash_fraction"] == 0
 
 
 def test_the_forging_fills_the_die_and_flashes(demo):
     # the defaults: the metal reaches the walls across, flows along the cavity and out
-    # between the lands; the load rises above the flat die's as the flash holds it back
+    # between the lands; the load rises above the flat die's as the flash holds it back.
+    # The bounds are the run's figures (measured in comments) within what a change of mesh
+    # moves them (benchmarks/forging.py: fill 0.88, 0.87, 0.84 at 3.4k, 7.4k, 19.6k
+    # unknowns, the flash's reach 1.03–1.07, the load within 0.9 %)
     d = demo.json("forging.py")
     assert d["reduction"] == pytest.approx(0.42, rel=1e-12)
-    assert d["die_fill"] > 0.85 and d["flash_width"] > 0.8
-    assert 0.005 < d["flash_fraction"] < 0.1
+    assert d["die_fill"] > 0.8 and d["flash_reach"] > 0.8  # 0.880, 1.05
+    assert 0.005 < d["flash_fraction"] < 0.05  # 0.014
     assert d["force"] > 1.3 * forming.frictionless_force(
-        0.42, 10.0, FiniteJ2Plasticity(E, NU, sigma0=400.0, H=1000.0).yield_stress, E)
+        0.42, 10.0, FiniteJ2Plasticity(E, NU, sigma0=400.0, H=1000.0).yield_stress, E)  # 1.48
     # the flash's slab estimate, with the flash's own yield stress: measured 1.10
     assert 0.8 < d["force_over_slab"] < 1.4
     assert all(b > a for a, b in zip(d["force_history"][:-1], d["force_history"][1:],
                                      strict=True))
-    assert abs(d["volume_change"]) < 1e-2  # elastic only (σ_m/K of a few GPa)
+    # elastic only: −σ_m/K, K = 167 GPa and a mean pressure of about 0.8 GPa: −4.8e-3
+    assert -1e-2 < d["volume_change"] < 0
     assert d["max_plastic_strain"] > 1.0
 
 

@@ -72,3 +72,23 @@ def test_the_penalty_and_friction_tangent_is_the_residuals_derivative():
 
     assert slopes(K) == pytest.approx(2.0, abs=0.05)
     assert slopes(K_frictionless)[-1] == pytest.approx(1.0, abs=0.1)
+
+
+def test_friction_opposes_the_slip_on_the_die_and_the_dies_own_motion_is_no_slip():
+    # a flat die over a unit cube's top: the body slips by s along +x (s ≫ ε), the die
+    # moves down by ΔZ: the traction on the body is −f p e_x (Coulomb's, against the slip),
+    # and the die's vertical motion, normal to it, adds no friction
+    m = mesh.create_unit_cube(MPI.COMM_SELF, 2, 2, 2)
+    top = mesh.locate_entities_boundary(m, 2, lambda X: np.isclose(X[2], 1.0))
+    tags = mesh.meshtags(m, 2, np.sort(top), np.ones(len(top), dtype=np.int32))
+    ds = ufl.Measure("ds", m, subdomain_data=tags)(1)
+    V = fem.functionspace(m, ("Lagrange", 1, (3,)))
+    u = fem.Function(V)
+    u.interpolate(lambda X: np.vstack([np.full(X.shape[1], 0.1), 0 * X[0], 0 * X[0] - 0.01]))
+    g, n = penalty.die_gap(ufl.SpatialCoordinate(m) + u, lambda lat: 0 * lat[0], 0.97)
+    p = penalty.pressure(g, 100.0)  # 0.02 deep: p = 2
+    for dZ in (0.0, -0.03):
+        slip = u - ufl.as_vector([0.0, 0.0, dZ])  # from u0 = 0, the die moved by dZ
+        t = penalty.friction_traction(p, n, slip, 0.3, 1e-6)
+        force = [fem.assemble_scalar(fem.form(t[i] * ds)) for i in range(3)]
+        assert force == pytest.approx([-0.3 * 2.0, 0.0, 0.0], abs=1e-9)

@@ -12,7 +12,8 @@ of a sloped one. The contact is the penalty energy Π_c = ∫ κ/2 ⟨−g⟩² 
 surface (Forge3's choice for forging), so that the contact pressure p = κ⟨−g⟩, its
 direction and its tangent are UFL's derivatives like the material's: no active set, the
 contact zone is where g < 0 at the quadrature points. The penetration is p/κ; κ a stiffness
-per unit area (e.g. 10 E/h: p/κ ≈ 1e-3 h at p ≈ 2σ_y for steel).
+per unit area (e.g. 3 E/h: p/κ ≈ 1.3e-3 h at p = 800 MPa for steel). Its variation is
+p n·δu to first order in g (δg also has g δ(1/√(1 + |∇h|²)) on a curved wall).
 
 Friction: the slip of a point on the die since the step's start is the tangential part of
 Δs = Δu − ΔZ e_z (the die moves along z only); Coulomb's law regularized over a slip ε,

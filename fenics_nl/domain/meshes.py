@@ -237,9 +237,10 @@ def quarter_cylinder(comm: MPI.Comm, radius: float, height: float, size: float,
     """The quarter cylinder x, y ≥ 0, x² + y² < R², 0 < z < `height`: tetrahedra of `size`.
 
     For a billet with three planes of symmetry (an eighth of it: `height` is half the
-    billet's). Curved faces of `order` (2: the round side is a curved P2 surface, whose area
-    is πR² h to the quadrature's accuracy). Physical groups: ``top`` (z = height), ``mid``
-    (z = 0), ``side`` (the round face), ``x0`` (the plane x = 0), ``y0`` (y = 0), ``body``.
+    billet's). Curved faces of `order` (2: the round side is a curved P2 surface whose
+    nodes are on the cylinder: the quarter disc's area is πR²/4 to 2e-6 at R/5). Physical
+    groups: ``top`` (z = height), ``mid`` (z = 0), ``side`` (the round face), ``x0`` (the
+    plane x = 0), ``y0`` (y = 0), ``body``.
     Meshed in units of R (gmsh's tolerances are absolute), scaled back.
     """
     if comm.rank == 0:

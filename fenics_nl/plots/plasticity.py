@@ -394,8 +394,8 @@ def forging_load_curve(history: list[dict], slab: float, path: str, title: str) 
     """The die's load against its stroke, the flat start's closed form and the slab estimate.
 
     Args:
-        history: each converged step's ``stroke``, ``force``, ``force_flat_die_exact``
-            and ``die_fill``.
+        history: each converged step's ``stroke``, ``force``, ``force_flat_die_exact``,
+            ``under_ceiling_alone`` (the closed form holds, frictionless) and ``die_fill``.
         slab: the flash's slab estimate of the last load.
         path: the PNG (call on one rank).
         title: the figure's title.
@@ -404,8 +404,9 @@ def forging_load_curve(history: list[dict], slab: float, path: str, title: str) 
     d = np.array([0.0] + [h["stroke"] for h in history])
     fig, (ax, fill) = plt.subplots(1, 2, figsize=(12, 4.8))
     ax.plot(d, [0.0] + [h["force"] for h in history], "o-", ms=3, label="computed")
-    ax.plot(d, [0.0] + [h["force_flat_die_exact"] for h in history], "k--",
-            label="flat die, frictionless: σ_y(p) π R0² h0/h")
+    flat = [0] + [i + 1 for i, h in enumerate(history) if h["under_ceiling_alone"]]
+    ax.plot(d[flat], [0.0] + [history[i - 1]["force_flat_die_exact"] for i in flat[1:]],
+            "k--", label="under the flat ceiling alone, frictionless: σ_y(p) π R0² h0/h")
     ax.plot([d[-1]], [slab], "g*", ms=12, label="the flash's slab estimate")
     ax.set_xlabel("die stroke d (length)")
     ax.set_ylabel("load F (force units)")
