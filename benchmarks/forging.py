@@ -38,7 +38,7 @@ def demo_run(ranks, *args):
 
 
 def row(d, **given):
-    keep = ("dofs", "ranks", "force", "die_fill", "flash_width", "flash_fraction",
+    keep = ("dofs", "ranks", "force", "die_fill", "flash_reach", "flash_fraction",
             "force_over_slab", "volume_change", "newton_iterations", "step_cuts",
             "linear_solves", "solve_time_s", "wall_time_s")
     r = {**given, **{k: d[k] for k in keep}}
@@ -75,13 +75,13 @@ def size_runs(quick):
 
 def table(out):
     lines = ["| tetrahedra | unknowns | ranks | linear solver | stroke | F | die fill | "
-             "flash width | Newton its (cuts) | linear solves | s per iteration | "
+             "flash reach | Newton its (cuts) | linear solves | s per iteration | "
              "solve time (s) |", "|" + "---|" * 12]
     for r in out["mesh"] + out["size"]:
         lines.append(
             f"| {r['size']:g} | {r['dofs']} | {r['ranks']} | {r['linear_solver']} | "
             f"{r['stroke']} | {r['force']:.5g} | {r['die_fill']:.3f} | "
-            f"{r['flash_width']:.3g} | {r['newton_iterations']} ({r['step_cuts']}) | "
+            f"{r['flash_reach']:.3g} | {r['newton_iterations']} ({r['step_cuts']}) | "
             f"{r['linear_solves']} | {r['per_iteration_s']:.2f} | {r['solve_time_s']:.1f} |")
     return "\n".join(lines)
 
