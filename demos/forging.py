@@ -114,7 +114,7 @@ class ForgingParameters(Parameters):
                               at_least=0)
     steps: int = number(20, "steps of the stroke, the first one ramped up from an eighth "
                         "of a step (a step that fails is cut)", at_least=1)
-    size: float = number(2.0, "tetrahedra's size (P2 displacements)", unit="length",
+    size: float = number(2.5, "tetrahedra's size (P2 displacements)", unit="length",
                          above=0)
     penalty: float = number(3.0, "the penalty's stiffness kappa, in E/size", above=0)
     slip: float = number(0.01, "friction's regularization: the slip eps below which it "
