@@ -18,7 +18,9 @@ then updates the statuses by the course's rules, extended to friction:
 * a slipping node whose slip increment goes along its friction force (Δg·s > 0, the
   friction would drive it) sticks;
 * a node that touches down within the step joins slipping (it cannot stick where it was at
-  the step's start), without friction until its first slip gives s = −Δg/|Δg|;
+  the step's start), its friction against the way it moved in the step before it touched
+  (s = −Δg/|Δg|: the slip it goes on with; the rules above correct a wrong guess), or
+  without friction until its first slip gives s if it had not moved;
 
 In 3D the direction s of a slipping node is a unit vector, which the loop finds by Newton's
 method rather than by substitution (s ← −Δg/|Δg| chatters): the node carries f |T_n| s
@@ -60,7 +62,8 @@ class FrictionalContact(ActiveSetContact):
     # normal forces of the last solve); its third visit is a cycle
     STATUSES, REVISITS = "statuses", 2
 
-    def __init__(self, *args, friction: float, consistent: bool | None = None, **kwargs):
+    def __init__(self, *args, friction: float, consistent: bool | None = None,
+                 sense_at_touchdown: bool = True, **kwargs):
         if not (math.isfinite(friction) and friction >= 0):
             raise ValueError(f"the friction coefficient must be a finite number >= 0, got "
                              f"{friction}")
@@ -76,6 +79,9 @@ class FrictionalContact(ActiveSetContact):
             consistent = not self.newton.linear
         self.consistent = bool(consistent) and self.newton.allow_unsymmetric()
         self.fallbacks = 0  # consistent steps taken again with point forces
+        # False: a node touching down has no friction until its first slip (the rule before
+        # the sense from its motion; kept to compare, benchmarks/forming.py)
+        self.sense_at_touchdown = bool(sense_at_touchdown)
         S = self.surface
         self.axes = S.tangential_axes
         n, m = len(S.dofs_n), len(self.axes)
@@ -328,6 +334,16 @@ class FrictionalContact(ActiveSetContact):
 
     # -- the loop ----------------------------------------------------------------------
 
+    @staticmethod
+    def _touchdown_sense(g: np.ndarray, tol_u: float) -> np.ndarray:
+        """The friction force's direction on nodes touching down after moving by `g`.
+
+        Against that motion in this step, the slip they go on with (an estimate the status
+        rule corrects: a node that then slides along it sticks); none if they did not move.
+        """
+        moved = np.linalg.norm(g, axis=1)[:, None]
+        return np.where(moved > tol_u, -g / np.where(moved > tol_u, moved, 1.0), 0.0)
+
     def _update_statuses(self) -> StatusUpdate:
         """Coulomb's rule on one solve: open/close as frictionless, stick/slip by |T_t| ≤ f|T_n|.
 
@@ -356,7 +372,8 @@ class FrictionalContact(ActiveSetContact):
         direction = self.direction.copy()
         sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
         direction[to_slip] = T_t[to_slip] / size[to_slip, None]
-        direction[join] = 0.0
+        direction[join] = (self._touchdown_sense(g[join], tol_u) if self.sense_at_touchdown
+                           else 0.0)
         slid = np.linalg.norm(g, axis=1)
         first = slip & self.slip & ~sensed & (slid > tol_u)
         direction[first] = -g[first] / slid[first, None]

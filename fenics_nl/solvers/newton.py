@@ -177,6 +177,9 @@ class NewtonSolver:
         rtol: convergence when ‖R‖ ≤ rtol ‖R₀‖ ...
         atol: ... or ‖R‖ ≤ atol F (relative too).
         max_it: iterations before ConvergenceError.
+        divergence_tol: ConvergenceError as soon as ‖R‖ > divergence_tol ‖R₀‖ (PETSc's
+            ``snes_divergence_tolerance``; where a failed solve is cut by the load driver, a
+            low one stops a lost Newton early).
         linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton;
             within a solve, the AMG hierarchy of its first tangent serves the later ones
             while CG needs at most twice the iterations per digit it took on it: an adaptive
@@ -219,6 +222,7 @@ class NewtonSolver:
         rtol: float = 1e-10,
         atol: float = 1e-10,
         max_it: int = 50,
+        divergence_tol: float = 1e8,
         # the linear solver
         linear_solver: LinearSolver = "lu",
         reuse_factorization: bool = False,
@@ -240,7 +244,8 @@ class NewtonSolver:
         self._force_scale = force_scale
         self._largest_r0 = 0.0  # the default force scale
         opts = PETSc.Options()
-        self.convergence = ConvergenceTest(rtol, atol, max_it).with_options(prefix)
+        self.convergence = ConvergenceTest(rtol, atol, max_it,
+                                           divergence_tol).with_options(prefix)
         if line_search not in (False, True, "residual", "slope"):
             raise ValueError("line_search must be False, True, 'residual' or 'slope', got "
                              f"{line_search!r}")
