@@ -337,7 +337,7 @@ def table(out):
                      f"{r['force']:.7g} | {abs(r['force'] / f['force'] - 1):.1e} |")
     lines += ["", "| upsetting f = 0.2 (the demo) | unknowns | ranks | wall time (s) | solve (s) "
               "| Newton its | status its | linear solves a load step (of 20, cuts included) "
-              "| step cuts | steps with point forces | solve time a linear solve (s) | force |",
+              "| step cuts | steps with point forces | solve time / linear solves (s) | force |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in out["size"]:
         lines.append(f"| {r['cells']} cells | {r['dofs']} | {r['ranks']} | "

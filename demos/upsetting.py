@@ -195,7 +195,7 @@ else:
 # whose $\|R\|$ passes 100 times its first is abandoned at once, for the fallback and then
 # the cut: where the side folds onto the die, a predicted state can send Newton away for
 # good (at 9k and 50k unknowns, none of the 16 solves that grew past 100× came back;
-# PETSc's default, 1e8, let them run on for up to 30 iterations first).
+# the solver's default, 1e8, let them run on for up to 30 iterations first).
 
 # +
 def die_gap(reduction):

@@ -19,8 +19,9 @@ then updates the statuses by the course's rules, extended to friction:
   friction would drive it) sticks;
 * a node that touches down within the step joins slipping (it cannot stick where it was at
   the step's start), its friction against the way it moved in the step before it touched
-  (s = −Δg/|Δg|: the slip it goes on with; the rules above correct a wrong guess), or
-  without friction until its first slip gives s if it had not moved;
+  (s = −Δg/|Δg|, a guess: the next solve, in contact, gives s again, which must agree
+  before the loop ends), or without friction until its first slip gives s if it had not
+  moved;
 
 In 3D the direction s of a slipping node is a unit vector, which the loop finds by Newton's
 method rather than by substitution (s ← −Δg/|Δg| chatters): the node carries f |T_n| s
@@ -90,6 +91,7 @@ class FrictionalContact(ActiveSetContact):
         self.slip_force = np.zeros((n, m))
         # 3D: the stiffness k of a slipping node against slip across its force's direction
         self.spring = np.zeros(n)
+        self._touched = np.zeros(n, dtype=bool)  # joined with a touchdown sense, last update
         self.motion = np.zeros(m)  # the obstacle's tangential displacement d
         # a component the body's own supports hold (a symmetry plane, the axis) is no
         # friction's: its reaction is the support's
@@ -114,6 +116,7 @@ class FrictionalContact(ActiveSetContact):
         """The statuses, directions, slip forces and springs of `_state()` back (copies)."""
         self.active, self.slip, self.direction, self.slip_force, self.spring = (
             a.copy() for a in state)
+        self._touched = np.zeros_like(self.active)
 
     def commit(self) -> None:
         """The current state becomes the start of the next step's increments."""
@@ -335,14 +338,14 @@ class FrictionalContact(ActiveSetContact):
     # -- the loop ----------------------------------------------------------------------
 
     @staticmethod
-    def _touchdown_sense(g: np.ndarray, tol_u: float) -> np.ndarray:
+    def _touchdown_sense(g: np.ndarray, tol: float) -> np.ndarray:
         """The friction force's direction on nodes touching down after moving by `g`.
 
-        Against that motion in this step, the slip they go on with (an estimate the status
-        rule corrects: a node that then slides along it sticks); none if they did not move.
+        Against that motion in this step (a guess of the slip they go on with, which the next
+        update takes again from a solve in contact); none if they moved `tol` or less.
         """
         moved = np.linalg.norm(g, axis=1)[:, None]
-        return np.where(moved > tol_u, -g / np.where(moved > tol_u, moved, 1.0), 0.0)
+        return np.where(moved > tol, -g / np.where(moved > tol, moved, 1.0), 0.0)
 
     def _update_statuses(self) -> StatusUpdate:
         """Coulomb's rule on one solve: open/close as frictionless, stick/slip by |T_t| ≤ f|T_n|.
@@ -362,24 +365,32 @@ class FrictionalContact(ActiveSetContact):
         leave = self.active & (T_n > tol_T)
         join = ~self.active & (self.normal_gap() > tol_u)
         to_slip = self.stick & ~leave & (size > bound + tol_T)
-        # (a node that slips with no friction force, f = 0 or T_n = 0, has no reason to)
-        back = (self.slip & ~leave & np.any(self.slip_force, axis=1)
+        # the friction forces the solve had: consistent, they followed its own T_n
+        # (`_set_conditions`); else they were the last solve's
+        solved = np.where(self.slip[:, None], bound[:, None] * self.direction, 0.0) \
+            if self.consistent else self.slip_force
+        # (a node that slipped with no friction force, f = 0 or T_n = 0, has no reason to)
+        back = (self.slip & ~leave & (np.linalg.norm(solved, axis=1) > tol_T)
                 & (np.sum(g * self.direction, axis=1) > tol_u))
         active = S.sync((self.active & ~leave) | join)
         # a node touching down within the step cannot stick where it was at the step's
-        # start: it joins slipping, with no friction until its first slip gives a sense
+        # start: it joins slipping, against the way it moved (`_touchdown_sense`)
         slip = S.sync(((self.slip & ~back) | to_slip | join) & active)
         direction = self.direction.copy()
         sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
         direction[to_slip] = T_t[to_slip] / size[to_slip, None]
-        direction[join] = (self._touchdown_sense(g[join], tol_u) if self.sense_at_touchdown
-                           else 0.0)
         slid = np.linalg.norm(g, axis=1)
-        first = slip & self.slip & ~sensed & (slid > tol_u)
+        direction[join] = 0.0
+        if self.sense_at_touchdown:  # (a motion at round-off gives no sense)
+            floor = max(tol_u, 1e-6 * global_max(self.comm, slid))
+            direction[join] = self._touchdown_sense(g[join], floor)
+        # a first sense, from a solve in contact; a touched-down node's is taken again
+        # (its guess was from before the contact: what changes it drives another solve)
+        first = slip & self.slip & (~sensed | self._touched) & (slid > tol_u)
         direction[first] = -g[first] / slid[first, None]
         spring = np.zeros_like(self.spring)
         if len(self.axes) > 1:  # 3D: the force turns with the spring's share
-            kept = slip & self.slip & sensed & (size > tol_T)
+            kept = slip & self.slip & sensed & ~self._touched & (size > tol_T)
             direction[kept] = T_t[kept] / size[kept, None]
             along = -np.sum(g * direction, axis=1)
             # a node that barely slides (below 1e-6 of the largest slip) gets no spring:
@@ -388,16 +399,14 @@ class FrictionalContact(ActiveSetContact):
             moving = kept & (along > max(tol_u, floor))
             spring[moving] = bound[moving] / along[moving]
         slip_force = np.where(slip[:, None], bound[:, None] * direction, 0.0)
-        # consistent: the solve's friction forces followed its own T_n (`_set_conditions`),
-        # what moves them is a new direction (a first sense, or one turning in 3D); else
-        # they were the last solve's, and follow T_n from solve to solve
-        solved = np.where(self.slip[:, None], bound[:, None] * self.direction, 0.0) \
-            if self.consistent else self.slip_force
+        # consistent: what moves the friction forces is a new direction (a first sense, or
+        # one turning in 3D); else they follow T_n from solve to solve
         drift = global_max(self.comm, np.abs(slip_force - solved))
         changes = S.count(active != self.active) + S.count(slip != self.slip)
         n_slip, n_stick = S.count(slip), S.count(active & ~slip)
         self.active, self.slip, self.direction = active, slip, direction
         self.slip_force, self.spring = slip_force, spring
+        self._touched = join & slip & np.any(direction, axis=1)
         # a state: the closed set, the slipping set and its slip senses
         state = (S.fingerprint(active), S.fingerprint(slip),
                  S.fingerprint(slip & (direction[:, 0] > 0)))

@@ -177,9 +177,10 @@ class NewtonSolver:
         rtol: convergence when ‖R‖ ≤ rtol ‖R₀‖ ...
         atol: ... or ‖R‖ ≤ atol F (relative too).
         max_it: iterations before ConvergenceError.
-        divergence_tol: ConvergenceError as soon as ‖R‖ > divergence_tol ‖R₀‖ (PETSc's
-            ``snes_divergence_tolerance``; where a failed solve is cut by the load driver, a
-            low one stops a lost Newton early).
+        divergence_tol: ConvergenceError as soon as ‖R‖ > divergence_tol ‖R₀‖, R₀ this
+            solve's own first residual (PETSc's ``snes_divergence_tolerance``, whose default
+            is 1e4; where a failed solve is cut by the load driver, a low one stops a lost
+            Newton early).
         linear_solver: ``lu``, ``cholesky`` (MUMPS) or ``gamg`` (CG + GAMG, inexact Newton;
             within a solve, the AMG hierarchy of its first tangent serves the later ones
             while CG needs at most twice the iterations per digit it took on it: an adaptive
