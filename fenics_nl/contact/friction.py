@@ -338,11 +338,10 @@ class FrictionalContact(ActiveSetContact):
     # -- the loop ----------------------------------------------------------------------
 
     @staticmethod
-    def _touchdown_sense(g: np.ndarray, tol: float) -> np.ndarray:
-        """The friction force's direction on nodes touching down after moving by `g`.
+    def _against(g: np.ndarray, tol: float) -> np.ndarray:
+        """−g/|g| for each row of `g`: a friction force's direction against that motion.
 
-        Against that motion in this step (a guess of the slip they go on with, which the next
-        update takes again from a solve in contact); none if they moved `tol` or less.
+        None (0) where |g| ≤ `tol`.
         """
         moved = np.linalg.norm(g, axis=1)[:, None]
         return np.where(moved > tol, -g / np.where(moved > tol, moved, 1.0), 0.0)
@@ -374,7 +373,8 @@ class FrictionalContact(ActiveSetContact):
                 & (np.sum(g * self.direction, axis=1) > tol_u))
         active = S.sync((self.active & ~leave) | join)
         # a node touching down within the step cannot stick where it was at the step's
-        # start: it joins slipping, against the way it moved (`_touchdown_sense`)
+        # start: it joins slipping, against the way it moved in the step (a guess of the
+        # slip it goes on with, which the next update takes again from a solve in contact)
         slip = S.sync(((self.slip & ~back) | to_slip | join) & active)
         direction = self.direction.copy()
         sensed = np.any(direction, axis=1)  # slipping nodes that have a sense already
@@ -382,12 +382,12 @@ class FrictionalContact(ActiveSetContact):
         slid = np.linalg.norm(g, axis=1)
         direction[join] = 0.0
         if self.sense_at_touchdown:  # (a motion at round-off gives no sense)
-            floor = max(tol_u, 1e-6 * global_max(self.comm, slid))
-            direction[join] = self._touchdown_sense(g[join], floor)
+            direction[join] = self._against(
+                g[join], max(tol_u, 1e-6 * global_max(self.comm, slid)))
         # a first sense, from a solve in contact; a touched-down node's is taken again
         # (its guess was from before the contact: what changes it drives another solve)
         first = slip & self.slip & (~sensed | self._touched) & (slid > tol_u)
-        direction[first] = -g[first] / slid[first, None]
+        direction[first] = self._against(g[first], tol_u)
         spring = np.zeros_like(self.spring)
         if len(self.axes) > 1:  # 3D: the force turns with the spring's share
             kept = slip & self.slip & sensed & ~self._touched & (size > tol_T)
