@@ -172,3 +172,46 @@ def test_gamg_on_an_indefinite_tangent_is_right_preconditioned_gmres_and_solves_
     A.mult(x, r)
     r.axpy(-1.0, b)
     assert r.norm() < 1e-9 * b.norm()  # the true residual: right preconditioning's norm
+
+
+def test_gmres_and_gamg_smooth_by_sor_unless_the_options_say_otherwise():
+    # Chebyshev (PETSc's smoother) is built on bounds of a real positive spectrum, which an
+    # indefinite or non-symmetric tangent lacks: GMRES's GAMG levels are smoothed by SOR,
+    # and converge in fewer iterations on the shifted (indefinite) elasticity matrix (19
+    # against 27); CG's keep Chebyshev; an option given keeps its choice
+    from dolfinx import fem
+    from dolfinx.fem import petsc
+
+    from fenics_nl.solvers.linear_solver import rigid_body_modes
+
+    a, bc, _ = _elasticity_with_a_support(MPI.COMM_SELF)
+    K = petsc.assemble_matrix(fem.form(a), bcs=[bc])
+    K.assemble()
+    dense = K.copy().convert("dense")
+    A = K.copy()
+    A.shift(-np.linalg.eigvalsh(dense.getDenseArray())[:2].mean())  # one negative eigenvalue
+    dense.destroy()
+    modes = rigid_body_modes(a.arguments()[0].ufl_function_space())
+    b, x = A.createVecs()
+    b.setRandom()
+
+    def solved(prefix, indefinite, options=()):
+        matrix = A if indefinite else K
+        for name, value in options:
+            PETSc.Options()[f"{prefix}{name}"] = value
+        ksp = create_ksp(matrix, "gamg", prefix=prefix, near_nullspace=modes, rtol=1e-8,
+                         indefinite=indefinite)
+        x.set(0.0)
+        ksp.solve(b, x)
+        for name in ("mg_levels_ksp_type", "mg_levels_pc_type"):
+            PETSc.Options().delValue(f"{prefix}{name}")
+        assert ksp.getConvergedReason() > 0
+        smoother = ksp.getPC().getMGSmoother(1)
+        return ksp.getIterationNumber(), smoother.getType(), smoother.getPC().getType()
+
+    sor_its, *sor = solved("sor_", True)
+    cheb_its, *cheb = solved("cheb_", True, (("mg_levels_ksp_type", "chebyshev"),
+                                            ("mg_levels_pc_type", "jacobi")))
+    assert sor == ["richardson", "sor"] and cheb == ["chebyshev", "jacobi"]
+    assert sor_its < cheb_its
+    assert solved("spd_", False)[1:] == ("chebyshev", "jacobi")

@@ -80,6 +80,27 @@ def test_iterative_linear_solver_gives_the_same_solution(snes_reference):
     assert inexact.work.krylov_iterations < 0.85 * tight.total.krylov_iterations
 
 
+def test_the_last_corrections_are_solved_no_tighter_than_convergence_needs(monkeypatch):
+    # at a Newton tolerance of 1e-6, 1e-3 ‖R_k‖/‖R_0‖ asks the last corrections for digits
+    # the convergence test never reads: η ≥ 0.1 (its threshold)/‖R_k‖ saves their Krylov
+    # iterations, with the same Newton iterations and a residual below the threshold
+    from fenics_nl.solvers import newton
+
+    runs = {}
+    plain = newton.forcing_term
+    for floor in (True, False):
+        if not floor:  # the forcing term without its floor
+            monkeypatch.setattr(newton, "forcing_term", lambda rel, enough=0.0: plain(rel))
+        p, r = solve(NewtonSolver, method="full", linear_solver="gamg", rtol=1e-6, atol=0)
+        runs[floor] = r, tip(p)
+    (floored, tip_floored), (plain_run, tip_plain) = runs[True], runs[False]
+    assert floored.converged and floored.residual_norms[-1] <= 1e-6 * floored.residual_norms[0]
+    assert floored.iterations == plain_run.iterations
+    # measured 98 against 122 Krylov iterations, 5 Newton iterations each
+    assert floored.work.krylov_iterations < 0.9 * plain_run.work.krylov_iterations
+    assert abs(tip_floored - tip_plain) < 1e-5 * abs(tip_plain)
+
+
 def test_an_amg_hierarchy_is_built_once_per_solve_and_lags_behind_the_tangent(
         snes_reference):
     # full Newton on CG + GAMG keeps the first tangent's hierarchy (PETSc counts its

@@ -101,6 +101,7 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         A.setNearNullSpace(near_nullspace)
         if indefinite:
             _true_residual_gmres(ksp, restart=200)
+            _sor_smoothing(prefix)
         else:  # the true residual ‖A x − b‖ is what an inexact Newton step controls
             ksp.setType("cg")
             ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
@@ -138,7 +139,24 @@ def allow_unsymmetric(ksp: PETSc.KSP) -> bool:
         return False
     if ksp.getType() == "cg":
         _true_residual_gmres(ksp, restart=200 if pc.getType() == "gamg" else 50)
+        if pc.getType() == "gamg":
+            _sor_smoothing(ksp.getOptionsPrefix() or "")
     return True
+
+
+def _sor_smoothing(prefix: str) -> None:
+    """GAMG's levels smoothed by SOR sweeps (Richardson), unless the options chose others.
+
+    PETSc's default smoother, Chebyshev on Jacobi, is built on bounds of a real positive
+    spectrum, which a non-symmetric (friction) or indefinite tangent does not have. On the
+    3D forging's friction tangent (19632 unknowns, 2 ranks, its first 22 Newton iterations)
+    GMRES took 448 iterations with SOR against 659 with Chebyshev, 3.1 s against 4.3 s.
+    Set in the options database (the levels exist only when GAMG sets up): the prefix's.
+    """
+    opts = PETSc.Options()
+    for name, value in (("mg_levels_ksp_type", "richardson"), ("mg_levels_pc_type", "sor")):
+        if not opts.hasName(f"{prefix}{name}"):
+            opts[f"{prefix}{name}"] = value
 
 
 def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
