@@ -387,7 +387,8 @@ out = {"force": last["force"], "reduction": last["reduction"], "friction": args.
        "flat_force_error": flat_error, "max_plastic_strain": max_plastic_strain,
        "volume_change": volume_change, "newton_iterations": run.iterations,
        "step_cuts": run.failures, "factorizations": run.work.factorizations,
-       "linear_solves": run.work.linear_solves, "dofs": dofs, "ranks": comm.size,
+       "linear_solves": run.work.linear_solves,
+       "krylov_iterations": run.work.krylov_iterations, "dofs": dofs, "ranks": comm.size,
        "solve_time_s": solve_time,
        **{f"{k}_phase_time_s": t for k, t in run.work.time.items()},  # where it went
        "warnings": ["the flash's slab estimate assumes Coulomb sliding on a strip of "

@@ -105,6 +105,14 @@ class Demos:
             assert proc.returncode == 0, proc.stderr
         return proc
 
+    def refuses(self, args, message, ranks=1) -> None:
+        """The run of `args` must refuse its input: a non-zero exit, one line on stderr
+        that says `message`, no traceback (the scene contract's error)."""
+        proc = self.run(args, check=False, ranks=ranks)
+        lines = proc.stderr.strip().splitlines()
+        assert proc.returncode != 0, args
+        assert len(lines) == 1 and message in lines[0], proc.stderr
+
     def case(self, *args, ranks=1) -> dict:
         """`python -m fenics_nl run args...` and its JSON."""
         return self._run_json("-m fenics_nl", ["run", *args], ranks)

@@ -235,9 +235,7 @@ def test_friction_two_ranks_give_the_serial_answer(demo):
      "does not touch"),
 ])
 def test_friction_bad_input_is_one_line(demo, args, words):
-    proc = demo.run(["punch_friction.py", *args], check=False)
-    lines = proc.stderr.strip().splitlines()
-    assert proc.returncode != 0 and len(lines) == 1 and words in lines[0], proc.stderr
+    demo.refuses(["punch_friction.py", *args], words)
 
 
 @pytest.mark.parametrize("model,block,growth,Q_bound,q_bound", [
@@ -336,6 +334,4 @@ def test_bracket_on_a_rough_floor_on_two_ranks(demo):
 
 
 def test_bracket_friction_needs_the_floor(demo):
-    proc = demo.run(["bracket.py", "--friction", "0.3"], check=False)
-    lines = proc.stderr.strip().splitlines()
-    assert proc.returncode != 0 and len(lines) == 1 and "--support contact" in lines[0]
+    demo.refuses(["bracket.py", "--friction", "0.3"], "--support contact")

@@ -94,10 +94,13 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
     if path is not None:
         if not Path(path).is_file():
             raise ValueError(f"mesh file not found: {path}")
-        try:
-            data = gmshio.read_from_msh(path, comm, 0, gdim=3)
-        except Exception as err:  # gmsh/dolfinx raise various types on corrupt files
-            raise ValueError(f"cannot read mesh file {path}: {err}") from None
+        error = None
+        if comm.rank == 0:  # gmsh's terminal off (start_model): its error is ours, one line
+            error = _opened(path)
+        error = comm.bcast(error, root=0)
+        if error is not None:
+            raise ValueError(error)
+        data = distributed(comm, 1.0, 3)  # in the file's own units
         check_cells(data.mesh, name=path)
     else:
         if comm.rank == 0:
@@ -108,3 +111,28 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
         raise ValueError(f"the mesh has no physical group {', '.join(missing)} "
                          f"(needs {', '.join(GROUPS)})")
     return data
+
+
+def _opened(path) -> str | None:
+    """Open the .msh `path` in gmsh (rank 0); what is wrong with it, or None.
+
+    gmsh logs a corrupt file's error, and raises on some only: the log is read.
+    """
+    start_model("bracket file")
+    gmsh.logger.start()
+    try:
+        gmsh.open(str(path))
+        logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
+    except Exception as err:
+        logged = [" ".join(str(err).split())]
+    finally:
+        gmsh.logger.stop()
+    if logged:
+        said = logged[0].split(":", 1)[1].strip() if logged[0].startswith("Error") else logged[0]
+        error = f"cannot read mesh file {path}: {said}"
+    elif not gmsh.model.getPhysicalGroups(3):
+        error = f"{path} has no 3D physical group (dolfinx keeps only their cells)"
+    else:
+        return None
+    gmsh.model.remove()
+    return error
