@@ -534,13 +534,32 @@ def _box_without_groups(path, fold=False):
     gmsh.finalize()
 
 
+def _two_boxes_one_tagged_twice(path):
+    import gmsh
+
+    from fenics_nl.domain.meshes import start_model
+
+    start_model("boxes")
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.addBox(1, 0, 0, 1, 1, 1)
+    gmsh.model.occ.fragment([(3, 1)], [(3, 2)])
+    gmsh.model.occ.synchronize()
+    gmsh.model.addPhysicalGroup(3, [1, 2], 1, name="solid")
+    gmsh.model.addPhysicalGroup(3, [2], 2, name="again")  # dolfinx refuses a cell in two
+    gmsh.model.mesh.generate(3)
+    gmsh.write(str(path))
+    gmsh.finalize()
+
+
 def test_bracket_bad_mesh_input_one_clear_line(tmp_path, demo):
     (tmp_path / "corrupt.msh").write_text("$MeshFormat\nthis is not a mesh\n")
     _box_without_groups(tmp_path / "box.msh")
     _box_without_groups(tmp_path / "folded.msh", fold=True)
+    _two_boxes_one_tagged_twice(tmp_path / "twice.msh")
     for args, message in [(["--mesh", "nowhere.msh"], "mesh file not found"),
                           (["--mesh", "corrupt.msh"], "cannot read mesh file"),
                           (["--mesh", "box.msh"], "no physical group load, base"),
+                          (["--mesh", "twice.msh"], "cells are expected to be tagged once"),
                           (["--mesh", "folded.msh"], "inverted (folded over a neighbour)"),
                           (["--support", "contact", "--newton", "snes"], "clamped only"),
                           (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size"),

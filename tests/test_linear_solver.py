@@ -182,7 +182,7 @@ def test_gmres_and_gamg_smooth_by_sor_unless_the_options_say_otherwise():
     from dolfinx import fem
     from dolfinx.fem import petsc
 
-    from fenics_nl.solvers.linear_solver import rigid_body_modes
+    from fenics_nl.solvers.linear_solver import allow_unsymmetric, rigid_body_modes
 
     a, bc, _ = _elasticity_with_a_support(MPI.COMM_SELF)
     K = petsc.assemble_matrix(fem.form(a), bcs=[bc])
@@ -195,15 +195,17 @@ def test_gmres_and_gamg_smooth_by_sor_unless_the_options_say_otherwise():
     b, x = A.createVecs()
     b.setRandom()
 
-    def solved(prefix, indefinite, options=()):
-        matrix = A if indefinite else K
+    def solved(prefix, indefinite, options=(), unsymmetric_later=False):
+        matrix = A if indefinite or unsymmetric_later else K
         for name, value in options:
             PETSc.Options()[f"{prefix}{name}"] = value
         ksp = create_ksp(matrix, "gamg", prefix=prefix, near_nullspace=modes, rtol=1e-8,
                          indefinite=indefinite)
+        if unsymmetric_later:  # friction's consistent tangent turns CG into GMRES
+            assert allow_unsymmetric(ksp) and ksp.getType() == "gmres"
         x.set(0.0)
         ksp.solve(b, x)
-        for name in ("mg_levels_ksp_type", "mg_levels_pc_type"):
+        for name, _ in options:
             PETSc.Options().delValue(f"{prefix}{name}")
         assert ksp.getConvergedReason() > 0
         smoother = ksp.getPC().getMGSmoother(1)
@@ -215,3 +217,6 @@ def test_gmres_and_gamg_smooth_by_sor_unless_the_options_say_otherwise():
     assert sor == ["richardson", "sor"] and cheb == ["chebyshev", "jacobi"]
     assert sor_its < cheb_its
     assert solved("spd_", False)[1:] == ("chebyshev", "jacobi")
+    # the database outlives a solver: CG after GMRES under one prefix is Chebyshev's again
+    assert solved("sor_", False)[1:] == ("chebyshev", "jacobi")
+    assert solved("later_", False, unsymmetric_later=True)[1:] == ("richardson", "sor")

@@ -90,7 +90,7 @@ def test_the_last_corrections_are_solved_no_tighter_than_convergence_needs(monke
     plain = newton.forcing_term
     for floor in (True, False):
         if not floor:  # the forcing term without its floor
-            monkeypatch.setattr(newton, "forcing_term", lambda rel, enough=0.0: plain(rel))
+            monkeypatch.setattr(newton, "forcing_term", lambda rel, threshold_ratio=0.0: plain(rel))
         p, r = solve(NewtonSolver, method="full", linear_solver="gamg", rtol=1e-6, atol=0)
         runs[floor] = r, tip(p)
     (floored, tip_floored), (plain_run, tip_plain) = runs[True], runs[False]

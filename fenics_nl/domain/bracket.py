@@ -96,11 +96,19 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
             raise ValueError(f"mesh file not found: {path}")
         error = None
         if comm.rank == 0:  # gmsh's terminal off (start_model): its error is ours, one line
-            error = _opened(path)
+            try:
+                error = _opened(path)
+            except Exception as err:  # said on every rank, not left on rank 0 alone
+                error = f"cannot read mesh file {path}: {err}"
         error = comm.bcast(error, root=0)
         if error is not None:
             raise ValueError(error)
-        data = distributed(comm, 1.0, 3)  # in the file's own units
+        try:
+            data = distributed(comm, 1.0, 3)  # in the file's own units
+        except RuntimeError as err:  # dolfinx's refusals (cells tagged twice or not at all)
+            if comm.rank == 0 and gmsh.model.list():  # (raised on every rank alike)
+                gmsh.model.remove()
+            raise ValueError(f"cannot read mesh file {path}: {err}") from None
         check_cells(data.mesh, name=path)
     else:
         if comm.rank == 0:

@@ -105,6 +105,7 @@ def create_ksp(A: PETSc.Mat, kind: str = "lu", prefix: str = "",
         else:  # the true residual ‖A x − b‖ is what an inexact Newton step controls
             ksp.setType("cg")
             ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
+            _forget_sor_smoothing(prefix)
         ksp.setTolerances(rtol=rtol, atol=0.0, max_it=1000)
         pc.setType("gamg")
     ksp.setFromOptions()
@@ -154,9 +155,26 @@ def _sor_smoothing(prefix: str) -> None:
     Set in the options database (the levels exist only when GAMG sets up): the prefix's.
     """
     opts = PETSc.Options()
-    for name, value in (("mg_levels_ksp_type", "richardson"), ("mg_levels_pc_type", "sor")):
+    for name, value in _SOR_SMOOTHING:
         if not opts.hasName(f"{prefix}{name}"):
             opts[f"{prefix}{name}"] = value
+            _SOR_SET.add(f"{prefix}{name}")
+
+
+def _forget_sor_smoothing(prefix: str) -> None:
+    """A CG + GAMG solver: the options `_sor_smoothing` set under `prefix`, removed.
+
+    The database outlives the solver: a later CG solver with the same prefix (a
+    frictionless run after a frictional one) would otherwise take them for the user's.
+    """
+    for name, _ in _SOR_SMOOTHING:
+        if f"{prefix}{name}" in _SOR_SET:
+            PETSc.Options().delValue(f"{prefix}{name}")
+            _SOR_SET.discard(f"{prefix}{name}")
+
+
+_SOR_SMOOTHING = (("mg_levels_ksp_type", "richardson"), ("mg_levels_pc_type", "sor"))
+_SOR_SET: set[str] = set()  # the options `_sor_smoothing` put in the database, not the user
 
 
 def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
