@@ -8,7 +8,6 @@ import pytest
 import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from fenics_nl.contact.friction import FrictionalContact
 
@@ -337,64 +336,3 @@ def test_bracket_on_a_rough_floor_on_two_ranks(demo):
 def test_bracket_friction_needs_the_floor(demo):
     demo.refuses(["bracket.py", "--friction", "0.3"], "--support contact")
 
-
-def test_the_slip_forces_coupled_tangent_is_the_residuals_derivative():
-    # friction's force inside Newton's iteration, T_t = −f s T_n (`solvers.nodal` couplings:
-    # R_t + c R_s and K_t + c K_s, the source rows read before their Dirichlet rows replace
-    # them), on a power-law cube held on three faces, its floor's nodes slipping along x
-    # against their z reactions: Taylor remainders of slope 2; the tangent without the
-    # coupling, slope 1 (the test sees a coupling the tangent would miss). Measured 2.010,
-    # 2.009 and 1.0005, 1.0001 on 6 slipping nodes
-    from fenics_nl.materials.laws import PowerLaw
-    from fenics_nl.solvers.newton import NewtonSolver
-    from fenics_nl.solvers.result import WorkCounts
-
-    m = mesh.create_box(MPI.COMM_SELF, [[0, 0, 0], [1, 1, 1]], [2, 2, 2],
-                        mesh.CellType.tetrahedron)
-    V = fem.functionspace(m, ("Lagrange", 1, (3,)))
-    u, v = fem.Function(V), ufl.TestFunction(V)
-    material = PowerLaw(E=1e3, nu=0.3, sigma0=1.0, n=0.3)
-    residual = material.internal_work(u, v) * ufl.dx
-
-    def held(axis):  # the dofs of component `axis` on the face x_axis = 0
-        facets = mesh.locate_entities_boundary(m, 2, lambda x: np.isclose(x[axis], 0.0))
-        return fem.locate_dofs_topological(V.sub(axis), 2, facets)
-
-    bcs = [fem.dirichletbc(0.0, held(axis), V.sub(axis)) for axis in range(3)]
-    floor_z = held(2)  # the reactions T_n: Dirichlet rows of the floor
-    x_held = set(held(0))
-    sources = np.array([d for d in floor_z if d - 2 not in x_held], dtype=np.int32)
-    targets = sources - 2  # the same nodes' x rows, free
-    c = 0.3 * np.where(np.arange(len(targets)) % 2, 1.0, -1.0)  # f s, both senses
-    solver = NewtonSolver(residual, u, bcs, prefix="coupled_")
-    rng = np.random.default_rng(5)
-    free = np.ones(u.x.array.size, dtype=bool)
-    free[np.concatenate([bc.dof_indices()[0] for bc in bcs])] = False
-    u0 = np.where(free, 0.02 * rng.standard_normal(free.size), 0.0)
-    step = np.where(free, 0.02 * rng.standard_normal(free.size), 0.0)
-
-    def R(at):
-        u.x.array[:] = at
-        solver.residual(WorkCounts())
-        return solver.b.array.copy()
-
-    def K():
-        u.x.array[:] = u0
-        solver.update_tangent(0, WorkCounts())
-        return solver.A.convert("dense", PETSc.Mat()).getDenseArray().copy()
-
-    solver.nodal.set_couplings(targets, sources, c)
-    coupled = K()
-    solver.nodal.set_couplings(np.zeros(0), np.zeros(0), np.zeros(0))
-    uncoupled = K()
-    solver.nodal.set_couplings(targets, sources, c)
-    R0 = R(u0)
-    assert np.abs(R0[targets]).max() > 0 and np.abs(coupled - uncoupled).max() > 0
-
-    def slopes(tangent):
-        out = [np.linalg.norm(R(u0 + h * step) - R0 - h * tangent @ step)
-               for h in (0.2, 0.1, 0.05)]
-        return np.log2(np.array(out[:-1]) / np.array(out[1:]))
-
-    assert slopes(coupled) == pytest.approx(2.0, abs=0.1)
-    assert slopes(uncoupled)[-1] == pytest.approx(1.0, abs=0.1)
