@@ -145,13 +145,18 @@ def allow_unsymmetric(ksp: PETSc.KSP) -> bool:
     return True
 
 
+_SOR_SMOOTHING = (("mg_levels_ksp_type", "richardson"), ("mg_levels_pc_type", "sor"))
+_SOR_SET: set[str] = set()  # the options `_sor_smoothing` put in the database, not the user
+
+
 def _sor_smoothing(prefix: str) -> None:
     """GAMG's levels smoothed by SOR sweeps (Richardson), unless the options chose others.
 
     PETSc's default smoother, Chebyshev on Jacobi, is built on bounds of a real positive
     spectrum, which a non-symmetric (friction) or indefinite tangent does not have. On the
     3D forging's friction tangent (19632 unknowns, 2 ranks, its first 22 Newton iterations)
-    GMRES took 448 iterations with SOR against 659 with Chebyshev, 3.1 s against 4.3 s.
+    GMRES took 448 iterations with SOR against 659 with Chebyshev, 3.7 s against 5.1 s
+    (benchmarks/forging.py, its smoother table).
     Set in the options database (the levels exist only when GAMG sets up): the prefix's.
     """
     opts = PETSc.Options()
@@ -171,10 +176,6 @@ def _forget_sor_smoothing(prefix: str) -> None:
         if f"{prefix}{name}" in _SOR_SET:
             PETSc.Options().delValue(f"{prefix}{name}")
             _SOR_SET.discard(f"{prefix}{name}")
-
-
-_SOR_SMOOTHING = (("mg_levels_ksp_type", "richardson"), ("mg_levels_pc_type", "sor"))
-_SOR_SET: set[str] = set()  # the options `_sor_smoothing` put in the database, not the user
 
 
 def _true_residual_gmres(ksp: PETSc.KSP, restart: int) -> None:
