@@ -559,7 +559,7 @@ def test_bracket_bad_mesh_input_one_clear_line(tmp_path, demo):
     for args, message in [(["--mesh", "nowhere.msh"], "mesh file not found"),
                           (["--mesh", "corrupt.msh"], "cannot read mesh file"),
                           (["--mesh", "box.msh"], "no physical group load, base"),
-                          (["--mesh", "twice.msh"], "cells are expected to be tagged once"),
+                          (["--mesh", "twice.msh"], "is in the physical groups"),
                           (["--mesh", "folded.msh"], "inverted (folded over a neighbour)"),
                           (["--support", "contact", "--newton", "snes"], "clamped only"),
                           (["--nu", "0.6"], "nu must be in"), (["--size", "0"], "--size"),

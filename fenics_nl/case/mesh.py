@@ -12,7 +12,7 @@ from mpi4py import MPI
 
 from fenics_nl.case.spec import Case, CaseError
 from fenics_nl.domain.mesh_check import check_cells
-from fenics_nl.domain.meshes import start_model
+from fenics_nl.domain.meshes import gmsh_error, group_error, start_model
 
 __all__ = ["geometry_dimension", "load_mesh"]
 
@@ -100,43 +100,16 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
     """The mesh, built and checked on rank 0, then distributed.
 
     A .msh is opened; a .geo is meshed with gmsh's default options, then the file's, then
-    `size`. gmsh reports a bad file in its log, not by an exception: the log is read.
+    `size`.
     """
-    error, name = None, case.mesh_file.name
-    action = "mesh" if case.mesh_file.suffix == ".geo" else "read"
+    error = None
     if comm.rank == 0:
+        action = "mesh" if case.mesh_file.suffix == ".geo" else "read"
         try:
             start_model("case")
-            gmsh.logger.start()
-            gmsh.open(str(case.mesh_file))
-            dim = gmsh.model.getDimension()
-            if case.mesh_file.suffix == ".geo" and dim >= 0:
-                if case.mesh_size is not None:
-                    gmsh.option.setNumber("Mesh.MeshSizeMax", case.mesh_size)
-                if case.refine_near is not None:
-                    error = _refine_near(case.refine_near, dim, case.mesh_size)
-                if error is None:
-                    gmsh.model.mesh.generate(dim)
-            logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
-            gmsh.logger.stop()
-            if error is not None:  # said already
-                logged = []
-            elif logged or dim < 0:
-                error = (f"mesh.file: gmsh cannot {action} {name}: "
-                         f"{logged[0] if logged else 'no geometry in it'}")
-            elif dim != case.dim:
-                error = (f"mesh.model: {case.model!r} needs a {case.dim}D mesh, {name} has "
-                         f"{dim}D cells")
-            elif not any(len(gmsh.model.mesh.getElements(dim, t)[1])
-                         for _, t in gmsh.model.getEntities(dim)):
-                error = f"mesh.file: {name} has no {dim}D element"
-            elif not gmsh.model.getPhysicalGroups(dim):
-                error = (f"mesh.file: {name} has no {dim}D physical group (dolfinx keeps only "
-                         f"the cells of physical groups)")
-            elif wrong := _not_one_group(dim):
-                error = f"mesh.file: {name}: {wrong} (each cell takes one group)"
+            error = _built(case, action)
         except Exception as err:  # gmsh raises Exception with its own message
-            error = (f"mesh.file: gmsh cannot {action} {name}: "
+            error = (f"mesh.file: gmsh cannot {action} {case.mesh_file.name}: "
                      f"{' '.join(str(err).split()) or type(err).__name__}")
     error = comm.bcast(error, root=0)
     if error is not None:
@@ -149,19 +122,25 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
     return data
 
 
-def _not_one_group(dim: int) -> str | None:
-    """What is wrong with the first `dim`D entity not in one physical group, or None."""
-    seen: dict[int, str] = {}
-    for _, tag in gmsh.model.getPhysicalGroups(dim):
-        group = gmsh.model.getPhysicalName(dim, tag) or str(tag)
-        for entity in map(int, gmsh.model.getEntitiesForPhysicalGroup(dim, tag)):
-            if entity in seen:
-                return (f"the {dim}D entity {entity} is in the physical groups "
-                        f"{seen[entity]!r} and {group!r}")
-            seen[entity] = group
-    bare = [t for _, t in gmsh.model.getEntities(dim) if t not in seen]
-    if bare:
-        return (f"the {dim}D entit{'ies' if len(bare) > 1 else 'y'} "
-                f"{', '.join(map(str, bare))} {'are' if len(bare) > 1 else 'is'} in no "
-                "physical group")
-    return None
+def _built(case: Case, action: str) -> str | None:
+    """The case's mesh in gmsh's model (rank 0): what is wrong with it, or None."""
+    name = case.mesh_file.name
+    said = gmsh_error(lambda: gmsh.open(str(case.mesh_file)))
+    dim = gmsh.model.getDimension() if said is None else -1
+    if said is None and case.mesh_file.suffix == ".geo" and dim >= 0:
+        if case.mesh_size is not None:
+            gmsh.option.setNumber("Mesh.MeshSizeMax", case.mesh_size)
+        if case.refine_near is not None:
+            missing = _refine_near(case.refine_near, dim, case.mesh_size)
+            if missing is not None:
+                return missing
+        said = gmsh_error(lambda: gmsh.model.mesh.generate(dim))
+    if said is not None or dim < 0:
+        return f"mesh.file: gmsh cannot {action} {name}: {said or 'no geometry in it'}"
+    if dim != case.dim:
+        return f"mesh.model: {case.model!r} needs a {case.dim}D mesh, {name} has {dim}D cells"
+    if not any(len(gmsh.model.mesh.getElements(dim, t)[1])
+               for _, t in gmsh.model.getEntities(dim)):
+        return f"mesh.file: {name} has no {dim}D element"
+    wrong = group_error(dim)
+    return None if wrong is None else f"mesh.file: {name}: {wrong}"

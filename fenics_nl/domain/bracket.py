@@ -23,7 +23,7 @@ from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
 from fenics_nl.domain.mesh_check import check_cells
-from fenics_nl.domain.meshes import distributed, start_model
+from fenics_nl.domain.meshes import distributed, gmsh_error, group_error, start_model
 
 __all__ = ["THICK", "bracket_mesh", "build"]
 
@@ -103,12 +103,7 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
         error = comm.bcast(error, root=0)
         if error is not None:
             raise ValueError(error)
-        try:
-            data = distributed(comm, 1.0, 3)  # in the file's own units
-        except RuntimeError as err:  # dolfinx's refusals (cells tagged twice or not at all)
-            if comm.rank == 0 and gmsh.model.list():  # (raised on every rank alike)
-                gmsh.model.remove()
-            raise ValueError(f"cannot read mesh file {path}: {err}") from None
+        data = distributed(comm, 1.0, 3)  # in the file's own units
         check_cells(data.mesh, name=path)
     else:
         if comm.rank == 0:
@@ -122,24 +117,13 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
 
 
 def _opened(path) -> str | None:
-    """Open the .msh `path` in gmsh (rank 0); what is wrong with it, or None.
-
-    gmsh logs a corrupt file's error, and raises on some only: the log is read.
-    """
+    """Open the .msh `path` in gmsh (rank 0); what is wrong with it, or None."""
     start_model("bracket file")
-    gmsh.logger.start()
-    try:
-        gmsh.open(str(path))
-        logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
-    except Exception as err:
-        logged = [" ".join(str(err).split())]
-    finally:
-        gmsh.logger.stop()
-    if logged:
-        said = logged[0].split(":", 1)[1].strip() if logged[0].startswith("Error") else logged[0]
+    said = gmsh_error(lambda: gmsh.open(str(path)))
+    if said is not None:
         error = f"cannot read mesh file {path}: {said}"
-    elif not gmsh.model.getPhysicalGroups(3):
-        error = f"{path} has no 3D physical group (dolfinx keeps only their cells)"
+    elif (wrong := group_error(3)) is not None:
+        error = f"{path}: {wrong}"
     else:
         return None
     gmsh.model.remove()

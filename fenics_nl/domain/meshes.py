@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import gmsh
 from dolfinx.io import gmsh as gmshio
 from mpi4py import MPI
 
-__all__ = ["PUNCH_GROWTH", "distributed", "graded_block", "punch_block", "punch_block_size",
-           "quarter_annulus", "quarter_cylinder", "size_by_field", "start_model",
-           "threshold_field"]
+__all__ = ["PUNCH_GROWTH", "distributed", "gmsh_error", "graded_block", "group_error",
+           "punch_block", "punch_block_size", "quarter_annulus", "quarter_cylinder",
+           "size_by_field", "start_model", "threshold_field"]
 
 
 def start_model(name: str) -> None:
@@ -22,6 +24,51 @@ def start_model(name: str) -> None:
     gmsh.option.restoreDefaults()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add(name)
+
+
+def gmsh_error(step: Callable[[], object]) -> str | None:
+    """Run the gmsh call `step` with gmsh's log read: the first error it logged or raised.
+
+    gmsh logs a corrupt file's error and raises on some only; with its terminal off
+    (`start_model`) the user reads the error once, in the caller's sentence.
+
+    Returns:
+        The error's text (without gmsh's ``Error :``), or None.
+    """
+    gmsh.logger.start()
+    try:
+        step()
+        logged = [line for line in gmsh.logger.get() if line.startswith("Error")]
+    except Exception as err:  # gmsh raises Exception with its own message
+        return " ".join(str(err).split()) or type(err).__name__
+    finally:
+        gmsh.logger.stop()
+    return logged[0].split(":", 1)[1].strip() if logged else None
+
+
+def group_error(dim: int) -> str | None:
+    """Why dolfinx cannot take the model's `dim`D cells as they are grouped, or None.
+
+    dolfinx keeps only the cells of physical groups, each cell in one: no group, an entity
+    in two groups (dolfinx's own refusal is a traceback) or in none (its cells would be
+    dropped silently).
+    """
+    if not gmsh.model.getPhysicalGroups(dim):
+        return f"no {dim}D physical group (dolfinx keeps only the cells of physical groups)"
+    seen: dict[int, str] = {}
+    for _, tag in gmsh.model.getPhysicalGroups(dim):
+        group = gmsh.model.getPhysicalName(dim, tag) or str(tag)
+        for entity in map(int, gmsh.model.getEntitiesForPhysicalGroup(dim, tag)):
+            if entity in seen:
+                return (f"the {dim}D entity {entity} is in the physical groups "
+                        f"{seen[entity]!r} and {group!r} (each cell takes one group)")
+            seen[entity] = group
+    bare = [t for _, t in gmsh.model.getEntities(dim) if t not in seen]
+    if bare:
+        return (f"the {dim}D entit{'ies' if len(bare) > 1 else 'y'} "
+                f"{', '.join(map(str, bare))} {'are' if len(bare) > 1 else 'is'} in no "
+                "physical group (each cell takes one group)")
+    return None
 
 
 def threshold_field(h_fine: float, fine_radius: float, h_coarse: float, far: float, *,
