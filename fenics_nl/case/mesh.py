@@ -123,7 +123,11 @@ def _read(case: Case, comm: MPI.Comm) -> gmshio.MeshData:
 
 
 def _built(case: Case, action: str) -> str | None:
-    """The case's mesh in gmsh's model (rank 0): what is wrong with it, or None."""
+    """The case's mesh in gmsh's model (rank 0): what is wrong with it, or None.
+
+    A .msh is read; a .geo is meshed, after `mesh.size` and `mesh.refine_near` (whose
+    missing group is the message then).
+    """
     name = case.mesh_file.name
     said = gmsh_error(lambda: gmsh.open(str(case.mesh_file)))
     dim = gmsh.model.getDimension() if said is None else -1

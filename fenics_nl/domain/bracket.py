@@ -103,7 +103,12 @@ def bracket_mesh(comm: MPI.Comm, size: float | None = None, path: str | None = N
         error = comm.bcast(error, root=0)
         if error is not None:
             raise ValueError(error)
-        data = distributed(comm, 1.0, 3)  # in the file's own units
+        try:
+            data = distributed(comm, 1.0, 3)  # in the file's own units
+        except RuntimeError as err:  # dolfinx's other refusals (facets of prisms, say)
+            if comm.rank == 0 and gmsh.model.list():  # (raised on every rank alike)
+                gmsh.model.remove()
+            raise ValueError(f"cannot read mesh file {path}: {err}") from None
         check_cells(data.mesh, name=path)
     else:
         if comm.rank == 0:

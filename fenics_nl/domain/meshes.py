@@ -27,7 +27,7 @@ def start_model(name: str) -> None:
 
 
 def gmsh_error(step: Callable[[], object]) -> str | None:
-    """Run the gmsh call `step` with gmsh's log read: the first error it logged or raised.
+    """Run `step` (gmsh calls) with gmsh's log read: the first error it logged or raised.
 
     gmsh logs a corrupt file's error and raises on some only; with its terminal off
     (`start_model`) the user reads the error once, in the caller's sentence.
@@ -49,9 +49,11 @@ def gmsh_error(step: Callable[[], object]) -> str | None:
 def group_error(dim: int) -> str | None:
     """Why dolfinx cannot take the model's `dim`D cells as they are grouped, or None.
 
-    dolfinx keeps only the cells of physical groups, each cell in one: no group, an entity
-    in two groups (dolfinx's own refusal is a traceback) or in none (its cells would be
-    dropped silently).
+    dolfinx reads the cells of physical groups, each cell in exactly one: a file with no
+    group, an entity in two groups or in none is refused here, in a sentence that names
+    the groups and entities (dolfinx refuses the last two with a count of cells, and a cell
+    type met only outside the groups with a KeyError on rank 0 alone, the other ranks
+    waiting).
     """
     if not gmsh.model.getPhysicalGroups(dim):
         return f"no {dim}D physical group (dolfinx keeps only the cells of physical groups)"
