@@ -10,6 +10,12 @@ B. The size on 2 ranks: the 20k mesh's whole stroke with GMRES + GAMG (its Krylo
    measured in the docs from a run stopped at 73 % of it, reduction 0.307.)
 C. GAMG's smoother under GMRES on the 20k mesh's first 8 % (2 ranks): SOR, the library's
    choice for GMRES, against PETSc's Chebyshev (by option): Krylov iterations, solve time.
+D. What GAMG's iterations grow with where the side meets the walls (reduction > 0.3): the
+   20k mesh's whole stroke on 2 ranks (B's run) against the same stroke with the plastic
+   flow 50 times stiffer (H = 50 000: the tangent far from incompressible) and with the
+   penalty 10 times softer: Krylov iterations a Newton iteration of the converged steps,
+   before and after reduction 0.3, and a solve in the attempts of the steps that were cut.
+   (The other runs' physics differs: a diagnosis, not a variant.)
 
 Writes benchmarks/results/forging_3d.json and, with --update-docs, its section of
 docs/benchmarks.md.
@@ -66,15 +72,16 @@ def size_runs(quick):
     start = ("--reduction", "0.034", "--steps", "2")
     runs = [(1.2 if quick else 1.0, "gamg", ())] + [(1.2 if quick else 0.55, solver, start)
                                                     for solver in ("gamg", "lu")]
-    rows = []
+    rows, stroke = [], None
     for size, solver, extra in runs:
-        r = row(demo_run(2, "--size", size, "--linear-solver", solver, *extra), size=size,
-                linear_solver=solver, stroke=" ".join(extra) or "the demo's")
+        d = demo_run(2, "--size", size, "--linear-solver", solver, *extra)
+        stroke = stroke or d  # the first: the whole stroke, D's reference
+        r = row(d, size=size, linear_solver=solver, stroke=" ".join(extra) or "the demo's")
         say(f"size {size}, {solver}, {r['stroke']}: {r['dofs']} unknowns on 2 ranks, "
             f"{r['linear_solves']} linear solves, {r['per_linear_solve_s']:.2f} s each, "
             f"{r['solve_time_s']:.1f} s")
         rows.append(r)
-    return rows
+    return rows, stroke
 
 
 CHEBYSHEV = ("-forging_mg_levels_ksp_type", "chebyshev", "-forging_mg_levels_pc_type",
@@ -91,6 +98,44 @@ def smoother_runs(quick):
              "krylov_iterations": d["krylov_iterations"], "force": d["force"],
              "solve_phase_s": d["solve_phase_time_s"]}
         say(f"{smoother}: {r['krylov_iterations']} Krylov its, {r['solve_phase_s']:.2f} s")
+        rows.append(r)
+    return rows
+
+
+WALLS = 0.3  # the reduction from which the side presses the cavity's walls (20k mesh)
+CAUSES = (("the demo (B's run)", ()), ("H = 50 000 (50x)", ("--hardening", "50000")),
+          ("penalty 0.3 (1/10)", ("--penalty", "0.3")))
+
+
+def krylov_by_phase(d):
+    """Krylov iterations a Newton iteration of the converged steps, before and after WALLS."""
+    def ratio(steps):
+        return (sum(s["krylov_iterations"] for s in steps)
+                / max(sum(s["newton_iterations"] for s in steps), 1))
+    return (ratio([s for s in d["steps"] if s["reduction"] <= WALLS]),
+            ratio([s for s in d["steps"] if s["reduction"] > WALLS]))
+
+
+def cause_runs(quick, demo_stroke):
+    size = 1.2 if quick else 1.0
+    rows = []
+    for cause, extra in CAUSES:
+        d = demo_stroke if not extra else demo_run(2, "--size", size, "--linear-solver",
+                                                   "gamg", *extra)
+        before, after = krylov_by_phase(d)
+        # the attempts of the steps that were cut: the solves no converged step counts
+        cut_solves = d["linear_solves"] - sum(s["newton_iterations"] for s in d["steps"])
+        cut_krylov = d["krylov_iterations"] - sum(s["krylov_iterations"] for s in d["steps"])
+        r = {"run": cause, "dofs": d["dofs"], "newton_iterations": d["newton_iterations"],
+             "step_cuts": d["step_cuts"], "linear_solves": d["linear_solves"],
+             "krylov_per_newton_before_walls": before, "krylov_per_newton_at_walls": after,
+             "cut_attempt_solves": cut_solves,
+             "krylov_per_cut_attempt_solve": cut_krylov / max(cut_solves, 1),
+             "force": d["force"], "solve_time_s": d["solve_time_s"]}
+        say(f"{cause}: {before:.1f} Krylov its a Newton iteration before the walls, "
+            f"{after:.1f} at them, {r['krylov_per_cut_attempt_solve']:.1f} in the "
+            f"{cut_solves} solves of cut steps; {r['linear_solves']} solves, "
+            f"{r['solve_time_s']:.1f} s")
         rows.append(r)
     return rows
 
@@ -116,13 +161,28 @@ def table(out):
         lines.append(f"| {r['smoother']} | {r['dofs']} | {r['newton_iterations']} | "
                      f"{r['krylov_iterations']} | {r['solve_phase_s']:.2f} | "
                      f"{r['force']:.10g} |")
+    lines += ["", f"GMRES + GAMG on the 20k mesh's whole stroke, 2 ranks: Krylov iterations "
+              f"a Newton iteration (converged steps) before the side meets the walls "
+              f"(reduction <= {WALLS}) and after:", "",
+              "| run | unknowns | Krylov its a Newton it., before | after | in the cut "
+              "steps' attempts (their solves) | Newton its (cuts) | linear solves | "
+              "solve time (s) | F |", "|" + "---|" * 9]
+    for r in out["causes"]:
+        lines.append(f"| {r['run']} | {r['dofs']} | "
+                     f"{r['krylov_per_newton_before_walls']:.1f} | "
+                     f"{r['krylov_per_newton_at_walls']:.1f} | "
+                     f"{r['krylov_per_cut_attempt_solve']:.1f} ({r['cut_attempt_solves']}) | "
+                     f"{r['newton_iterations']} "
+                     f"({r['step_cuts']}) | {r['linear_solves']} | {r['solve_time_s']:.1f} | "
+                     f"{r['force']:.6g} |")
     return "\n".join(lines)
 
 
 def main():
     args = options(__doc__, "size 2.0 only, and the 2-rank runs at size 1.2")
-    out = {"machine": machine(2), "mesh": mesh_runs(args.quick),
-           "size": size_runs(args.quick), "smoother": smoother_runs(args.quick)}
+    sizes, stroke = size_runs(args.quick)
+    out = {"machine": machine(2), "mesh": mesh_runs(args.quick), "size": sizes,
+           "smoother": smoother_runs(args.quick), "causes": cause_runs(args.quick, stroke)}
     publish("forging_3d", out, table, args, say)
 
 

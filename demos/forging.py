@@ -325,7 +325,8 @@ def record(t, result):
             "force_flat_die_exact": forming.frictionless_force(r, R0, material.yield_stress,
                                                                args.E),
             "under_ceiling_alone": R0 / math.sqrt(1 - r) < b - w,
-            "newton_iterations": result.iterations}
+            "newton_iterations": result.iterations,
+            "krylov_iterations": result.work.krylov_iterations}
     history.append(step)
     cli.converged_step(step, lambda: [u, *material.output_fields()])
     say(f"  reduction {r:.3f}: F = {step['force']:.6g} (flat die, frictionless "
