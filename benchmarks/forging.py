@@ -3,11 +3,13 @@
 A. The mesh: the demo's defaults (f = 0.2, 42 %) with tetrahedra of 2.0, 1.5 and 1.0 on one
    rank: the final load, die fill, flash, the Newton iterations, cuts and time, where the
    time went (assembly, factorization, solve).
+   The coarse mesh again with 40 and 80 steps: the path's dependence on the step.
 B. The size on 2 ranks: the 20k mesh's whole stroke with GMRES + GAMG (its Krylov
-   iterations where the flash forms); tetrahedra of 0.55 (108 738 unknowns) over the first
-   8 % of the stroke, with GMRES + GAMG and with MUMPS LU: the time per Newton iteration of
-   each, on the same mesh and steps. (The whole stroke there takes far beyond 10 minutes:
-   measured in the docs from a run stopped at 73 % of it, reduction 0.307.)
+   iterations where the flash forms), in the demo's 20 steps and in 40; tetrahedra of 0.55
+   (108 738 unknowns) over the first 8 % of the stroke, with GMRES + GAMG and with MUMPS
+   LU: the time per Newton iteration of each, on the same mesh and steps; and the whole
+   stroke there in 40 steps with GMRES + GAMG (about 13 minutes; in 20 steps it takes far
+   longer, from the steps cut where the side meets the walls).
 C. GAMG's smoother under GMRES on the 20k mesh's first 8 % (2 ranks): SOR, the library's
    choice for GMRES, against PETSc's Chebyshev (by option): Krylov iterations, solve time.
 D. What GAMG's iterations grow with where the side meets the walls (reduction > 0.3): the
@@ -58,9 +60,11 @@ def row(d, **given):
 
 def mesh_runs(quick):
     rows = []
-    for size in ((2.0,) if quick else (2.0, 1.5, 1.0)):
-        r = row(demo_run(1, "--size", size), size=size, linear_solver="lu",
-                stroke="the demo's")
+    runs = [(2.0, ())] if quick else [(2.0, ()), (1.5, ()), (1.0, ()), (2.0, ("--steps", "40")),
+                                      (2.0, ("--steps", "80"))]
+    for size, extra in runs:
+        r = row(demo_run(1, "--size", size, *extra), size=size, linear_solver="lu",
+                flags=" ".join(extra) or "the demo's")
         say(f"size {size}: {r['dofs']} unknowns, F = {r['force']:.6g}, fill "
             f"{r['die_fill']:.3f}, {r['newton_iterations']} Newton, {r['step_cuts']} cuts, "
             f"{r['solve_time_s']:.1f} s")
@@ -69,15 +73,16 @@ def mesh_runs(quick):
 
 
 def size_runs(quick):
-    start = ("--reduction", "0.034", "--steps", "2")
-    runs = [(1.2 if quick else 1.0, "gamg", ())] + [(1.2 if quick else 0.55, solver, start)
-                                                    for solver in ("gamg", "lu")]
+    start, fine = ("--reduction", "0.034", "--steps", "2"), ("--steps", "40")
+    small, large = (1.2, 1.2) if quick else (1.0, 0.55)
+    runs = [(small, "gamg", ()), (small, "gamg", fine), (large, "gamg", start),
+            (large, "lu", start), (large, "gamg", fine)]
     rows, stroke = [], None
     for size, solver, extra in runs:
         d = demo_run(2, "--size", size, "--linear-solver", solver, *extra)
         stroke = stroke or d  # the first: the whole stroke, D's reference
-        r = row(d, size=size, linear_solver=solver, stroke=" ".join(extra) or "the demo's")
-        say(f"size {size}, {solver}, {r['stroke']}: {r['dofs']} unknowns on 2 ranks, "
+        r = row(d, size=size, linear_solver=solver, flags=" ".join(extra) or "the demo's")
+        say(f"size {size}, {solver}, {r['flags']}: {r['dofs']} unknowns on 2 ranks, "
             f"{r['linear_solves']} linear solves, {r['per_linear_solve_s']:.2f} s each, "
             f"{r['solve_time_s']:.1f} s")
         rows.append(r)
@@ -141,7 +146,7 @@ def cause_runs(quick, demo_stroke):
 
 
 def table(out):
-    lines = ["| tetrahedra | unknowns | ranks | linear solver | stroke | F | die fill | "
+    lines = ["| tetrahedra | unknowns | ranks | linear solver | flags | F | die fill | "
              "flash reach | Newton its (cuts) | linear solves | Krylov its per solve | "
              "s per linear solve | solve time (s) |", "|" + "---|" * 13]
     for r in out["mesh"] + out["size"]:
@@ -149,7 +154,7 @@ def table(out):
                   if r["linear_solver"] == "gamg" else "")
         lines.append(
             f"| {r['size']:g} | {r['dofs']} | {r['ranks']} | {r['linear_solver']} | "
-            f"{r['stroke']} | {r['force']:.5g} | {r['die_fill']:.3f} | "
+            f"{r['flags']} | {r['force']:.5g} | {r['die_fill']:.3f} | "
             f"{r['flash_reach']:.3g} | {r['newton_iterations']} ({r['step_cuts']}) | "
             f"{r['linear_solves']} | {krylov} | {r['per_linear_solve_s']:.2f} | "
             f"{r['solve_time_s']:.1f} |")

@@ -52,11 +52,11 @@ def test_the_forging_fills_the_die_and_flashes(demo):
     # unknowns, the flash's reach 1.03–1.07, the load within 0.9 %; here 2205 unknowns)
     d = demo.json("forging.py")
     assert d["reduction"] == pytest.approx(0.42, rel=1e-12)
-    assert d["die_fill"] > 0.8 and d["flash_reach"] > 0.8  # 0.929, 1.01
+    assert d["die_fill"] > 0.8 and d["flash_reach"] > 0.8  # 0.928, 1.01
     assert 0.005 < d["flash_fraction"] < 0.05  # 0.013
     assert d["force"] > 1.3 * forming.frictionless_force(
-        0.42, 10.0, FiniteJ2Plasticity(E, NU, sigma0=400.0, H=1000.0).yield_stress, E)  # 1.48
-    # the flash's slab estimate, with the flash's own yield stress: measured 1.10
+        0.42, 10.0, FiniteJ2Plasticity(E, NU, sigma0=400.0, H=1000.0).yield_stress, E)  # 1.50
+    # the flash's slab estimate, with the flash's own yield stress: measured 1.12
     assert 0.8 < d["force_over_slab"] < 1.4
     assert all(b > a for a, b in zip(d["force_history"][:-1], d["force_history"][1:],
                                      strict=True))
