@@ -154,8 +154,8 @@ def _sor_smoothing(prefix: str) -> None:
 
     PETSc's default smoother, Chebyshev on Jacobi, is built on bounds of a real positive
     spectrum, which a non-symmetric (friction) or indefinite tangent does not have. On the
-    3D forging's friction tangent (19632 unknowns, 2 ranks, its first 22 Newton iterations)
-    GMRES took 448 iterations with SOR against 659 with Chebyshev, 3.5 s against 4.8 s
+    3D forging's friction tangent (19632 unknowns, 2 ranks, its first 23 Newton iterations)
+    GMRES took 472 iterations with SOR against 694 with Chebyshev, 2.9 s against 3.6 s
     (benchmarks/forging.py, its smoother table).
     Set in the options database (the levels exist only when GAMG sets up): the prefix's.
     """

@@ -90,7 +90,8 @@ def forcing_term(relative_residual: float, threshold_ratio: float = 0.0) -> floa
     either: the correction then leaves a linear residual a tenth of that threshold, and
     Newton's own quadratic term is smaller still near the solution, so the digits beyond
     buy nothing (Kelley's floor η ≥ c τ/‖R_k‖). On the 3D forging's first 22 iterations
-    (19632 unknowns, Newton to 1e-8) GMRES took 448 Krylov iterations with it, 648 without.
+    (19632 unknowns, Newton to 1e-8, commit a4a330f) GMRES took 448 Krylov iterations with
+    it, 648 without.
 
     Args:
         relative_residual: ‖R_k‖/‖R_0‖.
