@@ -28,7 +28,8 @@
 # $\varepsilon$ = `--slip` $\cdot |\Delta Z|$, the die's travel in the step, so that the law
 # compares the slip's rate with the die's and does not change with the steps (an $\varepsilon$
 # fixed in length made the die fill 0.880, 0.901, 0.939 in 20, 40, 80 steps at 3417
-# unknowns; in rate form 0.879, 0.888, 0.890: `benchmarks/forging.py`). (The project's
+# unknowns; in rate form 0.879, 0.888, 0.890: `benchmarks/results/forging_3d_fixed_slip.json`
+# against `forging_3d.json`). (The project's
 # active-set contact prescribes $u_n = \gamma$ along one coordinate axis; a die with walls
 # has a normal that turns, which the penalty's UFL gap carries: Forge3's choice too.)
 #
