@@ -25,7 +25,7 @@
 # $p = \kappa\langle -g\rangle$. **Friction**: Coulomb's law regularized over a slip
 # $\varepsilon$, $t_f = -f p\, \Delta s_t / \sqrt{|\Delta s_t|^2 + \varepsilon^2}$,
 # $\Delta s_t$ the tangential slip on the die since the step's start, in rate form:
-# $\varepsilon$ = `--slip` $\cdot |\Delta Z|$, the die's travel in the step, so that the law
+# $\varepsilon$ = `--slip-ratio` $\cdot |\Delta Z|$, the die's travel in the step, so that the law
 # compares the slip's rate with the die's and does not change with the steps (an $\varepsilon$
 # fixed in length made the die fill 0.880, 0.901, 0.939 in 20, 40, 80 steps at 3417
 # unknowns; in rate form 0.879, 0.888, 0.890: `benchmarks/results/forging_3d_fixed_slip.json`
@@ -95,8 +95,8 @@ class ForgingParameters(Parameters):
                                 "the dies' cavity outline",
                          "plot": "the load against the stroke, with the frictionless "
                                  "closed form of the flat start and the slab estimate",
-                         "output": "the displacement, the cumulated plastic strain and "
-                                   "the contact pressure"}
+                         "output": "the displacement and the cumulated plastic strain "
+                                   "(each cell's largest)"}
 
     friction: float = number(0.2, "Coulomb friction coefficient f on the dies (0: "
                              "frictionless)", at_least=0)
@@ -122,9 +122,10 @@ class ForgingParameters(Parameters):
     size: float = number(2.5, "tetrahedra's size (P2 displacements)", unit="length",
                          above=0)
     penalty: float = number(3.0, "the penalty's stiffness kappa, in E/size", above=0)
-    slip: float = number(0.05, "friction's regularization: the slip below which it sticks "
-                         "elastically, as a fraction of the die's travel in the step (a "
-                         "rate form: the law does not change with --steps)", above=0)
+    slip_ratio: float = number(0.05, "friction's regularization: the slip below which it "
+                               "sticks elastically, as a fraction of the die's travel in "
+                               "the step (a rate form: the law does not change with "
+                               "--steps)", above=0)
     linear_solver: str = choice("lu", ["lu", "gamg"], "MUMPS LU, or GMRES + GAMG (the "
                                 "rigid-body modes as near-nullspace): cheaper per Newton "
                                 "iteration from about 50k unknowns")
@@ -235,7 +236,7 @@ X = ufl.SpatialCoordinate(msh)
 gap, n = penalty.die_gap(X + u, cavity, Z)
 # the parameters as Constants: one compiled form for every f, κ and ε
 kappa = fem.Constant(msh, args.penalty * args.E / args.size)
-f, slip_ratio = fem.Constant(msh, args.friction), fem.Constant(msh, args.slip)
+f, slip_ratio = fem.Constant(msh, args.friction), fem.Constant(msh, args.slip_ratio)
 eps = slip_ratio * abs(Z - Z_start)  # the rate form: a fraction of the die's travel
 p_contact = penalty.pressure(gap, kappa)
 slip = u - u_start - (Z - Z_start) * ufl.as_vector([0, 0, 1])
@@ -255,7 +256,8 @@ press_force = p_contact * n[2] - t_friction[2]  # the die's vertical load per un
 # full one; each starts from the extrapolation of the last two converged states (the
 # driver's predictor: without it, the first iterate of a step presses the side's top edge
 # far into the die and Newton crawls back), and a step that fails is cut in half. A
-# converged step commits the plastic state and the slip's origin.
+# converged step commits the plastic state, measures the die's load (friction's part needs
+# the step's slip) and moves the slip's origin to its state.
 
 # +
 newton = NewtonSolver(residual, u, supports, rtol=1e-8, atol=1e-8,
@@ -275,10 +277,10 @@ def set_stroke(t):
 
 
 def commit():
-    """A converged step: its load (friction's part needs the step's slip: measured before
-    the slip's origin moves), the plastic state, and the slip's origin at this state."""
-    load["now"] = comm.allreduce(fem.assemble_scalar(forms["load"]))
+    """A converged step: the plastic state (it may refuse the step), the load (friction's
+    part needs the step's slip: before the slip's origin moves), the slip's origin."""
     material.commit(u, "3d")
+    load["now"] = comm.allreduce(fem.assemble_scalar(forms["load"]))
     u_start.x.array[:] = u.x.array
     Z_start.value = float(Z.value)
 # -
@@ -314,7 +316,7 @@ nodes = V.tabulate_dof_coordinates()
 
 
 def measured():
-    """The load, die fill, flash volume and reach, land area and volume now."""
+    """The load (`commit`'s), die fill, flash volume and reach, land area and volume."""
     values = {k: comm.allreduce(fem.assemble_scalar(f)) for k, f in forms.items()
               if k != "load"}  # (the load: `commit`'s, the step's friction in it)
     x = nodes + u.x.array.reshape(-1, 3)

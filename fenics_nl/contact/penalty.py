@@ -73,7 +73,8 @@ def friction_traction(p, n, slip, friction, regularization):
         n: the die's unit normal.
         slip: Δs, the displacement relative to the die since the step's start.
         friction: the coefficient f.
-        regularization: ε, the slip below which the law is a spring (a length).
+        regularization: ε > 0, the slip below which the law is a spring (a length; at
+            ε = 0 no slip gives 0/0).
 
     Returns:
         The friction traction on the body (a UFL vector).
