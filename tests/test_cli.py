@@ -42,6 +42,19 @@ def test_a_dolfinx_script_that_imports_dolfinx_first_runs_in_the_venv(tmp_path):
     assert proc.returncode == 0 and proc.stdout.strip() == "8", proc.stderr
 
 
+def test_a_flag_is_taken_whole(capsys):
+    # argparse's abbreviations would read an old flag as a new one: `--slip` (a length)
+    # became `--slip-ratio` in demos/forging.py, and `--slip 0.01` ran as a ratio
+    from fenics_nl.io import flags
+
+    p = flags.parser("x")
+    p.add_argument("--slip-ratio", type=float, default=0.05)
+    with pytest.raises(SystemExit) as exc:
+        parse_with_petsc_options(p, ["--slip", "0.01"])
+    assert exc.value.code == 2 and "unrecognized arguments: --slip" in capsys.readouterr().err
+    assert parse_with_petsc_options(p, ["--slip-ratio", "0.01"])[0].slip_ratio == 0.01
+
+
 def test_an_old_spelling_is_read_said_once_and_never_written(tmp_path, demo):
     # one vocabulary (fenics_nl.vocabulary): plane_strain, bfgs, lu/gamg; the old spellings
     # still read, each with one note, and the outputs use the new one

@@ -37,7 +37,15 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
 
 class ArgumentParser(argparse.ArgumentParser):
-    """Bad input is one line on stderr (`--help` has the usage), exit status 2."""
+    """Bad input is one line on stderr (`--help` has the usage), exit status 2.
+
+    A flag is taken whole: argparse's abbreviations would let an old or misspelt flag
+    (`--slip` once a length, now `--slip-ratio`) mean another one silently.
+    """
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         """Print `prog: error: message` alone (rank 0) and exit with status 2."""
