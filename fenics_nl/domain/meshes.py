@@ -47,7 +47,7 @@ def gmsh_error(step: Callable[[], object]) -> str | None:
 
 
 def group_error(dim: int) -> str | None:
-    """Why dolfinx cannot take the model's `dim`D cells as they are grouped, or None.
+    """Why dolfinx cannot take the model's cells of dimension `dim` as grouped, or None.
 
     dolfinx reads the cells of physical groups, each cell in exactly one: a file with no
     group, an entity in two groups or in none is refused here, in a sentence that names
