@@ -8,7 +8,7 @@ B. The size on 2 ranks: the 20k mesh's whole stroke with GMRES + GAMG (its Krylo
    iterations where the flash forms), in the demo's 20 steps and in 40; tetrahedra of 0.55
    (108 738 unknowns) over the first 8 % of the stroke, with GMRES + GAMG and with MUMPS
    LU: the time per Newton iteration of each, on the same mesh and steps; and the whole
-   stroke there in 40 steps with GMRES + GAMG (about 13 minutes; in 20 steps it takes far
+   stroke there in 40 steps with GMRES + GAMG (about 11 minutes; in 20 steps it takes far
    longer, from the steps cut where the side meets the walls).
 C. GAMG's smoother under GMRES on the 20k mesh's first 8 % (2 ranks): SOR, the library's
    choice for GMRES, against PETSc's Chebyshev (by option): Krylov iterations, solve time.

@@ -280,7 +280,7 @@ def commit():
     """A converged step: the plastic state (it may refuse the step), the load (friction's
     part needs the step's slip: before the slip's origin moves), the slip's origin."""
     material.commit(u, "3d")
-    load["now"] = comm.allreduce(fem.assemble_scalar(forms["load"]))
+    load["now"] = comm.allreduce(fem.assemble_scalar(load_form))
     u_start.x.array[:] = u.x.array
     Z_start.value = float(Z.value)
 # -
@@ -301,9 +301,9 @@ s_now = inside_outline(x_now[0], x_now[1])
 plan = ufl.dot(J * ufl.inv(F_def).T * ufl.FacetNormal(msh), ufl.as_vector([0, 0, 1]))
 touching = ufl.conditional(ufl.lt(gap, 0), 1, 0)
 on_ceiling = ufl.conditional(ufl.ge(s_now, w), 1, 0)
-load = {}  # the converged step's load (`commit`)
-forms = {"load": fem.form(4 * press_force * ds),
-         "ceiling": fem.form(touching * on_ceiling * plan * ds),
+# the die's load: assembled in `commit`, while the step's slip (friction's part) is there
+load_form, load = fem.form(4 * press_force * ds), {}
+forms = {"ceiling": fem.form(touching * on_ceiling * plan * ds),
          "land": fem.form(touching * ufl.conditional(ufl.le(s_now, 0), 1, 0) * plan * ds),
          "flash": fem.form(8 * ufl.conditional(ufl.lt(s_now, 0), J, 0) * dx),
          "flash_p": fem.form(8 * ufl.conditional(ufl.lt(s_now, 0), J, 0)
@@ -317,8 +317,7 @@ nodes = V.tabulate_dof_coordinates()
 
 def measured():
     """The load (`commit`'s), die fill, flash volume and reach, land area and volume."""
-    values = {k: comm.allreduce(fem.assemble_scalar(f)) for k, f in forms.items()
-              if k != "load"}  # (the load: `commit`'s, the step's friction in it)
+    values = {k: comm.allreduce(fem.assemble_scalar(f)) for k, f in forms.items()}
     x = nodes + u.x.array.reshape(-1, 3)
     # −s: how far beyond the outline, the distance across it (along x, b/a of it)
     outside = b * (np.hypot(x[:, 0] / a, x[:, 1] / b) - 1)
